@@ -1,0 +1,15 @@
+//! Host-side library of the `compensator` command-line tool: parameter
+//! files, temperature lists, CSV output, calibration against the paper's
+//! tables, design sizing and the dynamic-model commands.
+//!
+//! The binary (`src/main.rs`) is a thin argument parser over these modules,
+//! so that the tests can call the same code.
+
+pub mod commands;
+pub mod csv;
+pub mod lsq;
+pub mod paper;
+pub mod params_file;
+pub mod temps;
+
+pub use params_file::{LoadError, load, parse};

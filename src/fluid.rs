@@ -1,0 +1,155 @@
+//! Oil properties as functions of temperature (MODEL.md section 2).
+//!
+//! * Kinematic viscosity by Walther / ASTM D341:
+//!   `log10(log10(nu_cSt + 0.7)) = a - b log10(T_K)`.
+//! * Density `rho(t) = rho_15 / (1 + e (t - 15))`.
+//! * Dynamic viscosity `mu = nu rho`.
+//!
+//! ASTM D341's two-constant form holds down to 2 cSt; below that (very hot
+//! or very thin oil) the evaluation is refused with
+//! [`ModelError::OutOfRange`], as it is where the double exponential
+//! overflows (very cold oil).
+//!
+//! Cost (f32, Cortex-M4F): one `log10`, two `exp10`, a handful of
+//! multiplications: about 250 instructions.
+
+use crate::error::{ModelError, finite};
+use crate::scalar::Float;
+
+/// Offset between degrees Celsius and kelvin.
+pub const KELVIN_OFFSET: f64 = 273.15;
+/// Lowest kinematic viscosity for which ASTM D341's form holds [cSt].
+pub const WALTHER_MIN_CST: f64 = 2.0;
+/// Highest kinematic viscosity accepted [cSt] (beyond: the oil is a solid
+/// for any hydraulic purpose, and `f32` loses the double exponential).
+pub const WALTHER_MAX_CST: f64 = 1.0e6;
+
+/// The oil's temperature laws.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Oil<T> {
+    /// Walther constant `a` [-].
+    pub walther_a: T,
+    /// Walther slope `b` [-].
+    pub walther_b: T,
+    /// Density at 15 C [kg/m^3].
+    pub density_15: T,
+    /// Volumetric expansion coefficient `e` [1/K].
+    pub expansion: T,
+    /// Effective bulk modulus `beta_e` [Pa].
+    pub bulk_modulus: T,
+}
+
+/// The oil's state at one temperature.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FluidState<T> {
+    /// Temperature [C].
+    pub temperature: T,
+    /// Kinematic viscosity `nu` [m^2/s].
+    pub kinematic_viscosity: T,
+    /// Density `rho` [kg/m^3].
+    pub density: T,
+    /// Dynamic viscosity `mu = nu rho` [Pa s].
+    pub dynamic_viscosity: T,
+}
+
+/// A quantity with its first two temperature derivatives.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Derivatives<T> {
+    /// The value.
+    pub value: T,
+    /// First derivative with respect to temperature [unit/K].
+    pub d1: T,
+    /// Second derivative [unit/K^2].
+    pub d2: T,
+}
+
+impl<T: Float> Oil<T> {
+    /// Walther's inner variables at `t` [C]: `(Z = nu_cSt + 0.7, w = log10 Z, T_K)`.
+    fn walther(&self, t: T) -> Result<(T, T, T), ModelError> {
+        let t = finite(t, "temperature")?;
+        let tk = t + T::from_f64(KELVIN_OFFSET);
+        if !(tk > T::ZERO) {
+            return Err(ModelError::OutOfRange("temperature"));
+        }
+        let u = self.walther_a - self.walther_b * tk.log10();
+        let w = u.exp10();
+        let z = w.exp10();
+        if !z.is_finite() || z > T::from_f64(WALTHER_MAX_CST + 0.7) {
+            return Err(ModelError::OutOfRange(
+                "temperature (viscosity above the Walther range)",
+            ));
+        }
+        if !(z >= T::from_f64(WALTHER_MIN_CST + 0.7)) {
+            return Err(ModelError::OutOfRange(
+                "temperature (viscosity below 2 cSt)",
+            ));
+        }
+        Ok((z, w, tk))
+    }
+
+    /// Kinematic viscosity `nu(t)` [m^2/s].
+    pub fn kinematic_viscosity(&self, t: T) -> Result<T, ModelError> {
+        let (z, _, _) = self.walther(t)?;
+        Ok((z - T::from_f64(0.7)) * T::from_f64(1e-6))
+    }
+
+    /// `nu`, `dnu/dt`, `d2nu/dt2` [m^2/s, m^2/(s K), m^2/(s K^2)], closed form:
+    /// with `Z = nu_cSt + 0.7`, `w = log10 Z`,
+    /// `nu' = -b ln10 Z w / T_K`, `nu'' = -b ln10 w (nu'/T_K - Z (b + 1) / T_K^2)`.
+    pub fn kinematic_viscosity_derivatives(&self, t: T) -> Result<Derivatives<T>, ModelError> {
+        let (z, w, tk) = self.walther(t)?;
+        let ln10 = T::from_f64(core::f64::consts::LN_10);
+        let b = self.walther_b;
+        let d1 = -b * ln10 * z * w / tk;
+        let d2 = -b * ln10 * w * (d1 / tk - z * (b + T::ONE) / (tk * tk));
+        let cst = T::from_f64(1e-6);
+        Ok(Derivatives {
+            value: (z - T::from_f64(0.7)) * cst,
+            d1: d1 * cst,
+            d2: d2 * cst,
+        })
+    }
+
+    /// The factor `1 + e (t - 15)`; positive for every validated parameter
+    /// set and temperature above -85 C.
+    fn expansion_factor(&self, t: T) -> Result<T, ModelError> {
+        let f = T::ONE + self.expansion * (t - T::from_f64(15.0));
+        if f > T::ZERO {
+            Ok(f)
+        } else {
+            Err(ModelError::OutOfRange("temperature (density law)"))
+        }
+    }
+
+    /// Density `rho(t)` [kg/m^3].
+    pub fn density(&self, t: T) -> Result<T, ModelError> {
+        let t = finite(t, "temperature")?;
+        Ok(self.density_15 / self.expansion_factor(t)?)
+    }
+
+    /// `rho`, `drho/dt`, `d2rho/dt2`: `rho' = -e rho / f`, `rho'' = 2 e^2 rho / f^2`
+    /// with `f = 1 + e (t - 15)`.
+    pub fn density_derivatives(&self, t: T) -> Result<Derivatives<T>, ModelError> {
+        let t = finite(t, "temperature")?;
+        let f = self.expansion_factor(t)?;
+        let rho = self.density_15 / f;
+        let r = self.expansion / f;
+        Ok(Derivatives {
+            value: rho,
+            d1: -r * rho,
+            d2: T::from_f64(2.0) * r * r * rho,
+        })
+    }
+
+    /// Viscosity, density and dynamic viscosity at `t` [C].
+    pub fn state(&self, t: T) -> Result<FluidState<T>, ModelError> {
+        let nu = self.kinematic_viscosity(t)?;
+        let rho = self.density(t)?;
+        Ok(FluidState {
+            temperature: t,
+            kinematic_viscosity: nu,
+            density: rho,
+            dynamic_viscosity: finite(nu * rho, "dynamic viscosity")?,
+        })
+    }
+}

@@ -1,0 +1,445 @@
+//! The scalar types the core is generic over.
+//!
+//! * [`Real`]: what the fixed-step dynamics needs (ring operations, division,
+//!   square root, comparisons). Implemented for `f32`, `f64` and the
+//!   saturating fixed-point newtype [`Fix`].
+//! * [`Float`]: adds the transcendental functions the fluid-property laws need
+//!   (Walther's double exponential). Implemented for `f32` and `f64` only;
+//!   fluid properties are evaluated in floating point at the sensor rate and
+//!   handed to the fixed-point integrator as dimensionless coefficients.
+//!
+//! Cost notes (Cortex-M4F): `f32` square roots use the FPU's `VSQRT.F32`
+//! (14 cycles, one instruction) through inline assembly; `libm::sqrtf` would
+//! be a software routine of ~40 instructions. `exp`/`ln` come from `libm`
+//! (roughly 40-80 instructions each in `f32`, correctly rounded to ~1 ulp).
+//! `micromath`'s approximations are not used for the fluid laws: Walther's
+//! double exponential amplifies their ~1e-4 relative error about tenfold.
+
+use core::fmt::Debug;
+use core::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
+
+/// Arithmetic needed by the fixed-step integrator and the closed forms.
+///
+/// Every operation is total: no implementation panics on any input. For the
+/// floating-point types non-finite values propagate and are caught by the
+/// callers' checks; the fixed-point type saturates.
+pub trait Real:
+    Copy
+    + Debug
+    + PartialOrd
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + SubAssign
+    + MulAssign
+{
+    /// Additive identity.
+    const ZERO: Self;
+    /// Multiplicative identity.
+    const ONE: Self;
+    /// A short name for reports (`"f32"`, `"I16F16"`...).
+    const NAME: &'static str;
+
+    /// Conversion from a double (rounds; saturates for fixed point).
+    fn from_f64(v: f64) -> Self;
+    /// Conversion to a double (exact for all implementations).
+    fn to_f64(self) -> f64;
+    /// Square root; returns zero for negative input (and NaN for NaN in
+    /// floating point).
+    fn sqrt(self) -> Self;
+    /// Absolute value.
+    fn abs(self) -> Self;
+    /// `false` for NaN and infinities; always `true` for fixed point.
+    fn is_finite(self) -> bool;
+    /// The smallest positive value that can be used as a divisor safely
+    /// (the resolution for fixed point, `MIN_POSITIVE` for floats).
+    fn tiny() -> Self;
+
+    /// Larger of two values (the first one if they compare unordered).
+    #[inline]
+    fn max(self, other: Self) -> Self {
+        if other > self { other } else { self }
+    }
+    /// Smaller of two values (the first one if they compare unordered).
+    #[inline]
+    fn min(self, other: Self) -> Self {
+        if other < self { other } else { self }
+    }
+    /// `self` limited to `[lo, hi]`.
+    #[inline]
+    fn clamp_to(self, lo: Self, hi: Self) -> Self {
+        self.max(lo).min(hi)
+    }
+    /// Square.
+    #[inline]
+    fn sq(self) -> Self {
+        self * self
+    }
+}
+
+/// Transcendental functions for the fluid-property laws (floating point only).
+pub trait Float: Real {
+    /// Natural logarithm.
+    fn ln(self) -> Self;
+    /// Base-10 logarithm.
+    fn log10(self) -> Self;
+    /// `e^self`.
+    fn exp(self) -> Self;
+    /// `10^self`.
+    fn exp10(self) -> Self;
+    /// `self^p`.
+    fn powf(self, p: Self) -> Self;
+    /// Not-a-number (to report "no value" in flagged outputs).
+    fn nan() -> Self;
+    /// `true` for NaN.
+    fn is_nan(self) -> bool;
+}
+
+/// Hardware square root on the Cortex-M4F FPU.
+#[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+#[inline(always)]
+fn sqrt_f32(x: f32) -> f32 {
+    let r: f32;
+    // SAFETY: VSQRT.F32 only reads and writes the given FPU registers.
+    unsafe {
+        core::arch::asm!("vsqrt.f32 {0}, {1}", out(sreg) r, in(sreg) x,
+            options(pure, nomem, nostack, preserves_flags));
+    }
+    r
+}
+
+#[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
+#[inline(always)]
+fn sqrt_f32(x: f32) -> f32 {
+    libm::sqrtf(x)
+}
+
+impl Real for f32 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    const NAME: &'static str = "f32";
+    #[inline]
+    fn from_f64(v: f64) -> Self {
+        v as f32
+    }
+    #[inline]
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
+    #[inline]
+    fn sqrt(self) -> Self {
+        if self > 0.0 {
+            sqrt_f32(self)
+        } else if self.is_nan() {
+            self
+        } else {
+            0.0
+        }
+    }
+    #[inline]
+    fn abs(self) -> Self {
+        libm::fabsf(self)
+    }
+    #[inline]
+    fn is_finite(self) -> bool {
+        f32::is_finite(self)
+    }
+    #[inline]
+    fn tiny() -> Self {
+        f32::MIN_POSITIVE
+    }
+}
+
+impl Float for f32 {
+    #[inline]
+    fn ln(self) -> Self {
+        libm::logf(self)
+    }
+    #[inline]
+    fn log10(self) -> Self {
+        libm::log10f(self)
+    }
+    #[inline]
+    fn exp(self) -> Self {
+        libm::expf(self)
+    }
+    #[inline]
+    fn exp10(self) -> Self {
+        libm::exp10f(self)
+    }
+    #[inline]
+    fn powf(self, p: Self) -> Self {
+        libm::powf(self, p)
+    }
+    #[inline]
+    fn nan() -> Self {
+        f32::NAN
+    }
+    #[inline]
+    fn is_nan(self) -> bool {
+        f32::is_nan(self)
+    }
+}
+
+impl Real for f64 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    const NAME: &'static str = "f64";
+    #[inline]
+    fn from_f64(v: f64) -> Self {
+        v
+    }
+    #[inline]
+    fn to_f64(self) -> f64 {
+        self
+    }
+    #[inline]
+    fn sqrt(self) -> Self {
+        if self > 0.0 {
+            libm::sqrt(self)
+        } else if self.is_nan() {
+            self
+        } else {
+            0.0
+        }
+    }
+    #[inline]
+    fn abs(self) -> Self {
+        libm::fabs(self)
+    }
+    #[inline]
+    fn is_finite(self) -> bool {
+        f64::is_finite(self)
+    }
+    #[inline]
+    fn tiny() -> Self {
+        f64::MIN_POSITIVE
+    }
+}
+
+impl Float for f64 {
+    #[inline]
+    fn ln(self) -> Self {
+        libm::log(self)
+    }
+    #[inline]
+    fn log10(self) -> Self {
+        libm::log10(self)
+    }
+    #[inline]
+    fn exp(self) -> Self {
+        libm::exp(self)
+    }
+    #[inline]
+    fn exp10(self) -> Self {
+        libm::exp10(self)
+    }
+    #[inline]
+    fn powf(self, p: Self) -> Self {
+        libm::pow(self, p)
+    }
+    #[inline]
+    fn nan() -> Self {
+        f64::NAN
+    }
+    #[inline]
+    fn is_nan(self) -> bool {
+        f64::is_nan(self)
+    }
+}
+
+pub use fixed_point::{Fix, Q12_20, Q16_16};
+
+mod fixed_point {
+    use super::*;
+    use fixed::FixedI32;
+    use fixed::types::extra::LeEqU32;
+
+    /// Saturating, panic-free fixed-point scalar on 32 bits with `F`
+    /// fractional bits (`fixed::FixedI32<F>` underneath).
+    ///
+    /// Every operation saturates at the type's range instead of panicking or
+    /// wrapping: division by zero gives the saturated value with the sign of
+    /// the dividend (zero for `0/0`), the square root of a negative is zero.
+    #[repr(transparent)]
+    pub struct Fix<F: LeEqU32>(pub FixedI32<F>);
+
+    // Manual impls: derives would demand the same traits of the marker `F`.
+    impl<F: LeEqU32> Clone for Fix<F> {
+        #[inline]
+        fn clone(&self) -> Self {
+            *self
+        }
+    }
+    impl<F: LeEqU32> Copy for Fix<F> {}
+    impl<F: LeEqU32> Default for Fix<F> {
+        #[inline]
+        fn default() -> Self {
+            Fix(FixedI32::<F>::ZERO)
+        }
+    }
+    impl<F: LeEqU32> PartialEq for Fix<F> {
+        #[inline]
+        fn eq(&self, other: &Self) -> bool {
+            self.0 == other.0
+        }
+    }
+    impl<F: LeEqU32> PartialOrd for Fix<F> {
+        #[inline]
+        fn partial_cmp(&self, other: &Self) -> Option<core::cmp::Ordering> {
+            Some(self.0.cmp(&other.0))
+        }
+    }
+
+    /// 16 integer bits, 16 fractional bits: range +-32768, resolution 1.5e-5.
+    pub type Q16_16 = Fix<fixed::types::extra::U16>;
+    /// 12 integer bits, 20 fractional bits: range +-2048, resolution 9.5e-7.
+    pub type Q12_20 = Fix<fixed::types::extra::U20>;
+
+    impl<F: LeEqU32> Debug for Fix<F> {
+        fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+            Debug::fmt(&self.0, f)
+        }
+    }
+
+    impl<F: LeEqU32> Add for Fix<F> {
+        type Output = Self;
+        #[inline]
+        fn add(self, rhs: Self) -> Self {
+            Fix(self.0.saturating_add(rhs.0))
+        }
+    }
+    impl<F: LeEqU32> Sub for Fix<F> {
+        type Output = Self;
+        #[inline]
+        fn sub(self, rhs: Self) -> Self {
+            Fix(self.0.saturating_sub(rhs.0))
+        }
+    }
+    impl<F: LeEqU32> Mul for Fix<F> {
+        type Output = Self;
+        #[inline]
+        fn mul(self, rhs: Self) -> Self {
+            Fix(self.0.saturating_mul(rhs.0))
+        }
+    }
+    impl<F: LeEqU32> Div for Fix<F> {
+        type Output = Self;
+        #[inline]
+        fn div(self, rhs: Self) -> Self {
+            match self.0.checked_div(rhs.0) {
+                Some(q) => Fix(q),
+                None => {
+                    let zero = FixedI32::<F>::ZERO;
+                    if self.0 == zero {
+                        Fix(zero)
+                    } else if (self.0 < zero) == (rhs.0 < zero) {
+                        Fix(FixedI32::<F>::MAX)
+                    } else {
+                        Fix(FixedI32::<F>::MIN)
+                    }
+                }
+            }
+        }
+    }
+    impl<F: LeEqU32> Neg for Fix<F> {
+        type Output = Self;
+        #[inline]
+        fn neg(self) -> Self {
+            Fix(self.0.saturating_neg())
+        }
+    }
+    impl<F: LeEqU32> AddAssign for Fix<F> {
+        #[inline]
+        fn add_assign(&mut self, rhs: Self) {
+            *self = *self + rhs;
+        }
+    }
+    impl<F: LeEqU32> SubAssign for Fix<F> {
+        #[inline]
+        fn sub_assign(&mut self, rhs: Self) {
+            *self = *self - rhs;
+        }
+    }
+    impl<F: LeEqU32> MulAssign for Fix<F> {
+        #[inline]
+        fn mul_assign(&mut self, rhs: Self) {
+            *self = *self * rhs;
+        }
+    }
+
+    impl<F: LeEqU32> Real for Fix<F> {
+        const ZERO: Self = Fix(FixedI32::<F>::ZERO);
+        const ONE: Self = {
+            assert!(
+                F::U32 <= 30,
+                "fixed-point formats need at least two integer bits"
+            );
+            Fix(FixedI32::<F>::from_bits(1i32 << F::U32))
+        };
+        const NAME: &'static str = "fixed-i32";
+
+        #[inline]
+        fn from_f64(v: f64) -> Self {
+            // `saturating_from_num` maps NaN to zero and +-inf to MAX/MIN.
+            if v.is_nan() {
+                Self::ZERO
+            } else {
+                Fix(FixedI32::<F>::saturating_from_num(v))
+            }
+        }
+        #[inline]
+        fn to_f64(self) -> f64 {
+            self.0.to_num::<f64>()
+        }
+        #[inline]
+        fn sqrt(self) -> Self {
+            Fix(self.0.checked_sqrt().unwrap_or(FixedI32::<F>::ZERO))
+        }
+        #[inline]
+        fn abs(self) -> Self {
+            Fix(self.0.saturating_abs())
+        }
+        #[inline]
+        fn is_finite(self) -> bool {
+            true
+        }
+        #[inline]
+        fn tiny() -> Self {
+            Fix(FixedI32::<F>::DELTA)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fixed_point_never_panics() {
+        let big = Q16_16::from_f64(1e9);
+        let small = Q16_16::from_f64(-1e9);
+        let z = Q16_16::ZERO;
+        assert_eq!((big * big).to_f64(), 32768.0 - 1.0 / 65536.0);
+        assert_eq!((big / z).to_f64(), 32768.0 - 1.0 / 65536.0);
+        assert_eq!((small / z).to_f64(), -32768.0);
+        assert_eq!((z / z).to_f64(), 0.0);
+        assert_eq!(small.sqrt().to_f64(), 0.0);
+        assert_eq!((-small).to_f64(), 32768.0 - 1.0 / 65536.0);
+        assert_eq!(Q16_16::from_f64(f64::NAN).to_f64(), 0.0);
+        assert_eq!(Q16_16::ONE.to_f64(), 1.0);
+        assert_eq!(Q12_20::ONE.to_f64(), 1.0);
+        assert!((Q16_16::from_f64(2.0).sqrt().to_f64() - 2f64.sqrt()).abs() < 2e-5);
+    }
+
+    #[test]
+    fn float_sqrt_is_total() {
+        assert_eq!(Real::sqrt(-4.0f32), 0.0);
+        assert_eq!(Real::sqrt(-4.0f64), 0.0);
+        assert!(Real::sqrt(f32::NAN).is_nan());
+        assert_eq!(Real::sqrt(9.0f32), 3.0);
+    }
+}

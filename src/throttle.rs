@@ -1,0 +1,144 @@
+//! Throttle laws (MODEL.md section 3).
+//!
+//! * Laminar capillary, Hagen-Poiseuille: `Q = dp / R_l`,
+//!   `R_l = 128 mu L / (pi d^4)`.
+//! * Sharp-edged orifice: `Q = C_d f sqrt(2 |dp| / rho) sign(dp)`, i.e.
+//!   `dp = R_t Q |Q|` with `R_t = rho / (2 C_d^2 f^2)`, `f = pi d^2 / 4`.
+//! * The window the plunger opens: area `pi d x`, orifice law with the
+//!   window's own discharge coefficient (Eq. 7).
+//!
+//! The dynamic model needs the orifice law to be C1 at zero flow; it uses
+//! [`regularised_root`], the `regRoot` form of Modelica, Hopsan and Simscape.
+
+use crate::scalar::{Float, Real};
+
+/// Laminar throttle (capillary).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Capillary<T> {
+    /// Bore [m].
+    pub diameter: T,
+    /// Length [m].
+    pub length: T,
+}
+
+impl<T: Float> Capillary<T> {
+    /// `pi d^4 / (128 L)` [m^3]: the conductance times the dynamic viscosity.
+    #[inline]
+    pub fn bore_term(&self) -> T {
+        let d2 = self.diameter * self.diameter;
+        T::from_f64(core::f64::consts::PI / 128.0) * d2 * d2 / self.length
+    }
+
+    /// Resistance `R_l = 128 mu L / (pi d^4)` [Pa s/m^3] for dynamic viscosity `mu` [Pa s].
+    #[inline]
+    pub fn resistance(&self, dynamic_viscosity: T) -> T {
+        dynamic_viscosity / self.bore_term()
+    }
+}
+
+/// Turbulent throttle (sharp-edged orifice).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Orifice<T> {
+    /// Bore [m].
+    pub diameter: T,
+    /// Discharge coefficient `C_d` [-].
+    pub discharge_coefficient: T,
+}
+
+impl<T: Float> Orifice<T> {
+    /// Flow area `f = pi d^2 / 4` [m^2].
+    #[inline]
+    pub fn area(&self) -> T {
+        T::from_f64(core::f64::consts::FRAC_PI_4) * self.diameter * self.diameter
+    }
+
+    /// Quadratic resistance `R_t = rho / (2 C_d^2 f^2)` [Pa s^2/m^6].
+    #[inline]
+    pub fn resistance(&self, density: T) -> T {
+        let cf = self.discharge_coefficient * self.area();
+        density / (T::from_f64(2.0) * cf * cf)
+    }
+
+    /// Signed flow for a pressure drop `dp` [Pa] at density `rho` [kg/m^3]:
+    /// `C_d f sqrt(2 |dp| / rho) sign(dp)` [m^3/s].
+    #[inline]
+    pub fn flow(&self, dp: T, density: T) -> T {
+        let q = self.discharge_coefficient
+            * self.area()
+            * (T::from_f64(2.0) * dp.abs() / density).sqrt();
+        if dp < T::ZERO { -q } else { q }
+    }
+}
+
+/// The window opened by the plunger (Eq. 7): area `pi d x`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Slot<T> {
+    /// Window diameter `d` [m].
+    pub diameter: T,
+    /// Discharge coefficient `eta` [-].
+    pub discharge_coefficient: T,
+}
+
+impl<T: Float> Slot<T> {
+    /// Open area `f_throt = pi d x` [m^2] at opening `x` [m] (zero when closed).
+    #[inline]
+    pub fn area(&self, x: T) -> T {
+        T::from_f64(core::f64::consts::PI) * self.diameter * x.max(T::ZERO)
+    }
+
+    /// Flow through the window (Eq. 7): `eta pi d x sqrt(2 dp / rho)` [m^3/s].
+    #[inline]
+    pub fn flow(&self, x: T, dp: T, density: T) -> T {
+        self.discharge_coefficient
+            * self.area(x)
+            * (T::from_f64(2.0) * dp.max(T::ZERO) / density).sqrt()
+    }
+}
+
+/// C1 square-root law `u / (u^2 + u_tr^2)^(1/4)` and its derivative.
+///
+/// Equals `sign(u) sqrt(|u|)` to a relative `u_tr^2 / (4 u^2)` for
+/// `|u| >> u_tr`, has the finite slope `1 / sqrt(u_tr)` at zero, and is odd.
+/// Returns `(value, d value / du)`. Works in any [`Real`], including fixed
+/// point (where a `u_tr^2` below the resolution degrades to the plain root,
+/// with slope saturating rather than panicking).
+#[inline]
+pub fn regularised_root<T: Real>(u: T, u_tr: T) -> (T, T) {
+    let r = u * u + u_tr * u_tr;
+    let r14 = r.sqrt().sqrt(); // r^(1/4)
+    let value = u / r14;
+    // d/du = (u^2 / 2 + u_tr^2) / r^(5/4)
+    let half = T::ONE / (T::ONE + T::ONE);
+    let slope = (half * u * u + u_tr * u_tr) / (r * r14);
+    (value, slope)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn regularised_root_matches_root_away_from_zero() {
+        let (v, s) = regularised_root(0.25f64, 1e-4);
+        assert!((v - 0.5).abs() < 1e-7);
+        assert!((s - 1.0).abs() < 1e-6);
+        let (v0, s0) = regularised_root(0.0f64, 1e-4);
+        assert_eq!(v0, 0.0);
+        assert!((s0 - 100.0).abs() < 1e-9);
+        let (vn, _) = regularised_root(-0.25f64, 1e-4);
+        assert!((vn + 0.5).abs() < 1e-7);
+    }
+
+    #[test]
+    fn orifice_flow_and_resistance_agree() {
+        let o = Orifice {
+            diameter: 0.7e-3f64,
+            discharge_coefficient: 0.61,
+        };
+        let rho = 870.0;
+        let dp = 2.0e5;
+        let q = o.flow(dp, rho);
+        assert!((o.resistance(rho) * q * q - dp).abs() < 1e-6 * dp);
+        assert_eq!(o.flow(-dp, rho), -q);
+    }
+}
