@@ -24,7 +24,17 @@ pub const WALTHER_MIN_CST: f64 = 2.0;
 /// for any hydraulic purpose, and `f32` loses the double exponential).
 pub const WALTHER_MAX_CST: f64 = 1.0e6;
 
+/// Reference temperature of the cancellation-free Walther form [C].
+pub const WALTHER_REFERENCE_C: f64 = 40.0;
+
 /// The oil's temperature laws.
+///
+/// Walther's `a - b log10(T_K)` subtracts two numbers near 9 to get one
+/// near 0.3, which in `f32` costs about 1e-5 of relative viscosity. The
+/// evaluation therefore uses `u_ref - b log10(1 + (t - t_ref) / T_ref)`
+/// with `u_ref = a - b log10(T_ref)` computed once in `f64` by
+/// [`Oil::new`], and `log1p` for the small logarithm: the `f32` viscosity
+/// is then good to about 3e-7.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Oil<T> {
     /// Walther constant `a` [-].
@@ -37,6 +47,8 @@ pub struct Oil<T> {
     pub expansion: T,
     /// Effective bulk modulus `beta_e` [Pa].
     pub bulk_modulus: T,
+    /// `a - b log10(T_ref)` at [`WALTHER_REFERENCE_C`], computed in `f64`.
+    walther_u_ref: T,
 }
 
 /// The oil's state at one temperature.
@@ -64,6 +76,27 @@ pub struct Derivatives<T> {
 }
 
 impl<T: Float> Oil<T> {
+    /// An oil from its constants (Walther `a`, `b` [-], density at 15 C
+    /// [kg/m^3], expansion [1/K], bulk modulus [Pa]), given in `f64` so that
+    /// the reference term of the Walther form is exact to `f64` precision.
+    pub fn new(
+        walther_a: f64,
+        walther_b: f64,
+        density_15: f64,
+        expansion: f64,
+        bulk_modulus: f64,
+    ) -> Self {
+        let u_ref = walther_a - walther_b * libm::log10(WALTHER_REFERENCE_C + KELVIN_OFFSET);
+        Oil {
+            walther_a: T::from_f64(walther_a),
+            walther_b: T::from_f64(walther_b),
+            density_15: T::from_f64(density_15),
+            expansion: T::from_f64(expansion),
+            bulk_modulus: T::from_f64(bulk_modulus),
+            walther_u_ref: T::from_f64(u_ref),
+        }
+    }
+
     /// Walther's inner variables at `t` [C]: `(Z = nu_cSt + 0.7, w = log10 Z, T_K)`.
     fn walther(&self, t: T) -> Result<(T, T, T), ModelError> {
         let t = finite(t, "temperature")?;
@@ -71,7 +104,10 @@ impl<T: Float> Oil<T> {
         if !(tk > T::ZERO) {
             return Err(ModelError::OutOfRange("temperature"));
         }
-        let u = self.walther_a - self.walther_b * tk.log10();
+        let t_ref = T::from_f64(WALTHER_REFERENCE_C + KELVIN_OFFSET);
+        let delta = (t - T::from_f64(WALTHER_REFERENCE_C)) / t_ref;
+        let u = self.walther_u_ref
+            - self.walther_b * delta.ln_1p() * T::from_f64(core::f64::consts::LOG10_E);
         let w = u.exp10();
         let z = w.exp10();
         if !z.is_finite() || z > T::from_f64(WALTHER_MAX_CST + 0.7) {

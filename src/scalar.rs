@@ -86,6 +86,8 @@ pub trait Float: Real {
     fn ln(self) -> Self;
     /// Base-10 logarithm.
     fn log10(self) -> Self;
+    /// `ln(1 + self)`, accurate for small `self`.
+    fn ln_1p(self) -> Self;
     /// `e^self`.
     fn exp(self) -> Self;
     /// `10^self`.
@@ -163,6 +165,10 @@ impl Float for f32 {
         libm::log10f(self)
     }
     #[inline]
+    fn ln_1p(self) -> Self {
+        libm::log1pf(self)
+    }
+    #[inline]
     fn exp(self) -> Self {
         libm::expf(self)
     }
@@ -228,6 +234,10 @@ impl Float for f64 {
     #[inline]
     fn log10(self) -> Self {
         libm::log10(self)
+    }
+    #[inline]
+    fn ln_1p(self) -> Self {
+        libm::log1p(self)
     }
     #[inline]
     fn exp(self) -> Self {

@@ -1,1 +1,38 @@
-//! placeholder
+//! Shared pieces of the host tests: independent `f64` references, a
+//! deterministic generator of physical parameter sets, tolerance helpers.
+//!
+//! Nothing here calls the core's closed forms: the references are written
+//! from MODEL.md directly, so that an error in the core cannot hide in the
+//! reference.
+
+pub mod random;
+pub mod reference;
+
+use std::path::PathBuf;
+
+/// The repository root (where `Cargo.toml` of the workspace lives).
+pub fn repo_root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("host-tests sits in the repo root")
+        .to_path_buf()
+}
+
+/// numpy's `isclose`: `|actual - expected| <= atol + rtol |expected|`.
+pub fn isclose(actual: f64, expected: f64, rtol: f64, atol: f64) -> bool {
+    (actual - expected).abs() <= atol + rtol * expected.abs()
+}
+
+/// Asserts [`isclose`] element-wise with a message naming the quantity.
+#[track_caller]
+pub fn assert_allclose(what: &str, actual: &[f64], expected: &[f64], rtol: f64, atol: f64) {
+    assert_eq!(actual.len(), expected.len(), "{what}: lengths differ");
+    for (i, (a, e)) in actual.iter().zip(expected).enumerate() {
+        assert!(
+            isclose(*a, *e, rtol, atol),
+            "{what}[{i}]: {a} vs {e} (diff {:.3e}, allowed {:.3e})",
+            (a - e).abs(),
+            atol + rtol * e.abs()
+        );
+    }
+}

@@ -119,12 +119,11 @@ impl<T: Float> Params<T> {
         // pressure (20); everything else is strictly positive.
         let c = |i: usize| conv::<T>(f[i].path, v[i], !matches!(i, 3 | 11 | 13 | 20));
         let params = Params {
-            oil: Oil {
-                walther_a: c(0)?,
-                walther_b: c(1)?,
-                density_15: c(2)?,
-                expansion: c(3)?,
-                bulk_modulus: c(4)?,
+            oil: {
+                for i in 0..5 {
+                    c(i)?;
+                }
+                Oil::new(v[0], v[1], v[2], v[3], v[4])
             },
             capillary: Capillary {
                 diameter: c(5)?,

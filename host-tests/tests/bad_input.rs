@@ -1,0 +1,407 @@
+//! Bad input gets a typed error naming the field, never a panic, NaN or
+//! hang: parameter files, the core's conversions, and the CLI's contract
+//! (exit status 2, one line on stderr, nothing on stdout).
+
+use compensator::equilibrium::equilibrium;
+use compensator::params::{ParamError, Problem};
+use compensator::{ModelError, Params};
+use compensator_cli::{LoadError, params_file};
+use host_tests::repo_root;
+use std::path::PathBuf;
+use std::process::Command;
+use std::sync::OnceLock;
+
+fn preset_text() -> String {
+    std::fs::read_to_string(repo_root().join("presets/paper.toml")).unwrap()
+}
+
+/// The preset with `key = ...` inside `[section]` replaced (or removed when
+/// `value` is `None`).
+fn edited(section: &str, key: &str, value: Option<&str>) -> String {
+    let mut out = String::new();
+    let mut current = String::new();
+    let mut hit = false;
+    for line in preset_text().lines() {
+        let trimmed = line.trim();
+        if trimmed.starts_with('[') {
+            current = trimmed.trim_matches(|c| c == '[' || c == ']').to_string();
+        }
+        let is_key = trimmed.split('=').next().map(str::trim) == Some(key);
+        if current == section && is_key {
+            hit = true;
+            if let Some(v) = value {
+                out.push_str(&format!("{key} = {v}\n"));
+            }
+            continue;
+        }
+        out.push_str(line);
+        out.push('\n');
+    }
+    assert!(hit, "{section}.{key} not in the preset");
+    out
+}
+
+fn param_error(text: &str) -> ParamError {
+    match params_file::parse(text) {
+        Err(LoadError::Param(e)) => e,
+        other => panic!("expected a parameter error, got {other:?}"),
+    }
+}
+
+#[test]
+fn every_required_field_is_reported_missing_by_name() {
+    for f in compensator::params::CORE_FIELDS.iter() {
+        let e = param_error(&edited(f.section, f.key, None));
+        assert_eq!((e.field, e.problem), (f.path, Problem::Missing));
+        assert_eq!(e.to_string(), format!("{}: missing", f.path));
+    }
+}
+
+#[test]
+fn every_field_rejects_nan_and_infinity() {
+    for f in compensator::params::CORE_FIELDS.iter() {
+        let e = param_error(&edited(f.section, f.key, Some("nan")));
+        assert_eq!((e.field, e.problem), (f.path, Problem::NotANumber));
+        let e = param_error(&edited(f.section, f.key, Some("-inf")));
+        assert_eq!((e.field, e.problem), (f.path, Problem::Infinite));
+    }
+}
+
+#[test]
+fn non_physical_values_name_the_field_and_the_rule() {
+    let cases: &[(&str, &str, &str, &str)] = &[
+        (
+            "plunger",
+            "spring_rate",
+            "-25000.0",
+            "plunger.spring_rate = -25000: must be positive",
+        ),
+        ("plunger", "mass", "0", "plunger.mass = 0: must be positive"),
+        (
+            "plunger",
+            "damping",
+            "-1.0",
+            "plunger.damping = -1: must not be negative",
+        ),
+        (
+            "plunger",
+            "preload",
+            "0.002",
+            "plunger.preload = 0.002: preload beyond the stroke",
+        ),
+        (
+            "turbulent_throttle",
+            "discharge_coefficient",
+            "1.2",
+            "turbulent_throttle.discharge_coefficient = 1.2: must lie in [0, 1]",
+        ),
+        (
+            "slot",
+            "discharge_coefficient",
+            "0.0",
+            "slot.discharge_coefficient = 0: must be positive",
+        ),
+        (
+            "chambers",
+            "volume_a",
+            "1.0e-7",
+            "chambers.volume_a = 0.0000001: not larger than the swept volume A_p * stroke",
+        ),
+        (
+            "operating",
+            "pressure_drop",
+            "0.0",
+            "operating.pressure_drop = 0: must be positive",
+        ),
+        (
+            "fluid",
+            "expansion",
+            "0.5",
+            "fluid.expansion = 0.5: must lie in [0, 0.01]",
+        ),
+    ];
+    for (section, key, value, message) in cases {
+        let e = param_error(&edited(section, key, Some(value)));
+        assert_eq!(e.to_string(), *message);
+    }
+}
+
+#[test]
+fn unknown_keys_wrong_types_and_partial_sections_are_errors() {
+    let typo = preset_text().replace("spring_rate", "spring_rat");
+    assert!(
+        matches!(params_file::parse(&typo), Err(LoadError::UnknownKey(k)) if k == "plunger.spring_rat")
+    );
+    let text = edited("plunger", "mass", Some("\"heavy\""));
+    assert!(
+        matches!(params_file::parse(&text), Err(LoadError::NotANumber(k)) if k == "plunger.mass")
+    );
+    let partial = format!("{}\n[machine]\nworking_flow = 1e-5\n", preset_text());
+    let e = param_error(&partial);
+    assert_eq!(
+        (e.field, e.problem),
+        ("machine.leakage_reference", Problem::Missing)
+    );
+    assert!(matches!(
+        params_file::parse("[fluid\nx = 1"),
+        Err(LoadError::Syntax(_))
+    ));
+}
+
+#[test]
+fn f32_conversion_rejects_values_that_do_not_fit() {
+    let text = edited("plunger", "spring_rate", Some("1e300"));
+    let raw = params_file::parse(&text).unwrap();
+    assert!(Params::<f64>::new(&raw).is_ok());
+    let e = Params::<f32>::new(&raw).unwrap_err();
+    assert_eq!(
+        (e.field, e.problem),
+        ("plunger.spring_rate", Problem::NotRepresentable("f32"))
+    );
+}
+
+#[test]
+fn temperatures_outside_the_oil_range_are_typed_errors() {
+    let raw = params_file::parse(&preset_text()).unwrap();
+    let p = Params::<f32>::new(&raw).unwrap();
+    for t in [
+        f32::NAN,
+        f32::INFINITY,
+        -f32::INFINITY,
+        -300.0,
+        -273.15,
+        1.0e6,
+        400.0,
+        -250.0,
+        f32::MAX,
+    ] {
+        match equilibrium(&p, t) {
+            Err(ModelError::NonFinite(_)) | Err(ModelError::OutOfRange(_)) => {}
+            other => panic!("t = {t}: {other:?}"),
+        }
+    }
+}
+
+fn cli() -> &'static PathBuf {
+    static BIN: OnceLock<PathBuf> = OnceLock::new();
+    BIN.get_or_init(|| {
+        let root = repo_root();
+        let status = Command::new(env!("CARGO"))
+            .args([
+                "build",
+                "--quiet",
+                "-p",
+                "compensator-cli",
+                "--bin",
+                "compensator",
+            ])
+            .current_dir(&root)
+            .status()
+            .expect("cargo runs");
+        assert!(status.success());
+        let target = std::env::var_os("CARGO_TARGET_DIR")
+            .map(PathBuf::from)
+            .unwrap_or(root.join("target"));
+        target.join("debug").join("compensator")
+    })
+}
+
+fn run(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(cli())
+        .args(args)
+        .current_dir(repo_root())
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8(out.stdout).unwrap(),
+        String::from_utf8(out.stderr).unwrap(),
+    )
+}
+
+#[track_caller]
+fn assert_bad_input(args: &[&str], names: &str) {
+    let (code, stdout, stderr) = run(args);
+    assert_eq!(code, 2, "{args:?}: exit {code}, stderr {stderr}");
+    assert!(stdout.is_empty(), "{args:?}: stdout {stdout}");
+    assert_eq!(stderr.lines().count(), 1, "{args:?}: stderr {stderr:?}");
+    assert!(
+        stderr.contains(names),
+        "{args:?}: '{stderr}' does not name {names}"
+    );
+}
+
+#[test]
+fn cli_bad_input_exits_2_with_one_line_naming_the_field() {
+    let dir = std::env::temp_dir().join(format!("compensator-bad-input-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let write = |name: &str, text: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p.to_string_lossy().into_owned()
+    };
+    let missing = write("missing.toml", &edited("plunger", "spring_rate", None));
+    let negative = write(
+        "negative.toml",
+        &edited("laminar_throttle", "length", Some("-0.02")),
+    );
+    let nan = write("nan.toml", &edited("fluid", "density_15", Some("nan")));
+    assert_bad_input(
+        &["equilibrium", "--params", &missing],
+        "plunger.spring_rate",
+    );
+    assert_bad_input(
+        &["equilibrium", "--params", &negative],
+        "laminar_throttle.length",
+    );
+    assert_bad_input(
+        &[
+            "asymptotic",
+            "--params",
+            &nan,
+            "--order",
+            "1",
+            "--reading",
+            "property",
+        ],
+        "fluid.density_15",
+    );
+    assert_bad_input(
+        &[
+            "equilibrium",
+            "--params",
+            "presets/paper.toml",
+            "--temps",
+            "30:80:0",
+        ],
+        "--temps",
+    );
+    assert_bad_input(
+        &[
+            "equilibrium",
+            "--params",
+            "presets/paper.toml",
+            "--temps",
+            "30,abc",
+        ],
+        "--temps",
+    );
+    assert_bad_input(
+        &[
+            "equilibrium",
+            "--params",
+            "presets/paper.toml",
+            "--temps",
+            "500",
+        ],
+        "--temps",
+    );
+    assert_bad_input(
+        &["equilibrium", "--params", "/nonexistent/p.toml"],
+        "/nonexistent/p.toml",
+    );
+    assert_bad_input(
+        &[
+            "asymptotic",
+            "--params",
+            "presets/paper.toml",
+            "--order",
+            "3",
+            "--reading",
+            "property",
+        ],
+        "--order",
+    );
+    assert_bad_input(
+        &[
+            "asymptotic",
+            "--params",
+            "presets/paper.toml",
+            "--order",
+            "1",
+            "--reading",
+            "x",
+        ],
+        "--reading",
+    );
+    assert_bad_input(
+        &[
+            "asymptotic",
+            "--params",
+            "presets/paper.toml",
+            "--order",
+            "1",
+            "--reading",
+            "property",
+            "--t0",
+            "hot",
+        ],
+        "--t0",
+    );
+    assert_bad_input(
+        &[
+            "equilibrium",
+            "--params",
+            "presets/paper.toml",
+            "--precision",
+            "f16",
+        ],
+        "--precision",
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn cli_equilibrium_and_asymptotic_write_the_documented_columns() {
+    let (code, out, err) = run(&[
+        "equilibrium",
+        "--params",
+        "presets/paper.toml",
+        "--temps",
+        "30:80:10",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(
+        lines[0],
+        "t_c,a_sqrt_pa,p_a_pa,p_b_pa,dp_ab_pa,x_m,q_branch_m3s,q_throt_m3s,q_total_m3s"
+    );
+    assert_eq!(lines.len(), 7);
+    let row: Vec<f64> = lines[5].split(',').map(|v| v.parse().unwrap()).collect();
+    assert_eq!(row[0], 70.0);
+    let raw = params_file::parse(&preset_text()).unwrap();
+    let r = host_tests::reference::equilibrium(&raw.core, 70.0);
+    assert!(host_tests::isclose(row[5], r.x, 1e-12, 1e-15));
+    let (code32, out32, _) = run(&[
+        "equilibrium",
+        "--params",
+        "presets/paper.toml",
+        "--temps",
+        "70",
+        "--precision",
+        "f32",
+    ]);
+    assert_eq!(code32, 0);
+    let row32: Vec<f64> = out32
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert!((row32[5] - r.x).abs() < 1e-5 * raw.core.stroke);
+
+    let (code, out, err) = run(&[
+        "asymptotic",
+        "--params",
+        "presets/paper.toml",
+        "--order",
+        "2",
+        "--reading",
+        "property",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines[0], "t_c,x_qs_m,x_asym_m");
+    assert_eq!(lines.len(), 7);
+}

@@ -1,0 +1,117 @@
+//! The paper's tables, reproduced by the committed preset.
+
+use compensator::Params;
+use compensator::asymptotic::Reading;
+use compensator_cli::paper::{self, Table1, Table2};
+use compensator_cli::{commands, lsq, params_file};
+use host_tests::repo_root;
+
+fn tables() -> (Table1, Table2) {
+    paper::paper_tables(&repo_root()).unwrap()
+}
+
+fn preset() -> Params<f64> {
+    Params::new(&params_file::load(&repo_root().join("presets/paper.toml")).unwrap()).unwrap()
+}
+
+#[test]
+fn table1_columns_invert_to_one_temperature_law() {
+    let (t1, _) = tables();
+    let inv = paper::invert_table1(&t1);
+    // A(t) falls with temperature in every column...
+    for j in 0..t1.drops_bar.len() {
+        for i in 1..t1.temps.len() {
+            assert!(inv.a[i][j] < inv.a[i - 1][j]);
+        }
+    }
+    // ...and the three drops agree on it to about a tenth (digitising noise).
+    let worst = inv.spread.iter().cloned().fold(0.0, f64::max);
+    assert!(worst < 0.12, "spread {worst}");
+    assert!(
+        (inv.a[0][0] - 600.0).abs() < 0.1,
+        "A(30 C, 4 bar) = {}",
+        inv.a[0][0]
+    );
+}
+
+#[test]
+fn preset_reproduces_table1_within_0_06_bar_rms() {
+    let (t1, _) = tables();
+    let r = paper::table1_residuals(&preset(), &t1);
+    assert_eq!(r.len(), 18);
+    let rms = lsq::rms(&r);
+    assert!(rms <= 0.06, "Table 1 RMS {rms} bar");
+}
+
+#[test]
+fn preset_reproduces_table2_quasi_static_within_0_02_mm() {
+    let (_, t2) = tables();
+    let r = paper::table2_residuals(&preset(), &t2);
+    let worst = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(worst <= 0.02, "Table 2 worst {worst} mm");
+}
+
+#[test]
+fn committed_preset_is_what_calibrate_produces() {
+    let root = repo_root();
+    let (t1, t2) = tables();
+    let base = params_file::load(&root.join("presets/model-example.toml")).unwrap();
+    let cal = paper::calibrate(&base, &t1, &t2).unwrap();
+    let committed = params_file::load(&root.join("presets/paper.toml")).unwrap();
+    for (i, (a, b)) in cal
+        .params
+        .core
+        .to_array()
+        .iter()
+        .zip(committed.core.to_array())
+        .enumerate()
+    {
+        assert!(
+            (a - b).abs() <= 1e-6 * b.abs(),
+            "{}: calibrate gives {a}, presets/paper.toml has {b}; rerun `compensator calibrate`",
+            compensator::params::CORE_FIELDS[i].path
+        );
+    }
+}
+
+#[test]
+fn table2_asym_column_is_the_property_reading_at_second_order_about_the_balance_point() {
+    let (_, t2) = tables();
+    let p = preset();
+    let raw = params_file::load(&repo_root().join("presets/paper.toml")).unwrap();
+    let balance = commands::find_balance(&raw, &p).unwrap();
+    let (best, at_balance) = paper::asymptotic_search(&p, &t2, 26.0, 80.0);
+    let closest = best
+        .iter()
+        .min_by(|a, b| a.rms_mm.total_cmp(&b.rms_mm))
+        .unwrap();
+    assert_eq!((closest.reading, closest.order), (Reading::Property, 2));
+    assert!(
+        (closest.t0 - balance).abs() < 1.0,
+        "best t0 {} vs balance {balance}",
+        closest.t0
+    );
+    assert!(closest.rms_mm < 0.01);
+    let b = at_balance
+        .iter()
+        .find(|m| m.reading == Reading::Property && m.order == 2)
+        .unwrap();
+    assert!(b.rms_mm < 0.01, "at the balance point: {} mm", b.rms_mm);
+    // The paper calls its column first order; no first-order reading comes close.
+    for m in best.iter().filter(|m| m.order == 1) {
+        assert!(m.rms_mm > closest.rms_mm * 1.5);
+    }
+}
+
+#[test]
+fn equation_1_gradient_is_bounded_by_the_drop() {
+    let p = preset();
+    let (mean_a, max_a, mean_b) = paper::chamber_gradient(&p, 2.0e5, 26.0, 78.0).unwrap();
+    // p_a must stay in [p_c, p_p]: over 52 C its mean slope is at most dp / 52 C.
+    let bound = 2.0e5 / 52.0;
+    assert!(mean_a <= bound && mean_b <= bound);
+    assert!(mean_a < 8.3e3 / 2.0, "mean {mean_a} Pa/C");
+    assert!(max_a > mean_a);
+    // Symmetric branches: (a) falls exactly as (b) rises.
+    assert!((mean_a - mean_b).abs() < 1e-9 * mean_a);
+}
