@@ -11,6 +11,7 @@
 //! |---|---|---|
 //! | quasi-static equilibrium | [`equilibrium`], [`compensation`] | Eqs. 2-10 |
 //! | asymptotic closed forms, sensitivities, Eq. 32 | [`asymptotic`] | Eqs. 11-32 |
+//! | reduced-order FSI model, fixed-step twin, linearisation | [`dynamics`] | Eqs. 33-37 |
 //!
 //! Building blocks: [`params`] (validated parameter sets), [`fluid`] (oil
 //! properties), [`throttle`] (throttle laws), [`scalar`] (the `f32` / `f64` /
@@ -25,9 +26,11 @@
 
 pub mod asymptotic;
 pub mod compensation;
+pub mod dynamics;
 pub mod equilibrium;
 mod error;
 pub mod fluid;
+pub mod linalg;
 pub mod params;
 pub mod scalar;
 pub mod throttle;

@@ -7,6 +7,7 @@
 
 pub mod commands;
 pub mod csv;
+pub mod dynamics;
 pub mod lsq;
 pub mod paper;
 pub mod params_file;

@@ -27,6 +27,26 @@ enum StaticPrecision {
     F32,
 }
 
+/// Scalar type or solver of a dynamic computation.
+#[derive(Copy, Clone, Debug, ValueEnum, PartialEq, Eq)]
+enum DynPrecision {
+    F32,
+    F64,
+    Fixed,
+    Reduced,
+    Reference,
+}
+
+/// One-step scheme.
+#[derive(Copy, Clone, Debug, ValueEnum, PartialEq, Eq)]
+enum SchemeArg {
+    Rk4,
+    LinearlyImplicitEuler,
+    Ros2,
+    Ros3,
+    Rodas3,
+}
+
 /// Reading of the asymptotic expansion.
 #[derive(Copy, Clone, Debug, ValueEnum, PartialEq, Eq)]
 enum ReadingArg {
@@ -71,6 +91,56 @@ enum Command {
         #[arg(long, default_value = "26:78:2")]
         temps: String,
     },
+    /// Response to a temperature step or ramp (FSI model, Eqs. 33-36).
+    Step {
+        #[arg(long)]
+        params: PathBuf,
+        /// Initial temperature [C] (the twin starts at its equilibrium).
+        #[arg(long, allow_negative_numbers = true)]
+        from: f64,
+        /// Final temperature [C].
+        #[arg(long, allow_negative_numbers = true)]
+        to: f64,
+        /// Ramp rate [C/s]; without it, a step at t = 0.
+        #[arg(long)]
+        ramp: Option<f64>,
+        /// Tick [s]: output interval and integration step.
+        #[arg(long, default_value = "0.001")]
+        dt: f64,
+        /// Simulated time [s] (default: ramp duration + 0.5 s).
+        #[arg(long)]
+        t_end: Option<f64>,
+        /// Scalar type, the reduced model, or the adaptive reference solver.
+        #[arg(long, value_enum, default_value = "f64")]
+        precision: DynPrecision,
+        /// One-step scheme of the twin.
+        #[arg(long, value_enum, default_value = "ros2")]
+        scheme: SchemeArg,
+        /// Steps per tick.
+        #[arg(long, default_value = "1")]
+        substeps: u8,
+    },
+    /// Eigenvalues of the linearisation at the equilibrium (Eq. 37).
+    Eigen {
+        #[arg(long)]
+        params: PathBuf,
+        #[arg(long, default_value = "30:80:10")]
+        temps: String,
+    },
+    /// Step-response indicators of Table 3 (reference solver).
+    Indicators {
+        #[arg(long)]
+        params: PathBuf,
+        /// Steps as from:to pairs.
+        #[arg(long, default_value = "30:40,40:50,50:60,60:70,70:80")]
+        steps: String,
+        /// Sampling interval [s].
+        #[arg(long, default_value = "0.0001")]
+        dt: f64,
+        /// Simulated time per step [s].
+        #[arg(long, default_value = "1.0")]
+        t_end: f64,
+    },
     /// Fit a base parameter set to the paper's Tables 1 and 2; prints TOML.
     Calibrate {
         /// Base parameter file whose geometry is kept.
@@ -110,6 +180,44 @@ fn run(cli: Cli) -> Result<String, CliError> {
             commands::asymptotic(&params, order as usize, reading, &t0, &temps)
         }
         Command::Sensitivity { params, temps } => commands::sensitivity(&params, &temps),
+        Command::Step {
+            params,
+            from,
+            to,
+            ramp,
+            dt,
+            t_end,
+            precision,
+            scheme,
+            substeps,
+        } => {
+            use compensator::dynamics::Scheme;
+            use compensator_cli::dynamics::Precision;
+            let precision = match precision {
+                DynPrecision::F32 => Precision::F32,
+                DynPrecision::F64 => Precision::F64,
+                DynPrecision::Fixed => Precision::Fixed,
+                DynPrecision::Reduced => Precision::Reduced,
+                DynPrecision::Reference => Precision::Reference,
+            };
+            let scheme = match scheme {
+                SchemeArg::Rk4 => Scheme::Rk4,
+                SchemeArg::LinearlyImplicitEuler => Scheme::LinearlyImplicitEuler,
+                SchemeArg::Ros2 => Scheme::Ros2,
+                SchemeArg::Ros3 => Scheme::Ros3,
+                SchemeArg::Rodas3 => Scheme::Rodas3,
+            };
+            compensator_cli::dynamics::step(
+                &params, from, to, ramp, dt, t_end, precision, scheme, substeps,
+            )
+        }
+        Command::Eigen { params, temps } => compensator_cli::dynamics::eigen(&params, &temps),
+        Command::Indicators {
+            params,
+            steps,
+            dt,
+            t_end,
+        } => compensator_cli::dynamics::indicators(&params, &steps, dt, t_end),
         Command::Calibrate { base, data } => commands::calibrate(&base, &data),
         Command::Paper { params, data } => commands::paper(&params, &data),
     }

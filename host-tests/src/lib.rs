@@ -6,7 +6,7 @@
 //! reference.
 
 pub mod random;
-pub mod reference;
+pub use compensator_reference::statics as reference;
 
 use std::path::PathBuf;
 

@@ -59,7 +59,7 @@ pub fn physical_params(rng: &mut Rng) -> RawParams {
     let area = std::f64::consts::FRAC_PI_4 * core.plunger_diameter * core.plunger_diameter;
     let hydraulics = core;
     let dp_ab = |t: f64| {
-        let r = crate::reference::equilibrium(&hydraulics, t);
+        let r = compensator_reference::statics::equilibrium(&hydraulics, t);
         r.p_b - r.p_a
     };
     let travel = rng.uniform(0.3, 2.5) * core.stroke;

@@ -1,0 +1,370 @@
+//! Dynamic-model commands: step and ramp responses, eigenvalues, and the
+//! step-response indicators of the paper's Table 3.
+
+use crate::commands::{CliError, load_params};
+use crate::csv::Table;
+use crate::temps;
+use compensator::dynamics::linear::linearise;
+use compensator::dynamics::reduced::ReducedTwin;
+use compensator::dynamics::{DynamicState, Scheme, Twin, TwinConfig};
+use compensator::equilibrium::equilibrium;
+use compensator::scalar::Q16_16;
+use compensator::{Float, Params, RawParams, Real};
+use compensator_reference::dynamics::{self as reference, Method, Profile};
+use std::path::Path;
+
+/// Scalar type (or solver) of a dynamic computation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Precision {
+    /// The twin in `f32`.
+    F32,
+    /// The twin in `f64`.
+    F64,
+    /// The twin in Q16.16 fixed point (fluid properties in `f32`).
+    Fixed,
+    /// The reduced (quasi-steady pressure) model in `f64`.
+    Reduced,
+    /// The adaptive stiff reference solver (Radau5, rtol 1e-12).
+    Reference,
+}
+
+/// A simulated response sampled every tick.
+#[derive(Clone, Debug)]
+pub struct Response {
+    /// Times [s].
+    pub time: Vec<f64>,
+    /// States.
+    pub state: Vec<DynamicState>,
+}
+
+/// The temperature profile of a step (`ramp = None`) or a ramp [C/s].
+pub fn profile(from: f64, to: f64, ramp: Option<f64>) -> Result<Profile, CliError> {
+    for (name, v) in [("--from", from), ("--to", to)] {
+        if !v.is_finite() {
+            return Err(CliError::Input(format!("{name}: {v} is not finite")));
+        }
+    }
+    match ramp {
+        None => Ok(Profile::Step { from, to }),
+        Some(rate) if rate.is_finite() && rate > 0.0 => Ok(Profile::Ramp { from, to, rate }),
+        Some(rate) => Err(CliError::Input(format!(
+            "--ramp: {rate} must be a positive rate"
+        ))),
+    }
+}
+
+fn run_twin<F: Float, T: Real>(
+    params: &Params<F>,
+    config: TwinConfig,
+    prof: &Profile,
+    n: usize,
+) -> Result<Response, CliError> {
+    let mut twin = Twin::<F, T>::new(params, config, F::from_f64(prof.start()))
+        .map_err(|e| CliError::Input(format!("--from: {e}")))?;
+    let mut out = Response {
+        time: vec![0.0],
+        state: vec![twin.state()],
+    };
+    for k in 0..n {
+        // Coefficients at the tick's midpoint follow a ramp to second order.
+        let t_mid = prof.temperature((k as f64 + 0.5) * config.tick);
+        twin.set_temperature(F::from_f64(t_mid))
+            .map_err(|e| CliError::Input(format!("temperature {t_mid} C: {e}")))?;
+        twin.tick()
+            .map_err(|e| CliError::Failed(format!("tick {k}: {e:?}")))?;
+        out.time.push((k + 1) as f64 * config.tick);
+        out.state.push(twin.state());
+    }
+    Ok(out)
+}
+
+/// Simulates `prof` for `n` ticks of `config.tick` with the chosen precision.
+pub fn simulate(
+    raw: &RawParams,
+    precision: Precision,
+    config: TwinConfig,
+    prof: &Profile,
+    n: usize,
+) -> Result<Response, CliError> {
+    let p64 = || Params::<f64>::new(raw).map_err(|e| CliError::Input(e.to_string()));
+    let p32 = || Params::<f32>::new(raw).map_err(|e| CliError::Input(e.to_string()));
+    match precision {
+        Precision::F64 => run_twin::<f64, f64>(&p64()?, config, prof, n),
+        Precision::F32 => run_twin::<f32, f32>(&p32()?, config, prof, n),
+        Precision::Fixed => run_twin::<f32, Q16_16>(&p32()?, config, prof, n),
+        Precision::Reduced => {
+            let p = p64()?;
+            let mut twin = ReducedTwin::<f64, f64>::new(
+                &p,
+                config.scheme,
+                config.tick,
+                config.substeps,
+                prof.start(),
+            )
+            .map_err(|e| CliError::Input(format!("--from: {e}")))?;
+            let mut out = Response {
+                time: vec![0.0],
+                state: vec![twin.state()],
+            };
+            for k in 0..n {
+                let t_mid = prof.temperature((k as f64 + 0.5) * config.tick);
+                twin.set_temperature(t_mid)
+                    .map_err(|e| CliError::Input(format!("temperature {t_mid} C: {e}")))?;
+                twin.tick()
+                    .map_err(|e| CliError::Failed(format!("tick {k}: {e:?}")))?;
+                out.time.push((k + 1) as f64 * config.tick);
+                out.state.push(twin.state());
+            }
+            Ok(out)
+        }
+        Precision::Reference => {
+            // The profile's temperatures must be evaluable before the solver runs.
+            let p = p64()?;
+            for t in [prof.start(), prof.end()] {
+                p.oil
+                    .state(t)
+                    .map_err(|e| CliError::Input(format!("temperature {t} C: {e}")))?;
+            }
+            let tr = reference::simulate(
+                &raw.core,
+                *prof,
+                n as f64 * config.tick,
+                config.tick,
+                Method::Radau5,
+                1e-12,
+            )
+            .map_err(CliError::Failed)?;
+            Ok(Response {
+                time: tr.time,
+                state: tr
+                    .state
+                    .iter()
+                    .map(|s| DynamicState {
+                        x: s[0],
+                        v: s[1],
+                        p_a: s[2],
+                        p_b: s[3],
+                    })
+                    .collect(),
+            })
+        }
+    }
+}
+
+/// Default simulated time: the ramp's duration plus settling, or 0.5 s.
+pub fn default_t_end(prof: &Profile) -> f64 {
+    prof.kinks().first().copied().unwrap_or(0.0) + 0.5
+}
+
+/// Number of ticks for `t_end`, bounded to keep the output sane.
+pub fn tick_count(t_end: f64, dt: f64) -> Result<usize, CliError> {
+    if !(dt > 0.0 && dt.is_finite()) {
+        return Err(CliError::Input(format!("--dt: {dt} must be positive")));
+    }
+    if !(t_end > 0.0 && t_end.is_finite()) {
+        return Err(CliError::Input(format!(
+            "--t-end: {t_end} must be positive"
+        )));
+    }
+    let n = (t_end / dt).round();
+    if n > 10_000_000.0 {
+        return Err(CliError::Input(format!(
+            "--t-end / --dt: {n} ticks is more than 10,000,000"
+        )));
+    }
+    Ok((n as usize).max(1))
+}
+
+/// `step`: response table.
+#[allow(clippy::too_many_arguments)]
+pub fn step(
+    path: &Path,
+    from: f64,
+    to: f64,
+    ramp: Option<f64>,
+    dt: f64,
+    t_end: Option<f64>,
+    precision: Precision,
+    scheme: Scheme,
+    substeps: u8,
+) -> Result<String, CliError> {
+    let (raw, _) = load_params::<f64>(path)?;
+    let prof = profile(from, to, ramp)?;
+    if substeps == 0 || substeps > compensator::dynamics::twin::MAX_SUBSTEPS {
+        return Err(CliError::Input(format!(
+            "--substeps: {substeps} is not in 1..=16"
+        )));
+    }
+    let n = tick_count(t_end.unwrap_or_else(|| default_t_end(&prof)), dt)?;
+    let config = TwinConfig {
+        scheme,
+        tick: dt,
+        substeps,
+    };
+    let r = simulate(&raw, precision, config, &prof, n)?;
+    let mut table = Table::new(&["time_s", "x_m", "v_m_s", "p_a_pa", "p_b_pa"]);
+    for (t, s) in r.time.iter().zip(&r.state) {
+        table.row(&[*t, s.x, s.v, s.p_a, s.p_b]);
+    }
+    Ok(table.as_str().to_string())
+}
+
+/// `eigen`: eigenvalues of the linearisation per temperature.
+pub fn eigen(path: &Path, temps_spec: &str) -> Result<String, CliError> {
+    let temps = temps::parse(temps_spec)?;
+    let (_, p) = load_params::<f64>(path)?;
+    let mut table = Table::new(&[
+        "t_c",
+        "re_1",
+        "im_1",
+        "re_2",
+        "im_2",
+        "re_3",
+        "im_3",
+        "re_4",
+        "im_4",
+        "zeta_dominant",
+        "omega_n_dominant",
+    ]);
+    for &t in &temps {
+        let l = linearise(&p, t).map_err(|e| crate::commands::at_temperature(t, e))?;
+        let mut row = vec![t];
+        for e in &l.eigenvalues {
+            row.push(e.re);
+            row.push(e.im);
+        }
+        row.push(l.damping_ratio[0]);
+        row.push(l.natural_frequency[0]);
+        table.row(&row);
+    }
+    Ok(table.as_str().to_string())
+}
+
+/// Step-response indicators (Table 3).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Indicators {
+    /// Initial temperature [C].
+    pub from: f64,
+    /// Final temperature [C].
+    pub to: f64,
+    /// Final equilibrium displacement `x*` [m].
+    pub x_star: f64,
+    /// Time to enter and stay within +-2 % of `x*` [s].
+    pub settling_time: f64,
+    /// Largest excursion beyond `x*` in percent of the step `|x* - x0|`.
+    pub overshoot_pct: f64,
+    /// Largest real part of the linearisation at `to` [1/s].
+    pub dominant_re: f64,
+}
+
+/// Indicators of a sampled response.
+pub fn indicators_of(time: &[f64], x: &[f64], x_star: f64) -> (f64, f64) {
+    let band = 0.02 * x_star.abs();
+    let mut settle = 0.0;
+    for i in (0..x.len()).rev() {
+        if (x[i] - x_star).abs() > band {
+            settle = if i + 1 < time.len() {
+                time[i + 1]
+            } else {
+                f64::INFINITY
+            };
+            break;
+        }
+    }
+    let x0 = x[0];
+    let step = x_star - x0;
+    let over = if step != 0.0 {
+        x.iter()
+            .map(|v| (v - x_star) * step.signum())
+            .fold(0.0f64, f64::max)
+            / step.abs()
+            * 100.0
+    } else {
+        0.0
+    };
+    (settle, over)
+}
+
+/// Indicators for a step `from -> to`, from the reference solver sampled
+/// every `dt` over `t_end`.
+pub fn step_indicators(
+    raw: &RawParams,
+    p: &Params<f64>,
+    from: f64,
+    to: f64,
+    dt: f64,
+    t_end: f64,
+) -> Result<Indicators, CliError> {
+    let x_star = equilibrium(p, to)
+        .map_err(|e| CliError::Input(format!("--steps: {to} C: {e}")))?
+        .x;
+    equilibrium(p, from).map_err(|e| CliError::Input(format!("--steps: {from} C: {e}")))?;
+    let tr = reference::simulate(
+        &raw.core,
+        Profile::Step { from, to },
+        t_end,
+        dt,
+        Method::Radau5,
+        1e-10,
+    )
+    .map_err(CliError::Failed)?;
+    let x: Vec<f64> = tr.state.iter().map(|s| s[0]).collect();
+    let (settling_time, overshoot_pct) = indicators_of(&tr.time, &x, x_star);
+    let lin =
+        linearise(p, to).map_err(|e| CliError::Failed(format!("linearisation at {to} C: {e}")))?;
+    Ok(Indicators {
+        from,
+        to,
+        x_star,
+        settling_time,
+        overshoot_pct,
+        dominant_re: lin.dominant.re,
+    })
+}
+
+/// Parses `30:40,40:50,...`.
+pub fn parse_steps(spec: &str) -> Result<Vec<(f64, f64)>, CliError> {
+    spec.split(',')
+        .map(|pair| {
+            let mut it = pair.split(':');
+            let (a, b) = (it.next(), it.next());
+            match (
+                a.map(str::trim).and_then(|s| s.parse::<f64>().ok()),
+                b.map(str::trim).and_then(|s| s.parse::<f64>().ok()),
+                it.next(),
+            ) {
+                (Some(a), Some(b), None) if a.is_finite() && b.is_finite() => Ok((a, b)),
+                _ => Err(CliError::Input(format!(
+                    "--steps: '{pair}' is not of the form from:to"
+                ))),
+            }
+        })
+        .collect()
+}
+
+/// `indicators`: the Table 3 columns per step.
+pub fn indicators(path: &Path, steps_spec: &str, dt: f64, t_end: f64) -> Result<String, CliError> {
+    let (raw, p) = load_params::<f64>(path)?;
+    let steps = parse_steps(steps_spec)?;
+    tick_count(t_end, dt)?;
+    let mut table = Table::new(&[
+        "from_c",
+        "to_c",
+        "x_star_m",
+        "settling_time_s",
+        "overshoot_pct",
+        "dominant_re",
+    ]);
+    for (from, to) in steps {
+        let ind = step_indicators(&raw, &p, from, to, dt, t_end)?;
+        table.row(&[
+            ind.from,
+            ind.to,
+            ind.x_star,
+            ind.settling_time,
+            ind.overshoot_pct,
+            ind.dominant_re,
+        ]);
+    }
+    Ok(table.as_str().to_string())
+}

@@ -1,0 +1,443 @@
+//! Reference solution of the FSI model (MODEL.md section 6) in SI units.
+//!
+//! ```text
+//! C_a dp_a/dt = Q_t(p_p - p_a) - (p_a - p_c) / R_l + A_p v,  C_a = (V_a0 - A_p x) / beta
+//! C_b dp_b/dt = (p_p - p_b) / R_l - Q_t(p_b - p_c) - A_p v,  C_b = (V_b0 + A_p x) / beta
+//! m dv/dt     = A_p (p_b - p_a) - b v - c (x0 + x)
+//! ```
+//!
+//! with the orifice law regularised as in the core (`regRoot`, transition at
+//! `1e-5 dp`) and the oil's properties evaluated at the profile's
+//! temperature at every time (a ramp is followed exactly, not per tick).
+//!
+//! The end stops are events: in free motion the solver stops exactly where
+//! `x` reaches a stop (inelastic: `v = 0`, then held if the static force
+//! pushes into the stop); while held it stops where the force changes sign
+//! (release). Each phase restarts a fresh solver. Event times are found by
+//! the Illinois method on the solver's dense output ([`Phase`]), because the
+//! library's own event search can lose its bracket (0.7.0).
+
+use crate::statics;
+use compensator::params::RawCore;
+use differential_equations::ode::{OrdinaryNumericalMethod, solve_ode};
+use differential_equations::prelude::*;
+use std::f64::consts::PI;
+
+/// Transition of the regularised orifice law, as a fraction of `dp` (the
+/// core's value, restated).
+pub const TRANSITION_FRACTION: f64 = 1.0e-5;
+
+/// The temperature seen by the compensator over time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Profile {
+    /// At equilibrium at `from` before `t = 0`, at `to` after.
+    Step {
+        /// Initial temperature [C].
+        from: f64,
+        /// Final temperature [C].
+        to: f64,
+    },
+    /// From `from` to `to` at `rate` [C/s] starting at `t = 0`, then constant.
+    Ramp {
+        /// Initial temperature [C].
+        from: f64,
+        /// Final temperature [C].
+        to: f64,
+        /// Rate magnitude [C/s].
+        rate: f64,
+    },
+}
+
+impl Profile {
+    /// Temperature at time `t` [s].
+    pub fn temperature(&self, t: f64) -> f64 {
+        match *self {
+            Profile::Step { from, to } => {
+                if t > 0.0 {
+                    to
+                } else {
+                    from
+                }
+            }
+            Profile::Ramp { from, to, rate } => {
+                let span = (to - from).abs() / rate;
+                if t >= span {
+                    to
+                } else {
+                    from + (to - from) * (t.max(0.0) / span)
+                }
+            }
+        }
+    }
+
+    /// Initial temperature [C].
+    pub fn start(&self) -> f64 {
+        match *self {
+            Profile::Step { from, .. } | Profile::Ramp { from, .. } => from,
+        }
+    }
+
+    /// Final temperature [C].
+    pub fn end(&self) -> f64 {
+        match *self {
+            Profile::Step { to, .. } | Profile::Ramp { to, .. } => to,
+        }
+    }
+
+    /// Times where the temperature's derivative jumps (phase boundaries).
+    pub fn kinks(&self) -> Vec<f64> {
+        match *self {
+            Profile::Step { .. } => vec![],
+            Profile::Ramp { from, to, rate } => vec![(to - from).abs() / rate],
+        }
+    }
+}
+
+/// Motion state of the plunger.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    /// Free motion.
+    Free,
+    /// Held at `x = 0`.
+    Closed,
+    /// Held at `x = x_max`.
+    Open,
+}
+
+/// The model at a fixed mode.
+#[derive(Clone, Copy, Debug)]
+pub struct Fsi {
+    p: RawCore,
+    profile: Profile,
+    mode: Mode,
+}
+
+impl Fsi {
+    fn area(&self) -> f64 {
+        PI * self.p.plunger_diameter.powi(2) / 4.0
+    }
+
+    /// Orifice flow for drop `dp` [Pa] at density `rho`, regularised near zero.
+    fn orifice(&self, dp: f64, rho: f64) -> f64 {
+        let f = PI * self.p.turbulent_diameter.powi(2) / 4.0;
+        let tr = TRANSITION_FRACTION * self.p.pressure_drop;
+        self.p.turbulent_discharge * f * (2.0 / rho).sqrt() * dp / (dp * dp + tr * tr).powf(0.25)
+    }
+
+    /// Net static force on the plunger, positive towards `x_max` [N].
+    pub fn force(&self, y: &[f64; 4]) -> f64 {
+        self.area() * (y[3] - y[2]) - self.p.spring_rate * (self.p.preload + y[0])
+    }
+}
+
+impl ODE<f64, [f64; 4]> for Fsi {
+    fn diff(&self, t: f64, y: &[f64; 4], d: &mut [f64; 4]) {
+        let p = &self.p;
+        let (nu, rho) = statics::oil(p, self.profile.temperature(t));
+        let r_l = 128.0 * nu * rho * p.laminar_length / (PI * p.laminar_diameter.powi(4));
+        let (pc, pp) = (p.outlet_pressure, p.outlet_pressure + p.pressure_drop);
+        let area = self.area();
+        let (x, v) = match self.mode {
+            Mode::Free => (y[0], y[1]),
+            Mode::Closed => (0.0, 0.0),
+            Mode::Open => (p.stroke, 0.0),
+        };
+        let c_a = (p.volume_a - area * x) / p.bulk_modulus;
+        let c_b = (p.volume_b + area * x) / p.bulk_modulus;
+        d[2] = (self.orifice(pp - y[2], rho) - (y[2] - pc) / r_l + area * v) / c_a;
+        d[3] = ((pp - y[3]) / r_l - self.orifice(y[3] - pc, rho) - area * v) / c_b;
+        if self.mode == Mode::Free {
+            d[0] = v;
+            d[1] = (self.force(y) - p.damping * v) / p.mass;
+        } else {
+            d[0] = 0.0;
+            d[1] = 0.0;
+        }
+    }
+}
+
+/// Output handler of one phase: records samples on the output grid from
+/// the dense output, and stops exactly at the phase's event.
+struct Phase<'a> {
+    sys: &'a Fsi,
+    grid: &'a [f64],
+    next: usize,
+    samples: Vec<(f64, [f64; 4])>,
+    g_prev: Option<f64>,
+    event: Option<(f64, [f64; 4])>,
+    phase_end: f64,
+    end_state: Option<[f64; 4]>,
+}
+
+impl Phase<'_> {
+    /// Event function and the crossing direction that ends the phase.
+    fn g(&self, y: &[f64; 4]) -> (f64, f64) {
+        match self.sys.mode {
+            Mode::Free => (y[0].min(self.sys.p.stroke - y[0]), -1.0),
+            Mode::Closed => (self.sys.force(y), 1.0),
+            Mode::Open => (self.sys.force(y), -1.0),
+        }
+    }
+}
+
+impl Solout<f64, [f64; 4]> for Phase<'_> {
+    fn solout<I>(
+        &mut self,
+        t_curr: f64,
+        t_prev: f64,
+        y_curr: &[f64; 4],
+        _y_prev: &[f64; 4],
+        interp: &mut I,
+        _sol: &mut Solution<f64, [f64; 4]>,
+    ) -> ControlFlag<f64, [f64; 4]>
+    where
+        I: Interpolation<f64, [f64; 4]> + ?Sized,
+    {
+        let (gc, dir) = self.g(y_curr);
+        let Some(gp) = self.g_prev.replace(gc) else {
+            return ControlFlag::Continue; // first call, at the phase's start
+        };
+        let mut t_stop = t_curr;
+        let mut terminate = false;
+        if dir * gp < 0.0 && dir * gc >= 0.0 {
+            // Illinois regula falsi on the dense output, to adjacent doubles.
+            let (mut a, mut fa, mut b, mut fb) = (t_prev, gp, t_curr, gc);
+            let mut side = 0;
+            for it in 0..300 {
+                if b - a <= 4.0 * f64::EPSILON * b.abs().max(1e-300) || fb == 0.0 {
+                    break;
+                }
+                let mut c = if it < 100 {
+                    (a * fb - b * fa) / (fb - fa)
+                } else {
+                    0.5 * (a + b)
+                };
+                if !(c > a && c < b) {
+                    c = 0.5 * (a + b);
+                }
+                let Ok(yc) = interp.interpolate(c) else { break };
+                let fc = self.g(&yc).0;
+                if dir * fc >= 0.0 {
+                    (b, fb) = (c, fc);
+                    if side == -1 {
+                        fa *= 0.5;
+                    }
+                    side = -1;
+                } else {
+                    (a, fa) = (c, fc);
+                    if side == 1 {
+                        fb *= 0.5;
+                    }
+                    side = 1;
+                }
+            }
+            let yb = interp.interpolate(b).unwrap_or(*y_curr);
+            self.event = Some((b, yb));
+            t_stop = b;
+            terminate = true;
+        }
+        while self.next < self.grid.len() && self.grid[self.next] <= t_stop {
+            let ts = self.grid[self.next];
+            let y = if ts == t_curr {
+                *y_curr
+            } else {
+                interp.interpolate(ts).unwrap_or(*y_curr)
+            };
+            self.samples.push((ts, y));
+            self.next += 1;
+        }
+        if terminate {
+            return ControlFlag::Terminate;
+        }
+        if t_curr >= self.phase_end {
+            self.end_state = Some(*y_curr);
+        }
+        ControlFlag::Continue
+    }
+}
+
+/// Which integrator.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// Radau IIA of order 5 (stiff, implicit).
+    Radau5,
+    /// Dormand-Prince 8(5,3) (explicit), the cross-check.
+    Dop853,
+}
+
+/// A reference trajectory sampled on a uniform grid.
+#[derive(Clone, Debug)]
+pub struct Trajectory {
+    /// Sample times [s], `0, dt, 2 dt, ...`.
+    pub time: Vec<f64>,
+    /// States `(x [m], v [m/s], p_a [Pa], p_b [Pa])` at the sample times.
+    pub state: Vec<[f64; 4]>,
+    /// Mode changes `(time [s], new mode)`.
+    pub events: Vec<(f64, Mode)>,
+    /// Accepted steps of the integrator.
+    pub steps: usize,
+}
+
+/// The equilibrium state `(x, 0, p_a, p_b)` at temperature `t` [C] and its mode.
+pub fn equilibrium(p: &RawCore, t: f64) -> ([f64; 4], Mode) {
+    let e = statics::equilibrium(p, t);
+    let y = [e.x, 0.0, e.p_a, e.p_b];
+    let sys = Fsi {
+        p: *p,
+        profile: Profile::Step { from: t, to: t },
+        mode: Mode::Free,
+    };
+    let f = sys.force(&y);
+    let mode = if e.x <= 0.0 && f <= 0.0 {
+        Mode::Closed
+    } else if e.x >= p.stroke && f >= 0.0 {
+        Mode::Open
+    } else {
+        Mode::Free
+    };
+    (y, mode)
+}
+
+/// Integrates from the equilibrium at the profile's start over `[0, t_end]`,
+/// sampling every `dt` [s], with relative tolerance `rtol` (absolute
+/// tolerances scaled to the stroke, its speed over a millisecond, and `dp`).
+pub fn simulate(
+    p: &RawCore,
+    profile: Profile,
+    t_end: f64,
+    dt: f64,
+    method: Method,
+    rtol: f64,
+) -> Result<Trajectory, String> {
+    if !(t_end > 0.0 && dt > 0.0 && rtol > 0.0) {
+        return Err("t_end, dt and rtol must be positive".into());
+    }
+    let n = (t_end / dt).round() as usize;
+    let grid: Vec<f64> = (0..=n).map(|k| k as f64 * dt).collect();
+    let (mut y, mut mode) = equilibrium(p, profile.start());
+    let mut out = Trajectory {
+        time: vec![0.0],
+        state: vec![y],
+        events: vec![],
+        steps: 0,
+    };
+    let mut next = 1;
+    let mut t = 0.0;
+    let atol = [
+        rtol * p.stroke,
+        rtol * p.stroke * 1e3,
+        rtol * p.pressure_drop,
+        rtol * p.pressure_drop,
+    ];
+    // Phases end at events and at the profile's kinks.
+    let mut boundaries: Vec<f64> = profile
+        .kinks()
+        .into_iter()
+        .filter(|k| *k > 0.0 && *k < t_end)
+        .collect();
+    boundaries.push(t_end);
+    let mut guard = 0;
+    while t < t_end {
+        guard += 1;
+        if guard > 100_000 {
+            return Err("too many phases (chattering at a stop?)".into());
+        }
+        let phase_end = boundaries.iter().copied().find(|b| *b > t).unwrap_or(t_end);
+        let sys = Fsi {
+            p: *p,
+            profile,
+            mode,
+        };
+        let mut phase = Phase {
+            sys: &sys,
+            grid: &grid,
+            next,
+            samples: vec![],
+            g_prev: None,
+            event: None,
+            phase_end,
+            end_state: None,
+        };
+        let h_max = dt.min(phase_end - t);
+        let steps = match method {
+            Method::Radau5 => solve(
+                &sys,
+                t,
+                phase_end,
+                y,
+                &mut phase,
+                ImplicitRungeKutta::radau5()
+                    .rtol([rtol; 4])
+                    .atol(atol)
+                    .h_max(h_max),
+            )?,
+            Method::Dop853 => solve(
+                &sys,
+                t,
+                phase_end,
+                y,
+                &mut phase,
+                ExplicitRungeKutta::dop853()
+                    .rtol(rtol)
+                    .atol(atol)
+                    .h_max(h_max)
+                    .max_steps(100_000_000),
+            )?,
+        };
+        out.steps += steps;
+        for (ts, ys) in phase.samples.drain(..) {
+            out.time.push(ts);
+            out.state.push(ys);
+        }
+        next = phase.next;
+        if let Some((te, mut ye)) = phase.event {
+            t = te;
+            mode = match mode {
+                Mode::Free => {
+                    let low = ye[0] < 0.5 * p.stroke;
+                    ye[0] = if low { 0.0 } else { p.stroke };
+                    ye[1] = 0.0;
+                    let f = sys.force(&ye);
+                    if low && f <= 0.0 {
+                        Mode::Closed
+                    } else if !low && f >= 0.0 {
+                        Mode::Open
+                    } else {
+                        Mode::Free
+                    }
+                }
+                Mode::Closed | Mode::Open => Mode::Free,
+            };
+            y = ye;
+            out.events.push((t, mode));
+        } else {
+            y = phase
+                .end_state
+                .ok_or("integrator ended before the phase end")?;
+            t = phase_end;
+        }
+    }
+    if out.time.len() != grid.len() {
+        return Err(format!(
+            "sampled {} of {} output times",
+            out.time.len(),
+            grid.len()
+        ));
+    }
+    Ok(out)
+}
+
+fn solve<M>(
+    sys: &Fsi,
+    t0: f64,
+    t1: f64,
+    y0: [f64; 4],
+    phase: &mut Phase<'_>,
+    mut method: M,
+) -> Result<usize, String>
+where
+    M: OrdinaryNumericalMethod<f64, [f64; 4]> + Interpolation<f64, [f64; 4]>,
+{
+    let sol = solve_ode(&mut method, sys, t0, t1, &y0, phase).map_err(|e| format!("{e:?}"))?;
+    Ok(sol.steps.accepted)
+}

@@ -1,0 +1,14 @@
+//! Independent `f64` references for the compensator twin.
+//!
+//! Written from MODEL.md in SI units, sharing no model code with the core
+//! (only the parameter values, read through `compensator::params::RawCore`):
+//!
+//! * [`statics`]: the quasi-static equilibrium by bisection on each
+//!   chamber's flow balance (no closed form).
+//! * [`dynamics`]: the FSI model integrated by an adaptive stiff solver
+//!   (Radau IIA order 5, `differential-equations`) with exact location of
+//!   the end-stop events, and the same with the explicit Dormand-Prince
+//!   8(5,3) method as an unrelated cross-check.
+
+pub mod dynamics;
+pub mod statics;

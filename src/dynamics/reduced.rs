@@ -1,0 +1,162 @@
+//! The singular-perturbation limit of the FSI model: chamber pressures
+//! quasi-steady (`C_a, C_b -> 0`), the plunger keeps its inertia.
+//!
+//! With the chambers' flow balances solved for a plunger velocity `w`
+//! (orifice law without regularisation), both chambers give the same
+//! quadratic, `g_l s^2 + q_t s - (g_l - sigma w) = 0`, with
+//! `s = sqrt(1 - pi_a) = sqrt(pi_b)`:
+//!
+//! ```text
+//! s(w)        = 2 (g_l - sigma w) / (q_t + sqrt(q_t^2 + 4 g_l (g_l - sigma w)))
+//! pi_b - pi_a = 2 s^2 - 1
+//! ```
+//!
+//! so the reduced model is two states `(xi, w)` whose pressure force
+//! carries the hydraulic damping `d(2 s^2 - 1)/dw = -4 s sigma / (2 g_l s + q_t)`.
+//! It is valid while `sigma w < g_l` (the plunger does not outrun the
+//! capillaries' flow); beyond, `s` is held at zero.
+
+use super::fsi::{Coefficients, Contact, DynamicState, Model, apply_stops, contact_for};
+use super::schemes::{OdeSystem, Scheme, StepError, Stepper};
+use crate::equilibrium::equilibrium;
+use crate::error::ModelError;
+use crate::params::Params;
+use crate::scalar::{Float, Real};
+
+/// Quasi-steady `s = sqrt(1 - pi_a) = sqrt(pi_b)` and `ds/dw` for velocity `w`.
+pub fn quasi_steady<T: Real>(c: &Coefficients<T>, w: T) -> (T, T) {
+    let two = T::ONE + T::ONE;
+    let drive = (c.g_l - c.sigma * w).max(T::ZERO);
+    let root = (c.q_t * c.q_t + two * two * c.g_l * drive).sqrt();
+    let s = two * drive / (c.q_t + root);
+    let ds = if drive > T::ZERO {
+        -(c.sigma / (two * c.g_l * s + c.q_t))
+    } else {
+        T::ZERO
+    };
+    (s, ds)
+}
+
+/// The reduced model in one contact state.
+#[derive(Clone, Copy, Debug)]
+pub struct ReducedFsi<'a, T> {
+    /// Coefficients at the step's temperature.
+    pub coefficients: &'a Coefficients<T>,
+    /// Contact state, frozen over the step.
+    pub contact: Contact,
+}
+
+impl<T: Real> ReducedFsi<'_, T> {
+    /// Net static force (as in [`Coefficients::static_force`]) at rest.
+    pub fn static_force(&self, xi: T) -> T {
+        let c = self.coefficients;
+        let (s, _) = quasi_steady(c, T::ZERO);
+        c.phi_over_a_x * (s * s + s * s - T::ONE) - (c.xi0 + xi) * c.inv_a_x
+    }
+}
+
+impl<T: Real> OdeSystem<T, 2> for ReducedFsi<'_, T> {
+    fn rhs(&self, y: &[T; 2]) -> [T; 2] {
+        if self.contact != Contact::Free {
+            return [T::ZERO; 2];
+        }
+        let c = self.coefficients;
+        let (s, _) = quasi_steady(c, y[1]);
+        let force = c.phi_over_a_x * (s * s + s * s - T::ONE) - (c.xi0 + y[0]) * c.inv_a_x;
+        [c.a_x * y[1], force - c.two_zeta * y[1]]
+    }
+
+    fn jacobian(&self, y: &[T; 2]) -> [[T; 2]; 2] {
+        if self.contact != Contact::Free {
+            return [[T::ZERO; 2]; 2];
+        }
+        let c = self.coefficients;
+        let (s, ds) = quasi_steady(c, y[1]);
+        let four = T::from_f64(4.0);
+        [
+            [T::ZERO, c.a_x],
+            [-c.inv_a_x, c.phi_over_a_x * four * s * ds - c.two_zeta],
+        ]
+    }
+}
+
+/// The reduced model as a fixed-step twin (same ticks as [`super::Twin`]).
+#[derive(Clone, Copy, Debug)]
+pub struct ReducedTwin<F, T> {
+    model: Model<F>,
+    coefficients: Coefficients<T>,
+    stepper: Stepper<T>,
+    substeps: u8,
+    state: [T; 2],
+}
+
+impl<F: Float, T: Real> ReducedTwin<F, T> {
+    /// At rest in the equilibrium of `temperature` [C].
+    pub fn new(
+        params: &Params<F>,
+        scheme: Scheme,
+        tick: f64,
+        substeps: u8,
+        temperature: F,
+    ) -> Result<Self, ModelError> {
+        if substeps == 0 || !(tick > 0.0) {
+            return Err(ModelError::OutOfRange("tick"));
+        }
+        let model = Model::new(params)?;
+        let fluid = params.oil.state(temperature)?;
+        let eq = equilibrium(params, temperature)?;
+        let y: [T; 4] = model.equilibrium_state(&eq);
+        Ok(ReducedTwin {
+            coefficients: model.coefficients(&fluid)?,
+            stepper: Stepper::new(scheme, tick / substeps as f64 / model.scales.time),
+            substeps,
+            state: [y[0], T::ZERO],
+            model,
+        })
+    }
+
+    /// Sets the oil temperature [C] for the following ticks.
+    pub fn set_temperature(&mut self, temperature: F) -> Result<(), ModelError> {
+        let fluid = self.model.params().oil.state(temperature)?;
+        let (q_t, g_l) = self.model.hydraulic(&fluid)?;
+        self.coefficients.q_t = q_t.to_real();
+        self.coefficients.g_l = g_l.to_real();
+        Ok(())
+    }
+
+    /// Advances one tick (same stop handling as [`super::Twin::tick`]).
+    pub fn tick(&mut self) -> Result<(), StepError> {
+        for _ in 0..self.substeps {
+            let probe = ReducedFsi {
+                coefficients: &self.coefficients,
+                contact: Contact::Free,
+            };
+            let contact = contact_for(
+                self.state[0],
+                self.state[1],
+                probe.static_force(self.state[0]),
+            );
+            let sys = ReducedFsi {
+                coefficients: &self.coefficients,
+                contact,
+            };
+            let mut next = self.stepper.step(&sys, &self.state)?;
+            if contact != Contact::Free {
+                next = [self.state[0], T::ZERO];
+            }
+            let [xi, w] = &mut next;
+            apply_stops(xi, w);
+            self.state = next;
+        }
+        Ok(())
+    }
+
+    /// The state in SI units, with the quasi-steady pressures.
+    pub fn state(&self) -> DynamicState {
+        let (s, _) = quasi_steady(&self.coefficients, self.state[1]);
+        let pb = s * s;
+        self.model
+            .scales
+            .to_si(&[self.state[0], self.state[1], T::ONE - pb, pb])
+    }
+}

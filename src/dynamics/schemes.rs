@@ -1,0 +1,406 @@
+//! One-step schemes for `y' = f(y)` with a frozen right-hand side over the
+//! step, generic over the scalar type and the state dimension.
+//!
+//! Rosenbrock (linearly implicit Runge-Kutta) methods in the transformed
+//! form of Hairer & Wanner (IV.7), one LU factorisation per step:
+//!
+//! ```text
+//! (I / (h gamma) - J) U_i = f(y + sum_j a_ij U_j) + sum_j (c_ij / h) U_j
+//! y_next = y + sum_i m_i U_i
+//! ```
+//!
+//! | scheme | stages | order | stability | source |
+//! |---|---|---|---|---|
+//! | [`Scheme::LinearlyImplicitEuler`] | 1 | 1 | L-stable | - |
+//! | [`Scheme::Ros2`] | 2 | 2 | L-stable | Verwer, Spee, Blom, Hundsdorfer 1999 |
+//! | [`Scheme::Ros3`] | 3 | 3 | L-stable | Sandu et al. 1997 |
+//! | [`Scheme::Rodas3`] | 4 | 3 | L-stable, stiffly accurate | Sandu et al. 1997 |
+//! | [`Scheme::Rk4`] | 4 | 4 | explicit (|h lambda| < 2.8) | Kutta 1901 |
+//!
+//! The cost is fixed by the scheme: no iteration depends on the data.
+
+// Matrix code indexes rows and columns explicitly, as the algorithms are
+// written (EISPACK, Hairer & Wanner); iterator chains would obscure them.
+#![allow(clippy::needless_range_loop)]
+
+use crate::linalg::Lu;
+use crate::scalar::Real;
+
+/// A system `y' = f(y)` with its Jacobian.
+pub trait OdeSystem<T, const N: usize> {
+    /// The right-hand side `f(y)`.
+    fn rhs(&self, y: &[T; N]) -> [T; N];
+    /// The Jacobian `df/dy` at `y`.
+    fn jacobian(&self, y: &[T; N]) -> [[T; N]; N];
+}
+
+/// The one-step schemes the integrator can run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Scheme {
+    /// Classical explicit Runge-Kutta of order 4.
+    Rk4,
+    /// Linearly implicit (Rosenbrock) Euler, order 1.
+    LinearlyImplicitEuler,
+    /// Two-stage L-stable Rosenbrock method ROS2, order 2.
+    Ros2,
+    /// Three-stage L-stable Rosenbrock method ROS3, order 3.
+    Ros3,
+    /// Four-stage stiffly accurate Rosenbrock method RODAS3, order 3.
+    Rodas3,
+}
+
+impl Scheme {
+    /// Every scheme, for benchmarks.
+    pub const ALL: [Scheme; 5] = [
+        Scheme::Rk4,
+        Scheme::LinearlyImplicitEuler,
+        Scheme::Ros2,
+        Scheme::Ros3,
+        Scheme::Rodas3,
+    ];
+
+    /// Short name (`"ros2"`...).
+    pub const fn name(self) -> &'static str {
+        match self {
+            Scheme::Rk4 => "rk4",
+            Scheme::LinearlyImplicitEuler => "linearly-implicit-euler",
+            Scheme::Ros2 => "ros2",
+            Scheme::Ros3 => "ros3",
+            Scheme::Rodas3 => "rodas3",
+        }
+    }
+
+    /// Order of accuracy.
+    pub const fn order(self) -> u8 {
+        match self {
+            Scheme::Rk4 => 4,
+            Scheme::LinearlyImplicitEuler => 1,
+            Scheme::Ros2 => 2,
+            Scheme::Ros3 | Scheme::Rodas3 => 3,
+        }
+    }
+
+    /// The scheme with this [`Scheme::name`].
+    pub fn from_name(name: &str) -> Option<Scheme> {
+        Scheme::ALL.iter().copied().find(|s| s.name() == name)
+    }
+}
+
+/// Most stages of any scheme.
+const MAX_STAGES: usize = 4;
+
+/// A Rosenbrock tableau in transformed form (all in `f64`).
+struct Tableau {
+    stages: usize,
+    gamma: f64,
+    a: [[f64; MAX_STAGES]; MAX_STAGES],
+    c: [[f64; MAX_STAGES]; MAX_STAGES],
+    m: [f64; MAX_STAGES],
+}
+
+fn tableau(scheme: Scheme) -> Tableau {
+    let z = [[0.0; MAX_STAGES]; MAX_STAGES];
+    match scheme {
+        Scheme::LinearlyImplicitEuler | Scheme::Rk4 => Tableau {
+            stages: 1,
+            gamma: 1.0,
+            a: z,
+            c: z,
+            m: [1.0, 0.0, 0.0, 0.0],
+        },
+        Scheme::Ros2 => {
+            let g = 1.0 + core::f64::consts::FRAC_1_SQRT_2;
+            let mut a = z;
+            let mut c = z;
+            a[1][0] = 1.0 / g;
+            c[1][0] = -2.0 / g;
+            Tableau {
+                stages: 2,
+                gamma: g,
+                a,
+                c,
+                m: [1.5 / g, 0.5 / g, 0.0, 0.0],
+            }
+        }
+        Scheme::Ros3 => {
+            let mut a = z;
+            let mut c = z;
+            a[1][0] = 1.0;
+            a[2][0] = 1.0;
+            c[1][0] = -1.015_617_108_387_770_2;
+            c[2][0] = 4.075_995_645_253_77;
+            c[2][1] = 9.207_679_429_833_079;
+            Tableau {
+                stages: 3,
+                gamma: 0.435_866_521_508_459,
+                a,
+                c,
+                m: [1.0, 6.169_794_704_382_824_5, -0.427_722_565_432_185_7, 0.0],
+            }
+        }
+        Scheme::Rodas3 => {
+            let mut a = z;
+            let mut c = z;
+            a[2][0] = 2.0;
+            a[3][0] = 2.0;
+            a[3][2] = 1.0;
+            c[1][0] = 4.0;
+            c[2][0] = 1.0;
+            c[2][1] = -1.0;
+            c[3][0] = 1.0;
+            c[3][1] = -1.0;
+            c[3][2] = -8.0 / 3.0;
+            Tableau {
+                stages: 4,
+                gamma: 0.5,
+                a,
+                c,
+                m: [2.0, 0.0, 1.0, 1.0],
+            }
+        }
+    }
+}
+
+/// A scheme prepared for a fixed step `h`, in scalar type `T`.
+#[derive(Clone, Copy, Debug)]
+pub struct Stepper<T> {
+    scheme: Scheme,
+    stages: usize,
+    h: T,
+    inv_gamma_h: T,
+    a: [[T; MAX_STAGES]; MAX_STAGES],
+    c_over_h: [[T; MAX_STAGES]; MAX_STAGES],
+    m: [T; MAX_STAGES],
+    /// Stage `i` evaluates `f` at the same point as stage `i - 1`.
+    reuse_f: [bool; MAX_STAGES],
+}
+
+/// Why a step was not taken.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum StepError {
+    /// `I / (h gamma) - J` is singular (or not finite).
+    Singular,
+    /// The new state is not finite.
+    NonFinite,
+}
+
+impl<T: Real> Stepper<T> {
+    /// Prepares `scheme` for step `h` (in the system's time unit).
+    pub fn new(scheme: Scheme, h: f64) -> Self {
+        let tab = tableau(scheme);
+        let mut a = [[T::ZERO; MAX_STAGES]; MAX_STAGES];
+        let mut c_over_h = [[T::ZERO; MAX_STAGES]; MAX_STAGES];
+        let mut m = [T::ZERO; MAX_STAGES];
+        let mut reuse_f = [false; MAX_STAGES];
+        for i in 0..MAX_STAGES {
+            for j in 0..MAX_STAGES {
+                a[i][j] = T::from_f64(tab.a[i][j]);
+                c_over_h[i][j] = T::from_f64(tab.c[i][j] / h);
+            }
+            m[i] = T::from_f64(tab.m[i]);
+            // Same evaluation point as the previous stage: row i of `a`
+            // equals row i-1 (whose entry at i-1 is zero by triangularity).
+            reuse_f[i] = i > 0 && (0..MAX_STAGES).all(|j| tab.a[i][j] == tab.a[i - 1][j]);
+        }
+        Stepper {
+            scheme,
+            stages: tab.stages,
+            h: T::from_f64(h),
+            inv_gamma_h: T::from_f64(1.0 / (tab.gamma * h)),
+            a,
+            c_over_h,
+            m,
+            reuse_f,
+        }
+    }
+
+    /// The scheme.
+    pub fn scheme(&self) -> Scheme {
+        self.scheme
+    }
+
+    /// The same scheme for a step of `fraction` times this one's, computed
+    /// in `T` (a division and a dozen multiplications; no `f64`).
+    /// `fraction` must be positive.
+    pub fn scaled(&self, fraction: T) -> Self {
+        let inv = T::ONE / fraction;
+        let mut s = *self;
+        s.h = self.h * fraction;
+        s.inv_gamma_h = self.inv_gamma_h * inv;
+        for row in s.c_over_h.iter_mut() {
+            for c in row.iter_mut() {
+                *c *= inv;
+            }
+        }
+        s
+    }
+
+    /// Advances `y` by one step of `sys`.
+    pub fn step<S: OdeSystem<T, N>, const N: usize>(
+        &self,
+        sys: &S,
+        y: &[T; N],
+    ) -> Result<[T; N], StepError> {
+        let next = match self.scheme {
+            Scheme::Rk4 => self.rk4(sys, y),
+            _ => self.rosenbrock(sys, y)?,
+        };
+        if next.iter().all(|v| v.is_finite()) {
+            Ok(next)
+        } else {
+            Err(StepError::NonFinite)
+        }
+    }
+
+    fn rosenbrock<S: OdeSystem<T, N>, const N: usize>(
+        &self,
+        sys: &S,
+        y: &[T; N],
+    ) -> Result<[T; N], StepError> {
+        let jac = sys.jacobian(y);
+        let mut w = [[T::ZERO; N]; N];
+        for i in 0..N {
+            for j in 0..N {
+                w[i][j] = -jac[i][j];
+            }
+            w[i][i] += self.inv_gamma_h;
+        }
+        let lu = Lu::new(w).ok_or(StepError::Singular)?;
+        let mut u = [[T::ZERO; N]; MAX_STAGES];
+        let mut f = [T::ZERO; N];
+        for i in 0..self.stages {
+            if !self.reuse_f[i] || i == 0 {
+                let mut yi = *y;
+                for (j, uj) in u.iter().enumerate().take(i) {
+                    let aij = self.a[i][j];
+                    if aij != T::ZERO {
+                        for k in 0..N {
+                            yi[k] += aij * uj[k];
+                        }
+                    }
+                }
+                f = sys.rhs(&yi);
+            }
+            let mut rhs = f;
+            for (j, uj) in u.iter().enumerate().take(i) {
+                let cij = self.c_over_h[i][j];
+                if cij != T::ZERO {
+                    for k in 0..N {
+                        rhs[k] += cij * uj[k];
+                    }
+                }
+            }
+            u[i] = lu.solve(&rhs);
+        }
+        let mut next = *y;
+        for (i, ui) in u.iter().enumerate().take(self.stages) {
+            let mi = self.m[i];
+            if mi != T::ZERO {
+                for k in 0..N {
+                    next[k] += mi * ui[k];
+                }
+            }
+        }
+        Ok(next)
+    }
+
+    fn rk4<S: OdeSystem<T, N>, const N: usize>(&self, sys: &S, y: &[T; N]) -> [T; N] {
+        let half = self.h / (T::ONE + T::ONE);
+        let sixth = self.h / T::from_f64(6.0);
+        let shifted = |base: &[T; N], k: &[T; N], s: T| {
+            let mut out = *base;
+            for i in 0..N {
+                out[i] += s * k[i];
+            }
+            out
+        };
+        let k1 = sys.rhs(y);
+        let k2 = sys.rhs(&shifted(y, &k1, half));
+        let k3 = sys.rhs(&shifted(y, &k2, half));
+        let k4 = sys.rhs(&shifted(y, &k3, self.h));
+        let mut next = *y;
+        let two = T::ONE + T::ONE;
+        for i in 0..N {
+            next[i] += sixth * (k1[i] + two * k2[i] + two * k3[i] + k4[i]);
+        }
+        next
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// y' = A y with a stiff, non-normal A; exact solution by eigenvectors.
+    struct Linear;
+    const A: [[f64; 2]; 2] = [[-1.0, 1.0], [0.0, -100.0]];
+    impl OdeSystem<f64, 2> for Linear {
+        fn rhs(&self, y: &[f64; 2]) -> [f64; 2] {
+            [A[0][0] * y[0] + A[0][1] * y[1], A[1][1] * y[1]]
+        }
+        fn jacobian(&self, _: &[f64; 2]) -> [[f64; 2]; 2] {
+            A
+        }
+    }
+    fn exact(t: f64) -> [f64; 2] {
+        // y0 = (1, 1): y2 = e^{-100t}; y1 = e^{-t} + (e^{-t} - e^{-100t}) / 99.
+        let (e1, e100) = ((-t).exp(), (-100.0 * t).exp());
+        [e1 + (e1 - e100) / 99.0, e100]
+    }
+    /// Non-stiff test (observable order): y' = -y + cos-like coupling.
+    struct Smooth;
+    impl OdeSystem<f64, 2> for Smooth {
+        fn rhs(&self, y: &[f64; 2]) -> [f64; 2] {
+            [y[1], -y[0]]
+        }
+        fn jacobian(&self, _: &[f64; 2]) -> [[f64; 2]; 2] {
+            [[0.0, 1.0], [-1.0, 0.0]]
+        }
+    }
+
+    fn error(scheme: Scheme, n: usize) -> f64 {
+        let h = 1.0 / n as f64;
+        let s = Stepper::<f64>::new(scheme, h);
+        let mut y = [1.0, 0.0];
+        for _ in 0..n {
+            y = s.step(&Smooth, &y).unwrap();
+        }
+        ((y[0] - 1f64.cos()).powi(2) + (y[1] + 1f64.sin()).powi(2)).sqrt()
+    }
+
+    #[test]
+    fn each_scheme_converges_at_its_order() {
+        for scheme in Scheme::ALL {
+            let (e1, e2) = (error(scheme, 40), error(scheme, 80));
+            let observed = (e1 / e2).log2();
+            assert!(
+                (observed - scheme.order() as f64).abs() < 0.2,
+                "{scheme:?}: observed order {observed}"
+            );
+        }
+    }
+
+    #[test]
+    fn rosenbrock_schemes_damp_stiff_modes_at_large_steps() {
+        for scheme in [
+            Scheme::LinearlyImplicitEuler,
+            Scheme::Ros2,
+            Scheme::Ros3,
+            Scheme::Rodas3,
+        ] {
+            let h = 0.1; // h * 100 = 10: far outside any explicit stability region
+            let s = Stepper::<f64>::new(scheme, h);
+            let mut y = [1.0, 1.0];
+            for _ in 0..10 {
+                y = s.step(&Linear, &y).unwrap();
+            }
+            let e = exact(1.0);
+            assert!(
+                (y[0] - e[0]).abs() < 0.05 && y[1].abs() < 1e-3,
+                "{scheme:?}: {y:?} vs {e:?}"
+            );
+        }
+    }
+}
