@@ -29,9 +29,9 @@
 //! The expansion describes the branch between the stops; the series value
 //! is reported unclamped and clamped to the stops.
 
-use crate::equilibrium::{Stop, a_derivatives, a_parameter, branch_fraction, clamp_to_stops};
+use crate::equilibrium::{Stop, a_derivatives, a_derivatives_at, a_parameter, branch_fraction, clamp_to_stops};
 use crate::error::{ModelError, finite};
-use crate::fluid::Derivatives;
+use crate::fluid::{Derivatives, FluidPoint};
 use crate::params::Params;
 use crate::scalar::Float;
 
@@ -205,18 +205,11 @@ impl<T: Float> Expansion<T> {
         let (g0, s) = branch_fraction(ah);
         let g1 = -g0 / (s * sqrt_dp);
         let g2 = g0 * (s + ah) / (dp * s * s * s);
-        let kq = p.orifice.discharge_coefficient
-            * p.orifice.area()
-            * T::from_f64(core::f64::consts::SQRT_2)
-            * sqrt_dp;
+        let kq = p.orifice.discharge_coefficient * p.orifice.area() * T::from_f64(core::f64::consts::SQRT_2) * sqrt_dp;
         let qa0 = kq * g0 * h0;
         let qa1 = kq * (g1 * h0 * a1 + g0 * h1 * r1);
         let qa2 = kq
-            * (g1 * h0 * a2
-                + g0 * h1 * r2
-                + half * g2 * h0 * a1 * a1
-                + g1 * h1 * a1 * r1
-                + half * g0 * h2 * r1 * r1);
+            * (g1 * h0 * a2 + g0 * h1 * r2 + half * g2 * h0 * a1 * a1 + g1 * h1 * a1 * r1 + half * g0 * h2 * r1 * r1);
 
         let two = T::from_f64(2.0);
         let terms = Terms {
@@ -253,16 +246,18 @@ pub struct Sensitivity<T> {
 
 /// Sensitivities of the equilibrium to temperature at `t` [C] (Eqs. 30-31).
 pub fn sensitivity<T: Float>(params: &Params<T>, t: T) -> Result<Sensitivity<T>, ModelError> {
-    let a = a_derivatives(params, t)?;
-    let rho = params.oil.density_derivatives(t)?;
+    sensitivity_at(params, &params.oil.point(t)?)
+}
+
+/// As [`sensitivity`] from an evaluated [`FluidPoint`] (what the estimator
+/// uses, sharing one Walther evaluation with the fluid state).
+pub fn sensitivity_at<T: Float>(params: &Params<T>, point: &FluidPoint<T>) -> Result<Sensitivity<T>, ModelError> {
+    let a = a_derivatives_at(params, point)?;
+    let rho = &point.density;
     let ph = phi_derivatives(params, a.value);
     let dx_branch = ph.d1 * a.d1;
     let (x, stop) = clamp_to_stops(ph.value - params.plunger.preload, params.plunger.stroke);
-    let dx = if stop == Stop::Free {
-        dx_branch
-    } else {
-        T::ZERO
-    };
+    let dx = if stop == Stop::Free { dx_branch } else { T::ZERO };
     let w = params.slot.discharge_coefficient
         * T::from_f64(core::f64::consts::PI)
         * params.slot.diameter
@@ -271,7 +266,7 @@ pub fn sensitivity<T: Float>(params: &Params<T>, t: T) -> Result<Sensitivity<T>,
     // Eq. (30): eta pi d sqrt(2 dp / rho) dx/dt - eta pi d x sqrt(2 dp) rho^(-3/2) rho' / 2
     let dq = w * inv_sqrt_rho * dx - w * x * T::from_f64(0.5) * inv_sqrt_rho / rho.value * rho.d1;
     Ok(Sensitivity {
-        temperature: t,
+        temperature: point.state.temperature,
         dx_dt_branch: finite(dx_branch, "dx/dt")?,
         dx_dt: dx,
         dq_throt_dt: finite(dq, "dQ_throt/dt")?,
@@ -301,12 +296,7 @@ pub const MAX_MONOTONICITY_SAMPLES: u32 = 100_000;
 /// Checks Eq. (32), `Phi'(A(t)) dA/dt != 0` with one sign, on `samples`
 /// evenly spaced temperatures of `[lo, hi]` [C] (clamped to
 /// `2..=MAX_MONOTONICITY_SAMPLES`).
-pub fn monotonicity<T: Float>(
-    params: &Params<T>,
-    lo: T,
-    hi: T,
-    samples: u32,
-) -> Result<Monotonicity<T>, ModelError> {
+pub fn monotonicity<T: Float>(params: &Params<T>, lo: T, hi: T, samples: u32) -> Result<Monotonicity<T>, ModelError> {
     let (lo, hi) = (finite(lo, "temperature")?, finite(hi, "temperature")?);
     if !(hi > lo) {
         return Err(ModelError::OutOfRange("temperature interval"));

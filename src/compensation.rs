@@ -37,11 +37,14 @@ pub struct Compensation<T> {
 
 /// Laminar leakage of the machine at `t` [C]: `dQ_ref mu(t_ref) / mu(t)` [m^3/s].
 pub fn losses<T: Float>(params: &Params<T>, machine: &Machine<T>, t: T) -> Result<T, ModelError> {
-    let mu_ref = params
-        .oil
-        .state(machine.leakage_temperature)?
-        .dynamic_viscosity;
+    let mu_ref = params.oil.state(machine.leakage_temperature)?.dynamic_viscosity;
     let mu = params.oil.state(t)?.dynamic_viscosity;
+    losses_for(machine, mu_ref, mu)
+}
+
+/// Laminar leakage for the oil's dynamic viscosity `mu` [Pa s], given the
+/// viscosity `mu_ref` at the machine's reference temperature [m^3/s].
+pub fn losses_for<T: Float>(machine: &Machine<T>, mu_ref: T, mu: T) -> Result<T, ModelError> {
     finite(machine.leakage_reference * mu_ref / mu, "losses")
 }
 
@@ -57,8 +60,7 @@ pub fn compensation<T: Float>(params: &Params<T>, t: T) -> Result<Compensation<T
     let lost = losses(params, machine, t)?;
     let demand = machine.working_flow + lost;
     let velocity = (T::from_f64(2.0) * params.pressure_drop / eq.fluid.density).sqrt();
-    let required_area =
-        (demand - eq.q_branch - eq.q_branch) / (params.slot.discharge_coefficient * velocity);
+    let required_area = (demand - eq.q_branch - eq.q_branch) / (params.slot.discharge_coefficient * velocity);
     let required_x = required_area / (T::from_f64(core::f64::consts::PI) * params.slot.diameter);
     Ok(Compensation {
         equilibrium: eq,

@@ -20,7 +20,7 @@
 //! closed form, two of them square roots.
 
 use crate::error::{ModelError, finite};
-use crate::fluid::{Derivatives, FluidState};
+use crate::fluid::{Derivatives, FluidPoint, FluidState};
 use crate::params::Params;
 use crate::scalar::Float;
 
@@ -85,9 +85,7 @@ pub fn pressure_difference<T: Float>(a: T, dp: T) -> T {
 /// [1/m]. It depends on the throttles' geometry only.
 #[inline]
 pub fn geometry_factor<T: Float>(params: &Params<T>) -> T {
-    T::from_f64(core::f64::consts::SQRT_2)
-        * params.orifice.discharge_coefficient
-        * params.orifice.area()
+    T::from_f64(core::f64::consts::SQRT_2) * params.orifice.discharge_coefficient * params.orifice.area()
         / params.capillary.bore_term()
 }
 
@@ -102,8 +100,12 @@ pub fn a_parameter<T: Float>(params: &Params<T>, fluid: &FluidState<T>) -> T {
 /// `L2 = nu''/nu - (nu'/nu)^2 + rho''/(2 rho) - (rho'/rho)^2 / 2`,
 /// `A' = A L1` and `A'' = A (L1^2 + L2)`.
 pub fn a_derivatives<T: Float>(params: &Params<T>, t: T) -> Result<Derivatives<T>, ModelError> {
-    let nu = params.oil.kinematic_viscosity_derivatives(t)?;
-    let rho = params.oil.density_derivatives(t)?;
+    a_derivatives_at(params, &params.oil.point(t)?)
+}
+
+/// As [`a_derivatives`] from an evaluated [`FluidPoint`].
+pub fn a_derivatives_at<T: Float>(params: &Params<T>, point: &FluidPoint<T>) -> Result<Derivatives<T>, ModelError> {
+    let (nu, rho) = (&point.viscosity, &point.density);
     let a = geometry_factor(params) * nu.value * rho.value.sqrt();
     let n1 = nu.d1 / nu.value;
     let r1 = rho.d1 / rho.value;
@@ -130,11 +132,7 @@ pub fn clamp_to_stops<T: Float>(x_free: T, stroke: T) -> (T, Stop) {
 }
 
 /// The equilibrium for a given `A` [sqrt(Pa)] and fluid state.
-pub fn equilibrium_for<T: Float>(
-    params: &Params<T>,
-    fluid: FluidState<T>,
-    a: T,
-) -> Result<Equilibrium<T>, ModelError> {
+pub fn equilibrium_for<T: Float>(params: &Params<T>, fluid: FluidState<T>, a: T) -> Result<Equilibrium<T>, ModelError> {
     let dp = params.pressure_drop;
     let sqrt_dp = dp.sqrt();
     let (q, _) = branch_fraction(finite(a, "A(t)")? / sqrt_dp);
@@ -194,9 +192,7 @@ pub fn balance_temperature<T: Float>(params: &Params<T>, lo: T, hi: T) -> Result
         return Ok(hi);
     }
     if (g_lo > T::ZERO) == (g_hi > T::ZERO) {
-        return Err(ModelError::OutOfRange(
-            "balance temperature (not bracketed)",
-        ));
+        return Err(ModelError::OutOfRange("balance temperature (not bracketed)"));
     }
     let lo_positive = g_lo > T::ZERO;
     for _ in 0..64 {

@@ -64,6 +64,18 @@ pub struct FluidState<T> {
     pub dynamic_viscosity: T,
 }
 
+/// The oil at one temperature with the temperature derivatives of its
+/// viscosity and density, from a single Walther evaluation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FluidPoint<T> {
+    /// Viscosities and density.
+    pub state: FluidState<T>,
+    /// `nu`, `nu'`, `nu''` [m^2/s, per K, per K^2].
+    pub viscosity: Derivatives<T>,
+    /// `rho`, `rho'`, `rho''` [kg/m^3, per K, per K^2].
+    pub density: Derivatives<T>,
+}
+
 /// A quantity with its first two temperature derivatives.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Derivatives<T> {
@@ -79,13 +91,7 @@ impl<T: Float> Oil<T> {
     /// An oil from its constants (Walther `a`, `b` [-], density at 15 C
     /// [kg/m^3], expansion [1/K], bulk modulus [Pa]), given in `f64` so that
     /// the reference term of the Walther form is exact to `f64` precision.
-    pub fn new(
-        walther_a: f64,
-        walther_b: f64,
-        density_15: f64,
-        expansion: f64,
-        bulk_modulus: f64,
-    ) -> Self {
+    pub fn new(walther_a: f64, walther_b: f64, density_15: f64, expansion: f64, bulk_modulus: f64) -> Self {
         let u_ref = walther_a - walther_b * libm::log10(WALTHER_REFERENCE_C + KELVIN_OFFSET);
         Oil {
             walther_a: T::from_f64(walther_a),
@@ -106,8 +112,7 @@ impl<T: Float> Oil<T> {
         }
         let t_ref = T::from_f64(WALTHER_REFERENCE_C + KELVIN_OFFSET);
         let delta = (t - T::from_f64(WALTHER_REFERENCE_C)) / t_ref;
-        let u = self.walther_u_ref
-            - self.walther_b * delta.ln_1p() * T::from_f64(core::f64::consts::LOG10_E);
+        let u = self.walther_u_ref - self.walther_b * delta.ln_1p() * T::from_f64(core::f64::consts::LOG10_E);
         let w = u.exp10();
         let z = w.exp10();
         if !z.is_finite() || z > T::from_f64(WALTHER_MAX_CST + 0.7) {
@@ -116,9 +121,7 @@ impl<T: Float> Oil<T> {
             ));
         }
         if !(z >= T::from_f64(WALTHER_MIN_CST + 0.7)) {
-            return Err(ModelError::OutOfRange(
-                "temperature (viscosity below 2 cSt)",
-            ));
+            return Err(ModelError::OutOfRange("temperature (viscosity below 2 cSt)"));
         }
         Ok((z, w, tk))
     }
@@ -174,6 +177,22 @@ impl<T: Float> Oil<T> {
             value: rho,
             d1: -r * rho,
             d2: T::from_f64(2.0) * r * r * rho,
+        })
+    }
+
+    /// State and derivatives at `t` [C] (one Walther evaluation).
+    pub fn point(&self, t: T) -> Result<FluidPoint<T>, ModelError> {
+        let nu = self.kinematic_viscosity_derivatives(t)?;
+        let rho = self.density_derivatives(t)?;
+        Ok(FluidPoint {
+            state: FluidState {
+                temperature: t,
+                kinematic_viscosity: nu.value,
+                density: rho.value,
+                dynamic_viscosity: finite(nu.value * rho.value, "dynamic viscosity")?,
+            },
+            viscosity: nu,
+            density: rho,
         })
     }
 

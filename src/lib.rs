@@ -13,6 +13,9 @@
 //! | asymptotic closed forms, sensitivities, Eq. 32 | [`asymptotic`] | Eqs. 11-32 |
 //! | reduced-order FSI model, fixed-step twin, linearisation | [`dynamics`] | Eqs. 33-37 |
 //!
+//! On top: [`estimator`] (what the firmware runs every tick) and [`sensor`]
+//! (the temperature source: PT100 through a MAX31865).
+//!
 //! Building blocks: [`params`] (validated parameter sets), [`fluid`] (oil
 //! properties), [`throttle`] (throttle laws), [`scalar`] (the `f32` / `f64` /
 //! fixed-point scalar traits).
@@ -29,11 +32,17 @@ pub mod compensation;
 pub mod dynamics;
 pub mod equilibrium;
 mod error;
+pub mod estimator;
 pub mod fluid;
 pub mod linalg;
+pub mod mathf;
 pub mod params;
 pub mod scalar;
+pub mod sensor;
 pub mod throttle;
+
+#[cfg(all(feature = "qemu", target_os = "none"))]
+mod qemu_log;
 
 pub use error::ModelError;
 pub use params::{ParamError, Params, RawParams};

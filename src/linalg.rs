@@ -59,11 +59,7 @@ impl<T: Real, const N: usize> Lu<T, N> {
                 }
             }
         }
-        Some(Lu {
-            lu: a,
-            inv_diag,
-            perm,
-        })
+        Some(Lu { lu: a, inv_diag, perm })
     }
 
     /// Solves `A x = b`.

@@ -9,9 +9,11 @@
 //!   handed to the fixed-point integrator as dimensionless coefficients.
 //!
 //! Cost notes (Cortex-M4F): `f32` square roots use the FPU's `VSQRT.F32`
-//! (14 cycles, one instruction) through inline assembly; `libm::sqrtf` would
-//! be a software routine of ~40 instructions. `exp`/`ln` come from `libm`
-//! (roughly 40-80 instructions each in `f32`, correctly rounded to ~1 ulp).
+//! through inline assembly (five instructions); `libm::sqrtf` would be a
+//! software routine. `f32` exponentials and logarithms come from
+//! [`crate::mathf`] (native `f32`, within 2 ulp, 30-40 instructions):
+//! `libm`'s `f32` versions compute in double precision internally, which
+//! the single-precision FPU runs in software (~1,000 instructions).
 //! `micromath`'s approximations are not used for the fluid laws: Walther's
 //! double exponential amplifies their ~1e-4 relative error about tenfold.
 
@@ -50,6 +52,8 @@ pub trait Real:
     fn from_f32(v: f32) -> Self;
     /// Conversion to a double (exact for all implementations).
     fn to_f64(self) -> f64;
+    /// Conversion to a single (exact for `f32`; rounds otherwise).
+    fn to_f32(self) -> f32;
     /// Square root; returns zero for negative input (and NaN for NaN in
     /// floating point).
     fn sqrt(self) -> Self;
@@ -104,6 +108,9 @@ pub trait Float: Real {
     /// Conversion to another scalar type without a detour through `f64`
     /// where the source is `f32` (no soft-double code on a Cortex-M4F).
     fn to_real<T: Real>(self) -> T;
+    /// Conversion from another scalar type, through `f32` when `Self` is
+    /// `f32` (no soft-double code on a Cortex-M4F).
+    fn from_real<T: Real>(v: T) -> Self;
 }
 
 /// Hardware square root on the Cortex-M4F FPU.
@@ -157,6 +164,10 @@ impl Real for f32 {
         self as f64
     }
     #[inline]
+    fn to_f32(self) -> f32 {
+        self
+    }
+    #[inline]
     fn sqrt(self) -> Self {
         if self > 0.0 {
             sqrt_f32(self)
@@ -180,30 +191,33 @@ impl Real for f32 {
     }
 }
 
+/// `f32` transcendentals come from [`crate::mathf`] (native single
+/// precision); `libm`'s would compute in software double precision on the
+/// Cortex-M4F.
 impl Float for f32 {
     #[inline]
     fn ln(self) -> Self {
-        libm::logf(self)
+        crate::mathf::ln(self)
     }
     #[inline]
     fn log10(self) -> Self {
-        libm::log10f(self)
+        crate::mathf::log10(self)
     }
     #[inline]
     fn ln_1p(self) -> Self {
-        libm::log1pf(self)
+        crate::mathf::ln_1p(self)
     }
     #[inline]
     fn exp(self) -> Self {
-        libm::expf(self)
+        crate::mathf::exp(self)
     }
     #[inline]
     fn exp10(self) -> Self {
-        libm::exp10f(self)
+        crate::mathf::exp10(self)
     }
     #[inline]
     fn powf(self, p: Self) -> Self {
-        libm::powf(self, p)
+        crate::mathf::powf(self, p)
     }
     #[inline]
     fn nan() -> Self {
@@ -216,6 +230,10 @@ impl Float for f32 {
     #[inline]
     fn to_real<T: Real>(self) -> T {
         T::from_f32(self)
+    }
+    #[inline]
+    fn from_real<T: Real>(v: T) -> Self {
+        v.to_f32()
     }
 }
 
@@ -234,6 +252,10 @@ impl Real for f64 {
     #[inline]
     fn to_f64(self) -> f64 {
         self
+    }
+    #[inline]
+    fn to_f32(self) -> f32 {
+        self as f32
     }
     #[inline]
     fn sqrt(self) -> Self {
@@ -295,6 +317,10 @@ impl Float for f64 {
     #[inline]
     fn to_real<T: Real>(self) -> T {
         T::from_f64(self)
+    }
+    #[inline]
+    fn from_real<T: Real>(v: T) -> Self {
+        v.to_f64()
     }
 }
 
@@ -421,10 +447,7 @@ mod fixed_point {
     impl<F: LeEqU32> Real for Fix<F> {
         const ZERO: Self = Fix(FixedI32::<F>::ZERO);
         const ONE: Self = {
-            assert!(
-                F::U32 <= 30,
-                "fixed-point formats need at least two integer bits"
-            );
+            assert!(F::U32 <= 30, "fixed-point formats need at least two integer bits");
             Fix(FixedI32::<F>::from_bits(1i32 << F::U32))
         };
         const NAME: &'static str = "fixed-i32";
@@ -449,6 +472,10 @@ mod fixed_point {
         #[inline]
         fn to_f64(self) -> f64 {
             self.0.to_num::<f64>()
+        }
+        #[inline]
+        fn to_f32(self) -> f32 {
+            self.0.to_num::<f32>()
         }
         #[inline]
         fn sqrt(self) -> Self {

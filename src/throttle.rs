@@ -63,9 +63,7 @@ impl<T: Float> Orifice<T> {
     /// `C_d f sqrt(2 |dp| / rho) sign(dp)` [m^3/s].
     #[inline]
     pub fn flow(&self, dp: T, density: T) -> T {
-        let q = self.discharge_coefficient
-            * self.area()
-            * (T::from_f64(2.0) * dp.abs() / density).sqrt();
+        let q = self.discharge_coefficient * self.area() * (T::from_f64(2.0) * dp.abs() / density).sqrt();
         if dp < T::ZERO { -q } else { q }
     }
 }
@@ -89,10 +87,14 @@ impl<T: Float> Slot<T> {
     /// Flow through the window (Eq. 7): `eta pi d x sqrt(2 dp / rho)` [m^3/s].
     #[inline]
     pub fn flow(&self, x: T, dp: T, density: T) -> T {
-        self.discharge_coefficient
-            * self.area(x)
-            * (T::from_f64(2.0) * dp.max(T::ZERO) / density).sqrt()
+        self.discharge_coefficient * self.area(x) * (T::from_f64(2.0) * dp.max(T::ZERO) / density).sqrt()
     }
+}
+
+/// The value of [`regularised_root`] alone (no division for the slope).
+#[inline]
+pub fn regularised_root_value<T: Real>(u: T, u_tr: T) -> T {
+    u / (u * u + u_tr * u_tr).sqrt().sqrt()
 }
 
 /// C1 square-root law `u / (u^2 + u_tr^2)^(1/4)` and its derivative.

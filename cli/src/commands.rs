@@ -103,9 +103,7 @@ pub fn equilibrium_table(path: &Path, temps_spec: &str, single: bool) -> Result<
         let (_, p) = load_params::<f64>(path)?;
         for &t in &temps {
             let e = eq::equilibrium(&p, t).map_err(|e| at_temperature(t, e))?;
-            table.row(&[
-                t, e.a, e.p_a, e.p_b, e.dp_ab, e.x, e.q_branch, e.q_throt, e.q_total,
-            ]);
+            table.row(&[t, e.a, e.p_a, e.p_b, e.dp_ab, e.x, e.q_branch, e.q_throt, e.q_total]);
         }
     }
     Ok(table)
@@ -113,9 +111,7 @@ pub fn equilibrium_table(path: &Path, temps_spec: &str, single: bool) -> Result<
 
 /// `equilibrium` as text.
 pub fn equilibrium(path: &Path, temps_spec: &str, single: bool) -> Result<String, CliError> {
-    Ok(equilibrium_table(path, temps_spec, single)?
-        .as_str()
-        .to_string())
+    Ok(equilibrium_table(path, temps_spec, single)?.as_str().to_string())
 }
 
 /// Balance temperature (Eq. 2) searched over the estimator's oil range:
@@ -150,28 +146,22 @@ pub fn find_balance(raw: &RawParams, p: &Params<f64>) -> Result<f64, CliError> {
 }
 
 /// `asymptotic`: quasi-static and series displacement per temperature.
-pub fn asymptotic(
-    path: &Path,
-    order: usize,
-    reading: Reading,
-    t0: &str,
-    temps_spec: &str,
-) -> Result<String, CliError> {
+pub fn asymptotic(path: &Path, order: usize, reading: Reading, t0: &str, temps_spec: &str) -> Result<String, CliError> {
     let temps = temps::parse(temps_spec)?;
     let (raw, p) = load_params::<f64>(path)?;
     let t0 = if t0.trim() == "balance" {
         find_balance(&raw, &p)?
     } else {
-        let v: f64 = t0.trim().parse().map_err(|_| {
-            CliError::Input(format!("--t0: '{t0}' is neither a number nor 'balance'"))
-        })?;
+        let v: f64 = t0
+            .trim()
+            .parse()
+            .map_err(|_| CliError::Input(format!("--t0: '{t0}' is neither a number nor 'balance'")))?;
         if !v.is_finite() {
             return Err(CliError::Input(format!("--t0: '{t0}' is not finite")));
         }
         v
     };
-    let e = Expansion::new(&p, t0, reading)
-        .map_err(|e| CliError::Input(format!("--t0: {t0} C: {e}")))?;
+    let e = Expansion::new(&p, t0, reading).map_err(|e| CliError::Input(format!("--t0: {t0} C: {e}")))?;
     let mut table = Table::new(&["t_c", "x_qs_m", "x_asym_m"]);
     for &t in &temps {
         let qs = eq::equilibrium(&p, t).map_err(|e| at_temperature(t, e))?;
@@ -240,10 +230,7 @@ pub fn paper(path: &Path, data: &Path) -> Result<String, CliError> {
     let _ = writeln!(o, "# Paper reproduction with {}", path.display());
 
     let inv = paper::invert_table1(&t1);
-    let _ = writeln!(
-        o,
-        "\n## Table 1 inverted for A(t) [sqrt(Pa)], column by column"
-    );
+    let _ = writeln!(o, "\n## Table 1 inverted for A(t) [sqrt(Pa)], column by column");
     let _ = writeln!(
         o,
         "t_c  {}  spread",
@@ -255,19 +242,10 @@ pub fn paper(path: &Path, data: &Path) -> Result<String, CliError> {
     );
     for (i, t) in t1.temps.iter().enumerate() {
         let cols: Vec<String> = inv.a[i].iter().map(|a| format!("{a:9.1}")).collect();
-        let _ = writeln!(
-            o,
-            "{t:4}  {}  {:5.1} %",
-            cols.join("  "),
-            inv.spread[i] * 100.0
-        );
+        let _ = writeln!(o, "{t:4}  {}  {:5.1} %", cols.join("  "), inv.spread[i] * 100.0);
     }
     let max_spread = inv.spread.iter().fold(0.0f64, |m, v| m.max(*v));
-    let _ = writeln!(
-        o,
-        "largest spread between the three drops: {:.1} %",
-        max_spread * 100.0
-    );
+    let _ = writeln!(o, "largest spread between the three drops: {:.1} %", max_spread * 100.0);
 
     let r1 = paper::table1_residuals(&p, &t1);
     let _ = writeln!(o, "\n## Table 1: model p_b - p_a against the paper [bar]");
@@ -283,13 +261,7 @@ pub fn paper(path: &Path, data: &Path) -> Result<String, CliError> {
     let nd = t1.drops_bar.len();
     for (i, t) in t1.temps.iter().enumerate() {
         let cols: Vec<String> = (0..nd)
-            .map(|j| {
-                format!(
-                    "{:5.2} {:6.3}",
-                    t1.values[i][j],
-                    t1.values[i][j] + r1[i * nd + j]
-                )
-            })
+            .map(|j| format!("{:5.2} {:6.3}", t1.values[i][j], t1.values[i][j] + r1[i * nd + j]))
             .collect();
         let _ = writeln!(o, "{t:4}  {}", cols.join(" | "));
     }
@@ -324,10 +296,7 @@ pub fn paper(path: &Path, data: &Path) -> Result<String, CliError> {
 
     let (best, at_balance) = paper::asymptotic_search(&p, &t2, 26.0, 80.0);
     let balance = find_balance(&raw, &p).ok();
-    let _ = writeln!(
-        o,
-        "\n## Table 2 \"asym\" column: which expansion reproduces it"
-    );
+    let _ = writeln!(o, "\n## Table 2 \"asym\" column: which expansion reproduces it");
     if let Some(tb) = balance {
         let _ = writeln!(o, "balance temperature (p_a = p_b, Eq. 2): {tb:.2} C");
     }
@@ -371,8 +340,7 @@ pub fn paper(path: &Path, data: &Path) -> Result<String, CliError> {
         o,
         "\n## Eq. (1): chamber-pressure gradient at dp = 0.2 MPa over 26-78 C"
     );
-    let (mean_a, max_a, mean_b) =
-        paper::chamber_gradient(&p, 2.0e5, 26.0, 78.0).map_err(CliError::Failed)?;
+    let (mean_a, max_a, mean_b) = paper::chamber_gradient(&p, 2.0e5, 26.0, 78.0).map_err(CliError::Failed)?;
     let _ = writeln!(
         o,
         "model: mean |dp_a/dt| {:.2} kPa/C (max {:.2}), mean |dp_b/dt| {:.2} kPa/C; paper: 8.3 kPa/C",

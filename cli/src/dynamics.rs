@@ -34,7 +34,7 @@ pub struct Response {
     /// Times [s].
     pub time: Vec<f64>,
     /// States.
-    pub state: Vec<DynamicState>,
+    pub state: Vec<DynamicState<f64>>,
 }
 
 /// The temperature profile of a step (`ramp = None`) or a ramp [C/s].
@@ -47,9 +47,16 @@ pub fn profile(from: f64, to: f64, ramp: Option<f64>) -> Result<Profile, CliErro
     match ramp {
         None => Ok(Profile::Step { from, to }),
         Some(rate) if rate.is_finite() && rate > 0.0 => Ok(Profile::Ramp { from, to, rate }),
-        Some(rate) => Err(CliError::Input(format!(
-            "--ramp: {rate} must be a positive rate"
-        ))),
+        Some(rate) => Err(CliError::Input(format!("--ramp: {rate} must be a positive rate"))),
+    }
+}
+
+fn widen<F: Float>(s: DynamicState<F>) -> DynamicState<f64> {
+    DynamicState {
+        x: s.x.to_f64(),
+        v: s.v.to_f64(),
+        p_a: s.p_a.to_f64(),
+        p_b: s.p_b.to_f64(),
     }
 }
 
@@ -63,17 +70,16 @@ fn run_twin<F: Float, T: Real>(
         .map_err(|e| CliError::Input(format!("--from: {e}")))?;
     let mut out = Response {
         time: vec![0.0],
-        state: vec![twin.state()],
+        state: vec![widen(twin.state())],
     };
     for k in 0..n {
         // Coefficients at the tick's midpoint follow a ramp to second order.
         let t_mid = prof.temperature((k as f64 + 0.5) * config.tick);
         twin.set_temperature(F::from_f64(t_mid))
             .map_err(|e| CliError::Input(format!("temperature {t_mid} C: {e}")))?;
-        twin.tick()
-            .map_err(|e| CliError::Failed(format!("tick {k}: {e:?}")))?;
+        twin.tick().map_err(|e| CliError::Failed(format!("tick {k}: {e:?}")))?;
         out.time.push((k + 1) as f64 * config.tick);
-        out.state.push(twin.state());
+        out.state.push(widen(twin.state()));
     }
     Ok(out)
 }
@@ -94,14 +100,8 @@ pub fn simulate(
         Precision::Fixed => run_twin::<f32, Q16_16>(&p32()?, config, prof, n),
         Precision::Reduced => {
             let p = p64()?;
-            let mut twin = ReducedTwin::<f64, f64>::new(
-                &p,
-                config.scheme,
-                config.tick,
-                config.substeps,
-                prof.start(),
-            )
-            .map_err(|e| CliError::Input(format!("--from: {e}")))?;
+            let mut twin = ReducedTwin::<f64, f64>::new(&p, config.scheme, config.tick, config.substeps, prof.start())
+                .map_err(|e| CliError::Input(format!("--from: {e}")))?;
             let mut out = Response {
                 time: vec![0.0],
                 state: vec![twin.state()],
@@ -110,8 +110,7 @@ pub fn simulate(
                 let t_mid = prof.temperature((k as f64 + 0.5) * config.tick);
                 twin.set_temperature(t_mid)
                     .map_err(|e| CliError::Input(format!("temperature {t_mid} C: {e}")))?;
-                twin.tick()
-                    .map_err(|e| CliError::Failed(format!("tick {k}: {e:?}")))?;
+                twin.tick().map_err(|e| CliError::Failed(format!("tick {k}: {e:?}")))?;
                 out.time.push((k + 1) as f64 * config.tick);
                 out.state.push(twin.state());
             }
@@ -162,9 +161,7 @@ pub fn tick_count(t_end: f64, dt: f64) -> Result<usize, CliError> {
         return Err(CliError::Input(format!("--dt: {dt} must be positive")));
     }
     if !(t_end > 0.0 && t_end.is_finite()) {
-        return Err(CliError::Input(format!(
-            "--t-end: {t_end} must be positive"
-        )));
+        return Err(CliError::Input(format!("--t-end: {t_end} must be positive")));
     }
     let n = (t_end / dt).round();
     if n > 10_000_000.0 {
@@ -191,9 +188,7 @@ pub fn step(
     let (raw, _) = load_params::<f64>(path)?;
     let prof = profile(from, to, ramp)?;
     if substeps == 0 || substeps > compensator::dynamics::twin::MAX_SUBSTEPS {
-        return Err(CliError::Input(format!(
-            "--substeps: {substeps} is not in 1..=16"
-        )));
+        return Err(CliError::Input(format!("--substeps: {substeps} is not in 1..=16")));
     }
     let n = tick_count(t_end.unwrap_or_else(|| default_t_end(&prof)), dt)?;
     let config = TwinConfig {
@@ -263,22 +258,14 @@ pub fn indicators_of(time: &[f64], x: &[f64], x_star: f64) -> (f64, f64) {
     let mut settle = 0.0;
     for i in (0..x.len()).rev() {
         if (x[i] - x_star).abs() > band {
-            settle = if i + 1 < time.len() {
-                time[i + 1]
-            } else {
-                f64::INFINITY
-            };
+            settle = if i + 1 < time.len() { time[i + 1] } else { f64::INFINITY };
             break;
         }
     }
     let x0 = x[0];
     let step = x_star - x0;
     let over = if step != 0.0 {
-        x.iter()
-            .map(|v| (v - x_star) * step.signum())
-            .fold(0.0f64, f64::max)
-            / step.abs()
-            * 100.0
+        x.iter().map(|v| (v - x_star) * step.signum()).fold(0.0f64, f64::max) / step.abs() * 100.0
     } else {
         0.0
     };
@@ -299,19 +286,11 @@ pub fn step_indicators(
         .map_err(|e| CliError::Input(format!("--steps: {to} C: {e}")))?
         .x;
     equilibrium(p, from).map_err(|e| CliError::Input(format!("--steps: {from} C: {e}")))?;
-    let tr = reference::simulate(
-        &raw.core,
-        Profile::Step { from, to },
-        t_end,
-        dt,
-        Method::Radau5,
-        1e-10,
-    )
-    .map_err(CliError::Failed)?;
+    let tr = reference::simulate(&raw.core, Profile::Step { from, to }, t_end, dt, Method::Radau5, 1e-10)
+        .map_err(CliError::Failed)?;
     let x: Vec<f64> = tr.state.iter().map(|s| s[0]).collect();
     let (settling_time, overshoot_pct) = indicators_of(&tr.time, &x, x_star);
-    let lin =
-        linearise(p, to).map_err(|e| CliError::Failed(format!("linearisation at {to} C: {e}")))?;
+    let lin = linearise(p, to).map_err(|e| CliError::Failed(format!("linearisation at {to} C: {e}")))?;
     Ok(Indicators {
         from,
         to,
@@ -334,9 +313,7 @@ pub fn parse_steps(spec: &str) -> Result<Vec<(f64, f64)>, CliError> {
                 it.next(),
             ) {
                 (Some(a), Some(b), None) if a.is_finite() && b.is_finite() => Ok((a, b)),
-                _ => Err(CliError::Input(format!(
-                    "--steps: '{pair}' is not of the form from:to"
-                ))),
+                _ => Err(CliError::Input(format!("--steps: '{pair}' is not of the form from:to"))),
             }
         })
         .collect()

@@ -10,7 +10,7 @@ pub mod csv;
 pub mod dynamics;
 pub mod lsq;
 pub mod paper;
-pub mod params_file;
 pub mod temps;
 
-pub use params_file::{LoadError, load, parse};
+pub use compensator_params::file as params_file;
+pub use compensator_params::file::{LoadError, load, parse};

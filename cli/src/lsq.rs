@@ -76,12 +76,7 @@ fn cholesky_solve(a: &[f64], b: &[f64], n: usize) -> Option<Vec<f64>> {
 /// Minimises `sum f(x)_i^2` from `x0`. `step` gives the finite-difference
 /// step of each parameter (absolute). Stops when the relative cost decrease
 /// falls below 1e-15 or after `max_iter` iterations.
-pub fn levenberg_marquardt(
-    f: impl Fn(&[f64]) -> Vec<f64>,
-    x0: &[f64],
-    step: &[f64],
-    max_iter: usize,
-) -> Fit {
+pub fn levenberg_marquardt(f: impl Fn(&[f64]) -> Vec<f64>, x0: &[f64], step: &[f64], max_iter: usize) -> Fit {
     let n = x0.len();
     let mut x = x0.to_vec();
     let mut r = f(&x);

@@ -207,9 +207,7 @@ fn run(cli: Cli) -> Result<String, CliError> {
                 SchemeArg::Ros3 => Scheme::Ros3,
                 SchemeArg::Rodas3 => Scheme::Rodas3,
             };
-            compensator_cli::dynamics::step(
-                &params, from, to, ramp, dt, t_end, precision, scheme, substeps,
-            )
+            compensator_cli::dynamics::step(&params, from, to, ramp, dt, t_end, precision, scheme, substeps)
         }
         Command::Eigen { params, temps } => compensator_cli::dynamics::eigen(&params, &temps),
         Command::Indicators {

@@ -118,10 +118,7 @@ pub fn table1_residuals(params: &Params<f64>, t1: &Table1) -> Vec<f64> {
         let fluid = params.oil.state(t);
         for (j, &dp) in t1.drops_bar.iter().enumerate() {
             let model = match fluid {
-                Ok(f) => {
-                    pressure_difference(compensator::equilibrium::a_parameter(params, &f), dp * BAR)
-                        / BAR
-                }
+                Ok(f) => pressure_difference(compensator::equilibrium::a_parameter(params, &f), dp * BAR) / BAR,
                 Err(_) => f64::INFINITY,
             };
             r.push(model - t1.values[i][j]);
@@ -190,9 +187,7 @@ pub fn calibrate(base: &RawParams, t1: &Table1, t2: &Table2) -> Result<Calibrati
         500,
     );
     if !fit1.rms().is_finite() {
-        return Err(
-            "Table 1 fit failed: the model cannot be evaluated at the table's temperatures".into(),
-        );
+        return Err("Table 1 fit failed: the model cannot be evaluated at the table's temperatures".into());
     }
     let fluid_core = with_fluid(&fit1.x);
     let area = std::f64::consts::FRAC_PI_4 * base.core.plunger_diameter.powi(2);
@@ -240,10 +235,7 @@ fn initial_walther(base: &RawParams, t1: &Table1, g: f64) -> Option<[f64; 2]> {
     };
     let w = |nu: f64| (nu + 0.7).log10().log10();
     let (n0, n1) = (nu_cst(i0)?, nu_cst(i1)?);
-    let (l0, l1) = (
-        (t1.temps[i0] + 273.15).log10(),
-        (t1.temps[i1] + 273.15).log10(),
-    );
+    let (l0, l1) = ((t1.temps[i0] + 273.15).log10(), (t1.temps[i1] + 273.15).log10());
     let b = (w(n0) - w(n1)) / (l1 - l0);
     let a = w(n0) + b * l0;
     (a.is_finite() && b.is_finite() && b > 0.0).then_some([a, b])
@@ -275,9 +267,7 @@ pub fn invert_table1(t1: &Table1) -> Inversion {
         .map(|row| {
             let (lo, hi) = row
                 .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
-                    (l.min(*v), h.max(*v))
-                });
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
             let mean = row.iter().sum::<f64>() / row.len() as f64;
             (hi - lo) / mean
         })
@@ -356,12 +346,7 @@ pub fn asymptotic_search(
 /// Chamber-pressure gradient of Eq. (1) over `[lo, hi]` at drop `dp` [Pa]:
 /// (mean |dp_a/dt|, max |dp_a/dt|, mean |dp_b/dt|) [Pa/K], from the
 /// equilibrium's closed form at 0.5 C spacing (central differences).
-pub fn chamber_gradient(
-    params: &Params<f64>,
-    dp: f64,
-    lo: f64,
-    hi: f64,
-) -> Result<(f64, f64, f64), String> {
+pub fn chamber_gradient(params: &Params<f64>, dp: f64, lo: f64, hi: f64) -> Result<(f64, f64, f64), String> {
     let p = params.with_pressure_drop(dp).map_err(|e| e.to_string())?;
     let h = 0.5;
     let n = ((hi - lo) / h).round() as usize;

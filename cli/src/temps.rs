@@ -39,9 +39,7 @@ pub fn parse(spec: &str) -> Result<Vec<f64>, TempsError> {
     if spec.contains(':') {
         let parts: Vec<&str> = spec.split(':').collect();
         if parts.len() != 3 {
-            return Err(TempsError(format!(
-                "'{spec}' is not of the form start:end:step"
-            )));
+            return Err(TempsError(format!("'{spec}' is not of the form start:end:step")));
         }
         let (a, b, step) = (number(parts[0])?, number(parts[1])?, number(parts[2])?);
         if !(step > 0.0) {
@@ -70,10 +68,7 @@ mod tests {
 
     #[test]
     fn ranges_and_lists() {
-        assert_eq!(
-            parse("30:80:10").unwrap(),
-            vec![30.0, 40.0, 50.0, 60.0, 70.0, 80.0]
-        );
+        assert_eq!(parse("30:80:10").unwrap(), vec![30.0, 40.0, 50.0, 60.0, 70.0, 80.0]);
         assert_eq!(parse("30:35:10").unwrap(), vec![30.0]);
         assert_eq!(parse("26.5, 30").unwrap(), vec![26.5, 30.0]);
         assert!(parse("30:80:0").is_err());

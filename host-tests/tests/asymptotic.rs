@@ -2,9 +2,7 @@
 //! series' error shrinking at the expected order as t -> t0.
 
 use compensator::Params;
-use compensator::asymptotic::{
-    Expansion, Reading, monotonicity, phi, phi_derivatives, sensitivity,
-};
+use compensator::asymptotic::{Expansion, Reading, monotonicity, phi, phi_derivatives, sensitivity};
 use compensator::equilibrium::{Stop, a_derivatives, equilibrium};
 use host_tests::random::{Rng, physical_params};
 use host_tests::{isclose, reference, repo_root};
@@ -37,11 +35,7 @@ fn phi_derivatives_match_finite_differences() {
             let d = phi_derivatives(&p, a);
             let fd1 = (phi(&p, a + h) - phi(&p, a - h)) / (2.0 * h);
             let fd2 = (phi_derivatives(&p, a + h).d1 - phi_derivatives(&p, a - h).d1) / (2.0 * h);
-            assert!(
-                isclose(d.d1, fd1, 1e-7, 0.0),
-                "Phi' {} vs {fd1} at a_hat {a_hat}",
-                d.d1
-            );
+            assert!(isclose(d.d1, fd1, 1e-7, 0.0), "Phi' {} vs {fd1} at a_hat {a_hat}", d.d1);
             assert!(
                 isclose(d.d2, fd2, 1e-7, 0.0),
                 "Phi'' {} vs {fd2} at a_hat {a_hat}",
@@ -73,11 +67,7 @@ fn a_derivatives_match_the_reference_oil() {
                 a_reference(&raw.core, t + h),
             );
             assert!(isclose(d.value, a0, 1e-12, 0.0), "A {} vs {a0}", d.value);
-            assert!(
-                isclose(d.d1, (ap - am) / (2.0 * h), 1e-6, 0.0),
-                "A' {} vs fd",
-                d.d1
-            );
+            assert!(isclose(d.d1, (ap - am) / (2.0 * h), 1e-6, 0.0), "A' {} vs fd", d.d1);
             assert!(
                 isclose(d.d2, (ap - 2.0 * a0 + am) / (h * h), 1e-4, 0.0),
                 "A'' {} vs fd",
@@ -117,9 +107,7 @@ fn series_error_shrinks_at_the_expected_order() {
             if reading == Reading::Temperature {
                 let q_err: Vec<f64> = steps
                     .iter()
-                    .map(|dt| {
-                        (e.at(t0 + dt).unwrap().q_total_series(order) - q_total(t0 + dt)).abs()
-                    })
+                    .map(|dt| (e.at(t0 + dt).unwrap().q_total_series(order) - q_total(t0 + dt)).abs())
                     .collect();
                 for o in observed_orders(&q_err) {
                     assert!(
@@ -144,22 +132,11 @@ fn sensitivities_match_finite_differences() {
     for t in [36.0, 45.0, 60.0, 75.0] {
         let s = sensitivity(&p, t).unwrap();
         let h = 1e-3;
-        let (em, ep) = (
-            equilibrium(&p, t - h).unwrap(),
-            equilibrium(&p, t + h).unwrap(),
-        );
+        let (em, ep) = (equilibrium(&p, t - h).unwrap(), equilibrium(&p, t + h).unwrap());
         assert_eq!(s.stop, Stop::Free);
+        assert!(isclose(s.dx_dt, (ep.x - em.x) / (2.0 * h), 1e-6, 0.0), "dx/dt at {t}");
         assert!(
-            isclose(s.dx_dt, (ep.x - em.x) / (2.0 * h), 1e-6, 0.0),
-            "dx/dt at {t}"
-        );
-        assert!(
-            isclose(
-                s.dq_throt_dt,
-                (ep.q_throt - em.q_throt) / (2.0 * h),
-                1e-6,
-                0.0
-            ),
+            isclose(s.dq_throt_dt, (ep.q_throt - em.q_throt) / (2.0 * h), 1e-6, 0.0),
             "dQ_throt/dt at {t}"
         );
     }

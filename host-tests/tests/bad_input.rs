@@ -129,23 +129,13 @@ fn non_physical_values_name_the_field_and_the_rule() {
 #[test]
 fn unknown_keys_wrong_types_and_partial_sections_are_errors() {
     let typo = preset_text().replace("spring_rate", "spring_rat");
-    assert!(
-        matches!(params_file::parse(&typo), Err(LoadError::UnknownKey(k)) if k == "plunger.spring_rat")
-    );
+    assert!(matches!(params_file::parse(&typo), Err(LoadError::UnknownKey(k)) if k == "plunger.spring_rat"));
     let text = edited("plunger", "mass", Some("\"heavy\""));
-    assert!(
-        matches!(params_file::parse(&text), Err(LoadError::NotANumber(k)) if k == "plunger.mass")
-    );
+    assert!(matches!(params_file::parse(&text), Err(LoadError::NotANumber(k)) if k == "plunger.mass"));
     let partial = format!("{}\n[machine]\nworking_flow = 1e-5\n", preset_text());
     let e = param_error(&partial);
-    assert_eq!(
-        (e.field, e.problem),
-        ("machine.leakage_reference", Problem::Missing)
-    );
-    assert!(matches!(
-        params_file::parse("[fluid\nx = 1"),
-        Err(LoadError::Syntax(_))
-    ));
+    assert_eq!((e.field, e.problem), ("machine.leakage_reference", Problem::Missing));
+    assert!(matches!(params_file::parse("[fluid\nx = 1"), Err(LoadError::Syntax(_))));
 }
 
 #[test]
@@ -187,14 +177,7 @@ fn cli() -> &'static PathBuf {
     BIN.get_or_init(|| {
         let root = repo_root();
         let status = Command::new(env!("CARGO"))
-            .args([
-                "build",
-                "--quiet",
-                "-p",
-                "compensator-cli",
-                "--bin",
-                "compensator",
-            ])
+            .args(["build", "--quiet", "-p", "compensator-cli", "--bin", "compensator"])
             .current_dir(&root)
             .status()
             .expect("cargo runs");
@@ -225,10 +208,7 @@ fn assert_bad_input(args: &[&str], names: &str) {
     assert_eq!(code, 2, "{args:?}: exit {code}, stderr {stderr}");
     assert!(stdout.is_empty(), "{args:?}: stdout {stdout}");
     assert_eq!(stderr.lines().count(), 1, "{args:?}: stderr {stderr:?}");
-    assert!(
-        stderr.contains(names),
-        "{args:?}: '{stderr}' does not name {names}"
-    );
+    assert!(stderr.contains(names), "{args:?}: '{stderr}' does not name {names}");
 }
 
 #[test]
@@ -241,59 +221,24 @@ fn cli_bad_input_exits_2_with_one_line_naming_the_field() {
         p.to_string_lossy().into_owned()
     };
     let missing = write("missing.toml", &edited("plunger", "spring_rate", None));
-    let negative = write(
-        "negative.toml",
-        &edited("laminar_throttle", "length", Some("-0.02")),
-    );
+    let negative = write("negative.toml", &edited("laminar_throttle", "length", Some("-0.02")));
     let nan = write("nan.toml", &edited("fluid", "density_15", Some("nan")));
+    assert_bad_input(&["equilibrium", "--params", &missing], "plunger.spring_rate");
+    assert_bad_input(&["equilibrium", "--params", &negative], "laminar_throttle.length");
     assert_bad_input(
-        &["equilibrium", "--params", &missing],
-        "plunger.spring_rate",
-    );
-    assert_bad_input(
-        &["equilibrium", "--params", &negative],
-        "laminar_throttle.length",
-    );
-    assert_bad_input(
-        &[
-            "asymptotic",
-            "--params",
-            &nan,
-            "--order",
-            "1",
-            "--reading",
-            "property",
-        ],
+        &["asymptotic", "--params", &nan, "--order", "1", "--reading", "property"],
         "fluid.density_15",
     );
     assert_bad_input(
-        &[
-            "equilibrium",
-            "--params",
-            "presets/paper.toml",
-            "--temps",
-            "30:80:0",
-        ],
+        &["equilibrium", "--params", "presets/paper.toml", "--temps", "30:80:0"],
         "--temps",
     );
     assert_bad_input(
-        &[
-            "equilibrium",
-            "--params",
-            "presets/paper.toml",
-            "--temps",
-            "30,abc",
-        ],
+        &["equilibrium", "--params", "presets/paper.toml", "--temps", "30,abc"],
         "--temps",
     );
     assert_bad_input(
-        &[
-            "equilibrium",
-            "--params",
-            "presets/paper.toml",
-            "--temps",
-            "500",
-        ],
+        &["equilibrium", "--params", "presets/paper.toml", "--temps", "500"],
         "--temps",
     );
     assert_bad_input(
@@ -339,13 +284,7 @@ fn cli_bad_input_exits_2_with_one_line_naming_the_field() {
         "--t0",
     );
     assert_bad_input(
-        &[
-            "equilibrium",
-            "--params",
-            "presets/paper.toml",
-            "--precision",
-            "f16",
-        ],
+        &["equilibrium", "--params", "presets/paper.toml", "--precision", "f16"],
         "--precision",
     );
     std::fs::remove_dir_all(&dir).ok();
@@ -353,13 +292,7 @@ fn cli_bad_input_exits_2_with_one_line_naming_the_field() {
 
 #[test]
 fn cli_equilibrium_and_asymptotic_write_the_documented_columns() {
-    let (code, out, err) = run(&[
-        "equilibrium",
-        "--params",
-        "presets/paper.toml",
-        "--temps",
-        "30:80:10",
-    ]);
+    let (code, out, err) = run(&["equilibrium", "--params", "presets/paper.toml", "--temps", "30:80:10"]);
     assert_eq!(code, 0, "{err}");
     let lines: Vec<&str> = out.lines().collect();
     assert_eq!(

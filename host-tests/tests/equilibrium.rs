@@ -38,11 +38,7 @@ fn f64_path_agrees_with_root_finding_to_1e_12() {
                 r.p_b,
                 ctx()
             );
-            assert!(
-                isclose(e.dp_ab, r.p_b - r.p_a, 1e-12, 1e-12 * dp),
-                "dp_ab ({})",
-                ctx()
-            );
+            assert!(isclose(e.dp_ab, r.p_b - r.p_a, 1e-12, 1e-12 * dp), "dp_ab ({})", ctx());
             assert!(
                 isclose(e.x, r.x, 1e-12, 1e-12 * stroke),
                 "x {} vs {} ({})",
@@ -81,10 +77,7 @@ fn f64_path_agrees_with_root_finding_to_1e_12() {
         }
     }
     // The random sets must exercise the interior branch, not only the stops.
-    assert!(
-        interior > SETS * TEMPS_PER_SET / 10,
-        "only {interior} interior points"
-    );
+    assert!(interior > SETS * TEMPS_PER_SET / 10, "only {interior} interior points");
 }
 
 #[test]
@@ -101,20 +94,13 @@ fn f32_path_agrees_to_1e_5_of_stroke_and_drop() {
             // sees (the input rounded to f32).
             let t = rng.uniform(20.0, 90.0) as f32 as f64;
             let r = reference::equilibrium(&raw.core, t);
-            let e =
-                equilibrium(&p, t as f32).unwrap_or_else(|err| panic!("set {set}, t {t}: {err}"));
+            let e = equilibrium(&p, t as f32).unwrap_or_else(|err| panic!("set {set}, t {t}: {err}"));
             let ex = (e.x as f64 - r.x).abs() / stroke;
             let ep = ((e.p_a as f64 - r.p_a).abs()).max((e.p_b as f64 - r.p_b).abs()) / dp;
             worst_x = worst_x.max(ex);
             worst_p = worst_p.max(ep);
-            assert!(
-                ex <= 1e-5,
-                "x off by {ex:.2e} of the stroke (set {set}, t {t})"
-            );
-            assert!(
-                ep <= 1e-5,
-                "pressure off by {ep:.2e} of dp (set {set}, t {t})"
-            );
+            assert!(ex <= 1e-5, "x off by {ex:.2e} of the stroke (set {set}, t {t})");
+            assert!(ep <= 1e-5, "pressure off by {ep:.2e} of dp (set {set}, t {t})");
             // Flows inherit the displacement's error through the window:
             // 1e-5 of the flow plus 1e-5 of the fully open window's flow.
             let full_window = reference::window_flow(&raw.core, t, stroke);

@@ -27,11 +27,7 @@ fn table1_columns_invert_to_one_temperature_law() {
     // ...and the three drops agree on it to about a tenth (digitising noise).
     let worst = inv.spread.iter().cloned().fold(0.0, f64::max);
     assert!(worst < 0.12, "spread {worst}");
-    assert!(
-        (inv.a[0][0] - 600.0).abs() < 0.1,
-        "A(30 C, 4 bar) = {}",
-        inv.a[0][0]
-    );
+    assert!((inv.a[0][0] - 600.0).abs() < 0.1, "A(30 C, 4 bar) = {}", inv.a[0][0]);
 }
 
 #[test]
@@ -81,10 +77,7 @@ fn table2_asym_column_is_the_property_reading_at_second_order_about_the_balance_
     let raw = params_file::load(&repo_root().join("presets/paper.toml")).unwrap();
     let balance = commands::find_balance(&raw, &p).unwrap();
     let (best, at_balance) = paper::asymptotic_search(&p, &t2, 26.0, 80.0);
-    let closest = best
-        .iter()
-        .min_by(|a, b| a.rms_mm.total_cmp(&b.rms_mm))
-        .unwrap();
+    let closest = best.iter().min_by(|a, b| a.rms_mm.total_cmp(&b.rms_mm)).unwrap();
     assert_eq!((closest.reading, closest.order), (Reading::Property, 2));
     assert!(
         (closest.t0 - balance).abs() < 1.0,

@@ -18,7 +18,7 @@
 //! library's own event search can lose its bracket (0.7.0).
 
 use crate::statics;
-use compensator::params::RawCore;
+use compensator_params::RawCore;
 use differential_equations::ode::{OrdinaryNumericalMethod, solve_ode};
 use differential_equations::prelude::*;
 use std::f64::consts::PI;
@@ -330,11 +330,7 @@ pub fn simulate(
         rtol * p.pressure_drop,
     ];
     // Phases end at events and at the profile's kinks.
-    let mut boundaries: Vec<f64> = profile
-        .kinks()
-        .into_iter()
-        .filter(|k| *k > 0.0 && *k < t_end)
-        .collect();
+    let mut boundaries: Vec<f64> = profile.kinks().into_iter().filter(|k| *k > 0.0 && *k < t_end).collect();
     boundaries.push(t_end);
     let mut guard = 0;
     while t < t_end {
@@ -343,11 +339,7 @@ pub fn simulate(
             return Err("too many phases (chattering at a stop?)".into());
         }
         let phase_end = boundaries.iter().copied().find(|b| *b > t).unwrap_or(t_end);
-        let sys = Fsi {
-            p: *p,
-            profile,
-            mode,
-        };
+        let sys = Fsi { p: *p, profile, mode };
         let mut phase = Phase {
             sys: &sys,
             grid: &grid,
@@ -366,10 +358,7 @@ pub fn simulate(
                 phase_end,
                 y,
                 &mut phase,
-                ImplicitRungeKutta::radau5()
-                    .rtol([rtol; 4])
-                    .atol(atol)
-                    .h_max(h_max),
+                ImplicitRungeKutta::radau5().rtol([rtol; 4]).atol(atol).h_max(h_max),
             )?,
             Method::Dop853 => solve(
                 &sys,
@@ -411,30 +400,17 @@ pub fn simulate(
             y = ye;
             out.events.push((t, mode));
         } else {
-            y = phase
-                .end_state
-                .ok_or("integrator ended before the phase end")?;
+            y = phase.end_state.ok_or("integrator ended before the phase end")?;
             t = phase_end;
         }
     }
     if out.time.len() != grid.len() {
-        return Err(format!(
-            "sampled {} of {} output times",
-            out.time.len(),
-            grid.len()
-        ));
+        return Err(format!("sampled {} of {} output times", out.time.len(), grid.len()));
     }
     Ok(out)
 }
 
-fn solve<M>(
-    sys: &Fsi,
-    t0: f64,
-    t1: f64,
-    y0: [f64; 4],
-    phase: &mut Phase<'_>,
-    mut method: M,
-) -> Result<usize, String>
+fn solve<M>(sys: &Fsi, t0: f64, t1: f64, y0: [f64; 4], phase: &mut Phase<'_>, mut method: M) -> Result<usize, String>
 where
     M: OrdinaryNumericalMethod<f64, [f64; 4]> + Interpolation<f64, [f64; 4]>,
 {

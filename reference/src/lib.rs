@@ -1,7 +1,7 @@
 //! Independent `f64` references for the compensator twin.
 //!
-//! Written from MODEL.md in SI units, sharing no model code with the core
-//! (only the parameter values, read through `compensator::params::RawCore`):
+//! Written from MODEL.md in SI units, sharing no code with the core (only
+//! the parameter values, read through `compensator_params::RawCore`):
 //!
 //! * [`statics`]: the quasi-static equilibrium by bisection on each
 //!   chamber's flow balance (no closed form).
@@ -10,5 +10,6 @@
 //!   the end-stop events, and the same with the explicit Dormand-Prince
 //!   8(5,3) method as an unrelated cross-check.
 
+#[cfg(feature = "dynamics")]
 pub mod dynamics;
 pub mod statics;

@@ -5,7 +5,7 @@
 //! `A(t)`, no shared code with the core beyond reading the same parameter
 //! values.
 
-use compensator::params::RawCore;
+use compensator_params::RawCore;
 use std::f64::consts::PI;
 
 /// Oil properties at `t` [C]: (kinematic viscosity [m^2/s], density [kg/m^3]).
@@ -62,10 +62,8 @@ pub fn equilibrium(p: &RawCore, t: f64) -> Point {
     let (nu, rho) = oil(p, t);
     let mu = nu * rho;
     let r_lam = 128.0 * mu * p.laminar_length / (PI * p.laminar_diameter.powi(4));
-    let orifice = |dp: f64| {
-        p.turbulent_discharge * PI * p.turbulent_diameter.powi(2) / 4.0
-            * (2.0 * dp.max(0.0) / rho).sqrt()
-    };
+    let orifice =
+        |dp: f64| p.turbulent_discharge * PI * p.turbulent_diameter.powi(2) / 4.0 * (2.0 * dp.max(0.0) / rho).sqrt();
     let (pc, pp) = (p.outlet_pressure, p.outlet_pressure + p.pressure_drop);
     // (a): orifice in from p_p, capillary out to p_c.
     let p_a = bisect_decreasing(|pa| orifice(pp - pa) - (pa - pc) / r_lam, pc, pp);

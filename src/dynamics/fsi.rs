@@ -36,13 +36,13 @@
 //! into it and no velocity away from it, the plunger is held (`xi' = w' = 0`,
 //! [`Contact`]); a step that crosses a stop ends on it with `w = 0`.
 
-use super::schemes::OdeSystem;
+use super::schemes::{OdeSystem, ShiftedSolve};
 use crate::equilibrium::Equilibrium;
 use crate::error::{ModelError, finite};
 use crate::fluid::FluidState;
 use crate::params::Params;
 use crate::scalar::{Float, Real};
-use crate::throttle::regularised_root;
+use crate::throttle::{regularised_root, regularised_root_value};
 
 /// Transition pressure of the regularised orifice law, as a fraction of `dp`.
 pub const TRANSITION_FRACTION: f64 = 1.0e-5;
@@ -59,52 +59,53 @@ pub enum Contact {
     Open,
 }
 
-/// Conversion between the model's units and SI (all `f64`).
+/// Conversion between the model's units and SI, in the parameters' float
+/// type `F` (so that an `f32` firmware never runs soft-double code).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Scales {
+pub struct Scales<F> {
     /// Time unit `T = sqrt(m / c)` [s].
-    pub time: f64,
+    pub time: F,
     /// Length unit: the stroke [m].
-    pub length: f64,
+    pub length: F,
     /// Velocity unit `V = a_x L / T` [m/s].
-    pub velocity: f64,
+    pub velocity: F,
     /// Pressure unit `dp` [Pa].
-    pub pressure: f64,
+    pub pressure: F,
     /// Pressure origin `p_c` [Pa].
-    pub outlet_pressure: f64,
+    pub outlet_pressure: F,
 }
 
 /// A state in SI units.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DynamicState {
+pub struct DynamicState<F> {
     /// Plunger displacement `x` [m].
-    pub x: f64,
+    pub x: F,
     /// Plunger velocity `v` [m/s].
-    pub v: f64,
+    pub v: F,
     /// Chamber (a) pressure [Pa].
-    pub p_a: f64,
+    pub p_a: F,
     /// Chamber (b) pressure [Pa].
-    pub p_b: f64,
+    pub p_b: F,
 }
 
-impl Scales {
+impl<F: Float> Scales<F> {
     /// Model state `(xi, w, pi_a, pi_b)` to SI.
-    pub fn to_si<T: Real>(&self, y: &[T; 4]) -> DynamicState {
+    pub fn to_si<T: Real>(&self, y: &[T; 4]) -> DynamicState<F> {
         DynamicState {
-            x: y[0].to_f64() * self.length,
-            v: y[1].to_f64() * self.velocity,
-            p_a: self.outlet_pressure + y[2].to_f64() * self.pressure,
-            p_b: self.outlet_pressure + y[3].to_f64() * self.pressure,
+            x: F::from_real(y[0]) * self.length,
+            v: F::from_real(y[1]) * self.velocity,
+            p_a: self.outlet_pressure + F::from_real(y[2]) * self.pressure,
+            p_b: self.outlet_pressure + F::from_real(y[3]) * self.pressure,
         }
     }
 
     /// SI state to model state.
-    pub fn from_si<T: Real>(&self, s: &DynamicState) -> [T; 4] {
+    pub fn from_si<T: Real>(&self, s: &DynamicState<F>) -> [T; 4] {
         [
-            T::from_f64(s.x / self.length),
-            T::from_f64(s.v / self.velocity),
-            T::from_f64((s.p_a - self.outlet_pressure) / self.pressure),
-            T::from_f64((s.p_b - self.outlet_pressure) / self.pressure),
+            (s.x / self.length).to_real(),
+            (s.v / self.velocity).to_real(),
+            ((s.p_a - self.outlet_pressure) / self.pressure).to_real(),
+            ((s.p_b - self.outlet_pressure) / self.pressure).to_real(),
         ]
     }
 }
@@ -146,7 +147,7 @@ pub struct Coefficients<T> {
 pub struct Model<F> {
     params: Params<F>,
     /// Unit conversions.
-    pub scales: Scales,
+    pub scales: Scales<F>,
     q_star: F,
     a_x: F,
 }
@@ -159,25 +160,23 @@ impl<F: Float> Model<F> {
         let t = (pl.mass / pl.spring_rate).sqrt();
         let area = pl.area();
         let dp = p.pressure_drop;
-        let q_star = p.orifice.discharge_coefficient
-            * p.orifice.area()
-            * (F::from_f64(2.0) * dp / p.oil.density_15).sqrt();
+        let q_star =
+            p.orifice.discharge_coefficient * p.orifice.area() * (F::from_f64(2.0) * dp / p.oil.density_15).sqrt();
         let phi = area * dp / (pl.spring_rate * pl.stroke);
         let sigma1 = area * pl.stroke / (t * q_star);
-        let omega_mean = t * q_star * p.oil.bulk_modulus / dp
-            * F::from_f64(0.5)
-            * (F::ONE / p.volume_a + F::ONE / p.volume_b);
+        let omega_mean =
+            t * q_star * p.oil.bulk_modulus / dp * F::from_f64(0.5) * (F::ONE / p.volume_a + F::ONE / p.volume_b);
         let a_x = (phi / (omega_mean * sigma1)).sqrt();
         finite(a_x, "velocity scale")?;
         if !(a_x > F::ZERO) {
             return Err(ModelError::OutOfRange("velocity scale"));
         }
         let scales = Scales {
-            time: t.to_f64(),
-            length: pl.stroke.to_f64(),
-            velocity: (a_x * pl.stroke / t).to_f64(),
-            pressure: dp.to_f64(),
-            outlet_pressure: p.outlet_pressure.to_f64(),
+            time: t,
+            length: pl.stroke,
+            velocity: a_x * pl.stroke / t,
+            pressure: dp,
+            outlet_pressure: p.outlet_pressure,
         };
         Ok(Model {
             params: *params,
@@ -196,25 +195,26 @@ impl<F: Float> Model<F> {
     pub fn hydraulic(&self, fluid: &FluidState<F>) -> Result<(F, F), ModelError> {
         let p = &self.params;
         let q_t = (p.oil.density_15 / fluid.density).sqrt();
-        let g_l =
-            p.pressure_drop * p.capillary.bore_term() / (fluid.dynamic_viscosity * self.q_star);
+        let g_l = p.pressure_drop * p.capillary.bore_term() / (fluid.dynamic_viscosity * self.q_star);
         Ok((finite(q_t, "q_t")?, finite(g_l, "g_l")?))
     }
 
     /// All coefficients for a fluid state, converted to `T`.
-    pub fn coefficients<T: Real>(
-        &self,
-        fluid: &FluidState<F>,
-    ) -> Result<Coefficients<T>, ModelError> {
+    pub fn coefficients<T: Real>(&self, fluid: &FluidState<F>) -> Result<Coefficients<T>, ModelError> {
         let p = &self.params;
         let pl = &p.plunger;
         let s = &self.scales;
         let (q_t, g_l) = self.hydraulic(fluid)?;
-        let swept = pl.area().to_f64() * s.length;
-        let omega =
-            |v: f64| s.time * self.q_star.to_f64() * p.oil.bulk_modulus.to_f64() / (s.pressure * v);
+        let (time, length, pressure, velocity) = (
+            s.time.to_f64(),
+            s.length.to_f64(),
+            s.pressure.to_f64(),
+            s.velocity.to_f64(),
+        );
+        let swept = pl.area().to_f64() * length;
+        let omega = |v: f64| time * self.q_star.to_f64() * p.oil.bulk_modulus.to_f64() / (pressure * v);
         let a_x = self.a_x.to_f64();
-        let phi = pl.area().to_f64() * s.pressure / (pl.spring_rate.to_f64() * s.length);
+        let phi = pl.area().to_f64() * pressure / (pl.spring_rate.to_f64() * length);
         let c = |v: f64, what: &'static str| -> Result<T, ModelError> {
             let t = T::from_f64(v);
             if v.is_finite() && t.is_finite() {
@@ -231,15 +231,12 @@ impl<F: Float> Model<F> {
                 pl.damping.to_f64() / (pl.spring_rate.to_f64() * pl.mass.to_f64()).sqrt(),
                 "zeta",
             )?,
-            xi0: c(pl.preload.to_f64() / s.length, "preload")?,
+            xi0: c(pl.preload.to_f64() / length, "preload")?,
             omega_a0: c(omega(p.volume_a.to_f64()), "omega_a")?,
             eps_a: c(swept / p.volume_a.to_f64(), "eps_a")?,
             omega_b0: c(omega(p.volume_b.to_f64()), "omega_b")?,
             eps_b: c(swept / p.volume_b.to_f64(), "eps_b")?,
-            sigma: c(
-                pl.area().to_f64() * s.velocity / self.q_star.to_f64(),
-                "sigma",
-            )?,
+            sigma: c(pl.area().to_f64() * velocity / self.q_star.to_f64(), "sigma")?,
             u_tr: c(TRANSITION_FRACTION, "u_tr")?,
             q_t: c(q_t.to_f64(), "q_t")?,
             g_l: c(g_l.to_f64(), "g_l")?,
@@ -249,10 +246,10 @@ impl<F: Float> Model<F> {
     /// The model state of a quasi-static equilibrium (at rest).
     pub fn equilibrium_state<T: Real>(&self, eq: &Equilibrium<F>) -> [T; 4] {
         self.scales.from_si(&DynamicState {
-            x: eq.x.to_f64(),
-            v: 0.0,
-            p_a: eq.p_a.to_f64(),
-            p_b: eq.p_b.to_f64(),
+            x: eq.x,
+            v: F::ZERO,
+            p_a: eq.p_a,
+            p_b: eq.p_b,
         })
     }
 }
@@ -263,6 +260,17 @@ impl<T: Real> Coefficients<T> {
     #[inline]
     pub fn static_force(&self, y: &[T; 4]) -> T {
         self.phi_over_a_x * (y[3] - y[2]) - (self.xi0 + y[0]) * self.inv_a_x
+    }
+
+    /// The static force with the chambers at their quasi-steady pressures
+    /// for the current temperature (what the force settles to within tens
+    /// of microseconds at rest): `phi' (2 s0^2 - 1) - (xi0 + xi) / a_x`,
+    /// `s0 = 2 g_l / (q_t + sqrt(q_t^2 + 4 g_l^2))`.
+    #[inline]
+    pub fn quasi_steady_force(&self, xi: T) -> T {
+        let two = T::ONE + T::ONE;
+        let s0 = two * self.g_l / (self.q_t + (self.q_t * self.q_t + two * two * self.g_l * self.g_l).sqrt());
+        self.phi_over_a_x * (two * s0 * s0 - T::ONE) - (self.xi0 + xi) * self.inv_a_x
     }
 
     /// The contact state for `y` (see [`contact_for`]).
@@ -281,69 +289,189 @@ pub struct Fsi<'a, T> {
     pub contact: Contact,
 }
 
+/// What the right-hand side and the Jacobian share at one state.
+#[derive(Clone, Copy)]
+struct Local<T> {
+    /// `omega_a(xi)`, `omega_b(xi)`.
+    oa: T,
+    ob: T,
+    /// Their `xi` derivatives.
+    doa: T,
+    dob: T,
+    /// Orifice slopes `r'(1 - pi_a)`, `r'(pi_b)`.
+    sa: T,
+    sb: T,
+    /// Net inflows `q_t r(1 - pi_a) - g_l pi_a + sigma w` and its (b) twin.
+    fa: T,
+    fb: T,
+}
+
 impl<T: Real> Fsi<'_, T> {
+    /// `true` in free motion; while held the mechanical rows vanish.
     #[inline]
-    fn omegas(&self, xi: T) -> (T, T) {
+    fn moving(&self) -> bool {
+        self.contact == Contact::Free
+    }
+
+    #[inline]
+    fn local(&self, y: &[T; 4]) -> Local<T> {
         let c = self.coefficients;
-        (
-            c.omega_a0 / (T::ONE - c.eps_a * xi),
-            c.omega_b0 / (T::ONE + c.eps_b * xi),
-        )
+        let (xi, w, pa, pb) = (y[0], y[1], y[2], y[3]);
+        let (da, db) = (T::ONE - c.eps_a * xi, T::ONE + c.eps_b * xi);
+        let (oa, ob) = (c.omega_a0 / da, c.omega_b0 / db);
+        let (ra, sa) = regularised_root(T::ONE - pa, c.u_tr);
+        let (rb, sb) = regularised_root(pb, c.u_tr);
+        let sw = c.sigma * w;
+        Local {
+            oa,
+            ob,
+            // d omega_a / d xi = omega_a eps_a / (1 - eps_a xi); omega_b: -omega_b eps_b / (1 + eps_b xi).
+            doa: oa * c.eps_a / da,
+            dob: -(ob * c.eps_b / db),
+            sa,
+            sb,
+            fa: c.q_t * ra - c.g_l * pa + sw,
+            fb: c.g_l * (T::ONE - pb) - c.q_t * rb - sw,
+        }
+    }
+
+    /// `f(y)` from the net chamber inflows and `omega_a`, `omega_b`.
+    #[inline]
+    fn rhs_from(&self, y: &[T; 4], oa: T, ob: T, fa: T, fb: T) -> [T; 4] {
+        let c = self.coefficients;
+        let (dxi, dw) = if self.moving() {
+            (c.a_x * y[1], c.static_force(y) - c.two_zeta * y[1])
+        } else {
+            (T::ZERO, T::ZERO)
+        };
+        [dxi, dw, oa * fa, ob * fb]
+    }
+}
+
+/// `shift I - J` of the FSI model, factorised by its structure: each
+/// chamber's pressure couples only to itself and to the plunger, so the
+/// pressures are eliminated analytically and a 2x2 system in `(xi, w)`
+/// remains. Three divisions to factorise, ~14 multiply-adds to solve (a
+/// pivoted 4x4 LU takes four divisions and ~50).
+///
+/// With `m = 1` in free motion and `0` while held, `s = shift`,
+/// `e2 = 1 / (s - J22)`, `e3 = 1 / (s - J33)` and `phi' = phi / a_x`:
+///
+/// ```text
+/// u2 = (r2 + J20 u0 + J21 u1) e2,   u3 = (r3 + J30 u0 + J31 u1) e3
+/// [ s     -a_x m ] [u0]   [ r0                          ]
+/// [ A10    A11   ] [u1] = [ r1 - phi' m (r2 e2 - r3 e3) ]
+/// A10 = m / a_x + phi' m (J20 e2 - J30 e3),  A11 = s + 2 zeta m + phi' m (J21 e2 - J31 e3)
+/// ```
+#[derive(Clone, Copy, Debug)]
+pub struct FsiFactor<T> {
+    s: T,
+    a_x_m: T,
+    phi_m: T,
+    j20: T,
+    j21: T,
+    j30: T,
+    j31: T,
+    e2: T,
+    e3: T,
+    a10: T,
+    a11: T,
+    inv_det: T,
+}
+
+impl<T: Real> ShiftedSolve<T, 4> for FsiFactor<T> {
+    #[inline]
+    fn solve(&self, r: &[T; 4]) -> [T; 4] {
+        let (r2e, r3e) = (r[2] * self.e2, r[3] * self.e3);
+        let b1 = r[1] - self.phi_m * (r2e - r3e);
+        let u0 = (r[0] * self.a11 + self.a_x_m * b1) * self.inv_det;
+        let u1 = (self.s * b1 - self.a10 * r[0]) * self.inv_det;
+        let u2 = r2e + (self.j20 * u0 + self.j21 * u1) * self.e2;
+        let u3 = r3e + (self.j30 * u0 + self.j31 * u1) * self.e3;
+        [u0, u1, u2, u3]
     }
 }
 
 impl<T: Real> OdeSystem<T, 4> for Fsi<'_, T> {
+    type Factor = FsiFactor<T>;
+
     fn rhs(&self, y: &[T; 4]) -> [T; 4] {
+        // Values only: the slopes and the omega derivatives of `local` are
+        // needed by the Jacobian, not here (four divisions saved per stage).
         let c = self.coefficients;
         let (xi, w, pa, pb) = (y[0], y[1], y[2], y[3]);
-        let (oa, ob) = self.omegas(xi);
-        let (ra, _) = regularised_root(T::ONE - pa, c.u_tr);
-        let (rb, _) = regularised_root(pb, c.u_tr);
+        let oa = c.omega_a0 / (T::ONE - c.eps_a * xi);
+        let ob = c.omega_b0 / (T::ONE + c.eps_b * xi);
+        let ra = regularised_root_value(T::ONE - pa, c.u_tr);
+        let rb = regularised_root_value(pb, c.u_tr);
         let sw = c.sigma * w;
-        let dpa = oa * (c.q_t * ra - c.g_l * pa + sw);
-        let dpb = ob * (c.g_l * (T::ONE - pb) - c.q_t * rb - sw);
-        let (dxi, dw) = match self.contact {
-            Contact::Free => (c.a_x * w, c.static_force(y) - c.two_zeta * w),
-            Contact::Closed | Contact::Open => (T::ZERO, T::ZERO),
-        };
-        [dxi, dw, dpa, dpb]
+        let fa = c.q_t * ra - c.g_l * pa + sw;
+        let fb = c.g_l * (T::ONE - pb) - c.q_t * rb - sw;
+        self.rhs_from(y, oa, ob, fa, fb)
     }
 
     fn jacobian(&self, y: &[T; 4]) -> [[T; 4]; 4] {
         let c = self.coefficients;
-        let (xi, w, pa, pb) = (y[0], y[1], y[2], y[3]);
-        let (oa, ob) = self.omegas(xi);
-        let (ra, sa) = regularised_root(T::ONE - pa, c.u_tr);
-        let (rb, sb) = regularised_root(pb, c.u_tr);
-        let sw = c.sigma * w;
-        let fa = c.q_t * ra - c.g_l * pa + sw;
-        let fb = c.g_l * (T::ONE - pb) - c.q_t * rb - sw;
-        // d omega_a / d xi = omega_a eps_a / (1 - eps_a xi); omega_b: -omega_b eps_b / (1 + eps_b xi).
-        let doa = oa * c.eps_a / (T::ONE - c.eps_a * xi);
-        let dob = -(ob * c.eps_b / (T::ONE + c.eps_b * xi));
-        let mech = match self.contact {
-            Contact::Free => [
+        let l = self.local(y);
+        let mech = if self.moving() {
+            [
                 [T::ZERO, c.a_x, T::ZERO, T::ZERO],
                 [-c.inv_a_x, -c.two_zeta, -c.phi_over_a_x, c.phi_over_a_x],
-            ],
-            Contact::Closed | Contact::Open => [[T::ZERO; 4]; 2],
+            ]
+        } else {
+            [[T::ZERO; 4]; 2]
         };
         [
             mech[0],
             mech[1],
+            [l.doa * l.fa, l.oa * c.sigma, -(l.oa * (c.q_t * l.sa + c.g_l)), T::ZERO],
             [
-                doa * fa,
-                oa * c.sigma,
-                -(oa * (c.q_t * sa + c.g_l)),
+                l.dob * l.fb,
+                -(l.ob * c.sigma),
                 T::ZERO,
-            ],
-            [
-                dob * fb,
-                -(ob * c.sigma),
-                T::ZERO,
-                -(ob * (c.g_l + c.q_t * sb)),
+                -(l.ob * (c.g_l + c.q_t * l.sb)),
             ],
         ]
+    }
+
+    fn linearise(&self, y: &[T; 4], shift: T) -> Option<([T; 4], FsiFactor<T>)> {
+        let c = self.coefficients;
+        let l = self.local(y);
+        let f = self.rhs_from(y, l.oa, l.ob, l.fa, l.fb);
+        let (j20, j21) = (l.doa * l.fa, l.oa * c.sigma);
+        let (j30, j31) = (l.dob * l.fb, -(l.ob * c.sigma));
+        let d2 = shift + l.oa * (c.q_t * l.sa + c.g_l);
+        let d3 = shift + l.ob * (c.g_l + c.q_t * l.sb);
+        if !(d2 > T::ZERO && d3 > T::ZERO) {
+            return None;
+        }
+        let (e2, e3) = (T::ONE / d2, T::ONE / d3);
+        let (a_x_m, phi_m, inv_a_x_m, two_zeta_m) = if self.moving() {
+            (c.a_x, c.phi_over_a_x, c.inv_a_x, c.two_zeta)
+        } else {
+            (T::ZERO, T::ZERO, T::ZERO, T::ZERO)
+        };
+        let a10 = inv_a_x_m + phi_m * (j20 * e2 - j30 * e3);
+        let a11 = shift + two_zeta_m + phi_m * (j21 * e2 - j31 * e3);
+        let det = shift * a11 + a_x_m * a10;
+        if !(det.abs() > T::tiny()) || !det.is_finite() {
+            return None;
+        }
+        let factor = FsiFactor {
+            s: shift,
+            a_x_m,
+            phi_m,
+            j20,
+            j21,
+            j30,
+            j31,
+            e2,
+            e3,
+            a10,
+            a11,
+            inv_det: T::ONE / det,
+        };
+        Some((f, factor))
     }
 }
 
@@ -378,4 +506,82 @@ pub fn apply_stops<T: Real>(xi: &mut T, w: &mut T) -> bool {
         *w = T::ZERO;
     }
     hit
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dynamics::schemes::dense_linearisation;
+
+    fn coefficients() -> Coefficients<f64> {
+        Coefficients {
+            a_x: 0.062,
+            inv_a_x: 1.0 / 0.062,
+            phi_over_a_x: 13.5,
+            two_zeta: 0.09,
+            xi0: 0.007,
+            omega_a0: 13.4,
+            eps_a: 0.059,
+            omega_b0: 13.4,
+            eps_b: 0.059,
+            sigma: 1.02,
+            u_tr: 1e-5,
+            q_t: 1.02,
+            g_l: 1.4,
+        }
+    }
+
+    #[test]
+    fn structured_factor_solves_like_a_dense_lu() {
+        let c = coefficients();
+        for contact in [Contact::Free, Contact::Closed] {
+            let sys = Fsi {
+                coefficients: &c,
+                contact,
+            };
+            for (k, y) in [[0.3, 0.01, 0.4, 0.6], [0.0, 0.0, 0.8, 0.2], [0.9, -0.2, 0.15, 0.95]]
+                .iter()
+                .enumerate()
+            {
+                let shift = 0.5 + k as f64;
+                let (f, structured) = sys.linearise(y, shift).unwrap();
+                let (f_dense, dense) = dense_linearisation(&sys, y, shift).unwrap();
+                assert_eq!(f, f_dense);
+                let r = [0.3, -1.2, 2.5, 0.7];
+                let (a, b) = (structured.solve(&r), dense.solve(&r));
+                for i in 0..4 {
+                    assert!(
+                        (a[i] - b[i]).abs() <= 1e-12 * (1.0 + b[i].abs()),
+                        "{contact:?} {y:?}: {a:?} vs {b:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn analytic_jacobian_matches_finite_differences() {
+        let c = coefficients();
+        let sys = Fsi {
+            coefficients: &c,
+            contact: Contact::Free,
+        };
+        let y = [0.4, 0.02, 0.35, 0.7];
+        let jac = sys.jacobian(&y);
+        for j in 0..4 {
+            let h = 1e-6;
+            let (mut yp, mut ym) = (y, y);
+            yp[j] += h;
+            ym[j] -= h;
+            let (fp, fm) = (sys.rhs(&yp), sys.rhs(&ym));
+            for i in 0..4 {
+                let fd = (fp[i] - fm[i]) / (2.0 * h);
+                assert!(
+                    (jac[i][j] - fd).abs() <= 1e-6 * (1.0 + fd.abs()),
+                    "J[{i}][{j}] = {} vs {fd}",
+                    jac[i][j]
+                );
+            }
+        }
+    }
 }

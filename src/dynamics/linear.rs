@@ -76,10 +76,7 @@ pub fn eigenvalues<T: Float>(m: &[[T; 4]; 4]) -> Result<[Complex<T>; 4], ModelEr
     // Insertion sort: real part descending, then imaginary descending.
     for i in 1..N {
         let mut j = i;
-        while j > 0
-            && (out[j].re > out[j - 1].re
-                || (out[j].re == out[j - 1].re && out[j].im > out[j - 1].im))
-        {
+        while j > 0 && (out[j].re > out[j - 1].re || (out[j].re == out[j - 1].re && out[j].im > out[j - 1].im)) {
             out.swap(j, j - 1);
             j -= 1;
         }
@@ -289,11 +286,7 @@ fn hqr<T: Float>(a: &mut [[T; 5]; 5], wr: &mut [T; 5], wi: &mut [T; 5]) -> Resul
                 if k != m {
                     p = a[k][k - 1];
                     q = a[k + 1][k - 1];
-                    r = if k != nn - 1 {
-                        a[k + 2][k - 1]
-                    } else {
-                        T::ZERO
-                    };
+                    r = if k != nn - 1 { a[k + 2][k - 1] } else { T::ZERO };
                     x = p.abs() + q.abs() + r.abs();
                     if x != T::ZERO {
                         p = p / x;
@@ -354,8 +347,7 @@ fn hqr<T: Float>(a: &mut [[T; 5]; 5], wr: &mut [T; 5], wi: &mut [T; 5]) -> Resul
 pub fn characteristic_polynomial<T: Real>(m: &[[T; 4]; 4]) -> [T; 4] {
     let det2 = |i: usize, j: usize| m[i][i] * m[j][j] - m[i][j] * m[j][i];
     let det3 = |i: usize, j: usize, k: usize| {
-        m[i][i] * (m[j][j] * m[k][k] - m[j][k] * m[k][j])
-            - m[i][j] * (m[j][i] * m[k][k] - m[j][k] * m[k][i])
+        m[i][i] * (m[j][j] * m[k][k] - m[j][k] * m[k][j]) - m[i][j] * (m[j][i] * m[k][k] - m[j][k] * m[k][i])
             + m[i][k] * (m[j][i] * m[k][j] - m[j][j] * m[k][i])
     };
     let trace = m[0][0] + m[1][1] + m[2][2] + m[3][3];
@@ -370,8 +362,7 @@ pub fn characteristic_polynomial<T: Real>(m: &[[T; 4]; 4]) -> [T; 4] {
             _ => [0, 1, 2],
         };
         let e = |r: usize, c: usize| m[r][cols[c]];
-        e(1, 0) * (e(2, 1) * e(3, 2) - e(2, 2) * e(3, 1))
-            - e(1, 1) * (e(2, 0) * e(3, 2) - e(2, 2) * e(3, 0))
+        e(1, 0) * (e(2, 1) * e(3, 2) - e(2, 2) * e(3, 1)) - e(1, 1) * (e(2, 0) * e(3, 2) - e(2, 2) * e(3, 0))
             + e(1, 2) * (e(2, 0) * e(3, 1) - e(2, 1) * e(3, 0))
     };
     let det = m[0][0] * minor(0) - m[0][1] * minor(1) + m[0][2] * minor(2) - m[0][3] * minor(3);
@@ -410,10 +401,7 @@ pub struct Linearisation<F> {
 }
 
 /// The model-unit Jacobian of the free motion at the equilibrium of `t` [C].
-pub fn jacobian_at_equilibrium<F: Float>(
-    model: &Model<F>,
-    t: F,
-) -> Result<[[F; 4]; 4], ModelError> {
+pub fn jacobian_at_equilibrium<F: Float>(model: &Model<F>, t: F) -> Result<[[F; 4]; 4], ModelError> {
     let p = model.params();
     let eq = equilibrium(p, t)?;
     let c = model.coefficients::<F>(&eq.fluid)?;
@@ -429,7 +417,7 @@ pub fn jacobian_at_equilibrium<F: Float>(
 pub fn linearise<F: Float>(params: &Params<F>, t: F) -> Result<Linearisation<F>, ModelError> {
     let model = Model::new(params)?;
     let jac = jacobian_at_equilibrium(&model, t)?;
-    let scale = F::from_f64(1.0 / model.scales.time);
+    let scale = F::ONE / model.scales.time;
     let mut ev = eigenvalues(&jac)?;
     for e in ev.iter_mut() {
         e.re *= scale;
@@ -439,11 +427,7 @@ pub fn linearise<F: Float>(params: &Params<F>, t: F) -> Result<Linearisation<F>,
     let mut zeta = [F::ZERO; 4];
     for i in 0..4 {
         wn[i] = ev[i].abs();
-        zeta[i] = if wn[i] > F::ZERO {
-            -ev[i].re / wn[i]
-        } else {
-            F::ONE
-        };
+        zeta[i] = if wn[i] > F::ZERO { -ev[i].re / wn[i] } else { F::ONE };
     }
     let eq = equilibrium(params, t)?;
     let c = model.coefficients::<F>(&eq.fluid)?;
@@ -479,10 +463,7 @@ mod tests {
         let ev = eigenvalues(&m).unwrap();
         let expect = [(-1.0, 2.0), (-1.0, 0.0), (-1.0, -2.0), (-2.0, 0.0)];
         for (e, (re, im)) in ev.iter().zip(expect) {
-            assert!(
-                (e.re - re).abs() < 1e-12 && (e.im - im).abs() < 1e-12,
-                "{ev:?}"
-            );
+            assert!((e.re - re).abs() < 1e-12 && (e.im - im).abs() < 1e-12, "{ev:?}");
         }
         assert_eq!(characteristic_polynomial(&m), [5.0, 13.0, 19.0, 10.0]);
         assert!(hurwitz_stable(&m));

@@ -17,9 +17,10 @@
 //! capillaries' flow); beyond, `s` is held at zero.
 
 use super::fsi::{Coefficients, Contact, DynamicState, Model, apply_stops, contact_for};
-use super::schemes::{OdeSystem, Scheme, StepError, Stepper};
+use super::schemes::{OdeSystem, Scheme, StepError, Stepper, dense_linearisation};
 use crate::equilibrium::equilibrium;
 use crate::error::ModelError;
+use crate::linalg::Lu;
 use crate::params::Params;
 use crate::scalar::{Float, Real};
 
@@ -56,6 +57,12 @@ impl<T: Real> ReducedFsi<'_, T> {
 }
 
 impl<T: Real> OdeSystem<T, 2> for ReducedFsi<'_, T> {
+    type Factor = Lu<T, 2>;
+
+    fn linearise(&self, y: &[T; 2], shift: T) -> Option<([T; 2], Lu<T, 2>)> {
+        dense_linearisation(self, y, shift)
+    }
+
     fn rhs(&self, y: &[T; 2]) -> [T; 2] {
         if self.contact != Contact::Free {
             return [T::ZERO; 2];
@@ -108,7 +115,7 @@ impl<F: Float, T: Real> ReducedTwin<F, T> {
         let y: [T; 4] = model.equilibrium_state(&eq);
         Ok(ReducedTwin {
             coefficients: model.coefficients(&fluid)?,
-            stepper: Stepper::new(scheme, tick / substeps as f64 / model.scales.time),
+            stepper: Stepper::new(scheme, tick / substeps as f64 / model.scales.time.to_f64()),
             substeps,
             state: [y[0], T::ZERO],
             model,
@@ -131,11 +138,7 @@ impl<F: Float, T: Real> ReducedTwin<F, T> {
                 coefficients: &self.coefficients,
                 contact: Contact::Free,
             };
-            let contact = contact_for(
-                self.state[0],
-                self.state[1],
-                probe.static_force(self.state[0]),
-            );
+            let contact = contact_for(self.state[0], self.state[1], probe.static_force(self.state[0]));
             let sys = ReducedFsi {
                 coefficients: &self.coefficients,
                 contact,
@@ -152,7 +155,7 @@ impl<F: Float, T: Real> ReducedTwin<F, T> {
     }
 
     /// The state in SI units, with the quasi-steady pressures.
-    pub fn state(&self) -> DynamicState {
+    pub fn state(&self) -> DynamicState<F> {
         let (s, _) = quasi_steady(&self.coefficients, self.state[1]);
         let pb = s * s;
         self.model

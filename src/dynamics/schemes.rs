@@ -28,10 +28,46 @@ use crate::scalar::Real;
 
 /// A system `y' = f(y)` with its Jacobian.
 pub trait OdeSystem<T, const N: usize> {
+    /// How the system factorises `shift I - J` (a dense [`Lu`] through
+    /// [`dense_linearisation`], or something exploiting its structure).
+    type Factor: ShiftedSolve<T, N>;
     /// The right-hand side `f(y)`.
     fn rhs(&self, y: &[T; N]) -> [T; N];
     /// The Jacobian `df/dy` at `y`.
     fn jacobian(&self, y: &[T; N]) -> [[T; N]; N];
+    /// `f(y)` together with a factorisation of `shift I - J(y)` (one pass
+    /// can share the work of both); `None` when the matrix is singular.
+    fn linearise(&self, y: &[T; N], shift: T) -> Option<([T; N], Self::Factor)>;
+}
+
+/// Solves `(shift I - J) u = r` with a factorised matrix.
+pub trait ShiftedSolve<T, const N: usize> {
+    /// The solution `u`.
+    fn solve(&self, r: &[T; N]) -> [T; N];
+}
+
+impl<T: Real, const N: usize> ShiftedSolve<T, N> for Lu<T, N> {
+    fn solve(&self, r: &[T; N]) -> [T; N] {
+        Lu::solve(self, r)
+    }
+}
+
+/// [`OdeSystem::linearise`] for any system: `f(y)` and a dense pivoted LU
+/// of `shift I - J(y)`.
+pub fn dense_linearisation<T: Real, S: OdeSystem<T, N> + ?Sized, const N: usize>(
+    sys: &S,
+    y: &[T; N],
+    shift: T,
+) -> Option<([T; N], Lu<T, N>)> {
+    let jac = sys.jacobian(y);
+    let mut w = [[T::ZERO; N]; N];
+    for i in 0..N {
+        for j in 0..N {
+            w[i][j] = -jac[i][j];
+        }
+        w[i][i] += shift;
+    }
+    Some((sys.rhs(y), Lu::new(w)?))
 }
 
 /// The one-step schemes the integrator can run.
@@ -238,11 +274,7 @@ impl<T: Real> Stepper<T> {
     }
 
     /// Advances `y` by one step of `sys`.
-    pub fn step<S: OdeSystem<T, N>, const N: usize>(
-        &self,
-        sys: &S,
-        y: &[T; N],
-    ) -> Result<[T; N], StepError> {
+    pub fn step<S: OdeSystem<T, N>, const N: usize>(&self, sys: &S, y: &[T; N]) -> Result<[T; N], StepError> {
         let next = match self.scheme {
             Scheme::Rk4 => self.rk4(sys, y),
             _ => self.rosenbrock(sys, y)?,
@@ -254,24 +286,12 @@ impl<T: Real> Stepper<T> {
         }
     }
 
-    fn rosenbrock<S: OdeSystem<T, N>, const N: usize>(
-        &self,
-        sys: &S,
-        y: &[T; N],
-    ) -> Result<[T; N], StepError> {
-        let jac = sys.jacobian(y);
-        let mut w = [[T::ZERO; N]; N];
-        for i in 0..N {
-            for j in 0..N {
-                w[i][j] = -jac[i][j];
-            }
-            w[i][i] += self.inv_gamma_h;
-        }
-        let lu = Lu::new(w).ok_or(StepError::Singular)?;
+    fn rosenbrock<S: OdeSystem<T, N>, const N: usize>(&self, sys: &S, y: &[T; N]) -> Result<[T; N], StepError> {
+        let (f0, lu) = sys.linearise(y, self.inv_gamma_h).ok_or(StepError::Singular)?;
         let mut u = [[T::ZERO; N]; MAX_STAGES];
-        let mut f = [T::ZERO; N];
+        let mut f = f0;
         for i in 0..self.stages {
-            if !self.reuse_f[i] || i == 0 {
+            if i > 0 && !self.reuse_f[i] {
                 let mut yi = *y;
                 for (j, uj) in u.iter().enumerate().take(i) {
                     let aij = self.a[i][j];
@@ -337,6 +357,10 @@ mod tests {
     struct Linear;
     const A: [[f64; 2]; 2] = [[-1.0, 1.0], [0.0, -100.0]];
     impl OdeSystem<f64, 2> for Linear {
+        type Factor = Lu<f64, 2>;
+        fn linearise(&self, y: &[f64; 2], shift: f64) -> Option<([f64; 2], Lu<f64, 2>)> {
+            dense_linearisation(self, y, shift)
+        }
         fn rhs(&self, y: &[f64; 2]) -> [f64; 2] {
             [A[0][0] * y[0] + A[0][1] * y[1], A[1][1] * y[1]]
         }
@@ -352,6 +376,10 @@ mod tests {
     /// Non-stiff test (observable order): y' = -y + cos-like coupling.
     struct Smooth;
     impl OdeSystem<f64, 2> for Smooth {
+        type Factor = Lu<f64, 2>;
+        fn linearise(&self, y: &[f64; 2], shift: f64) -> Option<([f64; 2], Lu<f64, 2>)> {
+            dense_linearisation(self, y, shift)
+        }
         fn rhs(&self, y: &[f64; 2]) -> [f64; 2] {
             [y[1], -y[0]]
         }

@@ -11,7 +11,7 @@
 //! fluid properties at the sensor rate) and the integration scalar `T`
 //! (`f32`, `f64` or fixed point).
 
-use super::fsi::{Coefficients, Contact, DynamicState, Fsi, Model, apply_stops};
+use super::fsi::{Coefficients, Contact, DynamicState, Fsi, Model, apply_stops, contact_for};
 use super::schemes::{Scheme, StepError, Stepper};
 use crate::equilibrium::equilibrium;
 use crate::error::ModelError;
@@ -34,12 +34,13 @@ pub struct TwinConfig {
 }
 
 impl TwinConfig {
-    /// What the firmware ships: ROS2, one step per 1 ms tick (the
-    /// accuracy/cost trade-off is in the project's `docs/dynamics.md`).
+    /// What the firmware ships: ROS3 (three-stage, L-stable, order 3), two
+    /// steps per 1 ms tick. The accuracy/cost trade-off against the other
+    /// schemes is in the project's `docs/dynamics.md`.
     pub const SHIPPED: TwinConfig = TwinConfig {
-        scheme: Scheme::Ros2,
+        scheme: Scheme::Ros3,
         tick: 1.0e-3,
-        substeps: 1,
+        substeps: 2,
     };
 }
 
@@ -76,7 +77,7 @@ impl<F: Float, T: Real> Twin<F, T> {
         let model = Model::new(params)?;
         let fluid = params.oil.state(temperature)?;
         let eq = equilibrium(params, temperature)?;
-        let h = config.tick / config.substeps as f64 / model.scales.time;
+        let h = config.tick / config.substeps as f64 / model.scales.time.to_f64();
         Ok(Twin {
             coefficients: model.coefficients(&fluid)?,
             stepper: Stepper::new(config.scheme, h),
@@ -125,19 +126,20 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// good substep and the error is returned.
     ///
     /// Stops are handled per substep:
-    /// * a substep that starts held is integrated held; if the static force
-    ///   at its end pulls away from the stop, the plunger was released during
-    ///   the substep, and the substep is redone in free motion from its start.
-    ///   The pressure transient that flips the force lasts tens of
-    ///   microseconds, so the release belongs at the substep's start (linear
-    ///   interpolation of the force would place it far too late). A release
-    ///   substep that ends a little beyond the stop but moving away from it
-    ///   is put on the stop with its velocity kept;
+    /// * on a stop, the plunger stays held only if both the actual static
+    ///   force and the quasi-steady one (the force the pressures settle to
+    ///   within tens of microseconds) push into the stop; otherwise it is
+    ///   released at the substep's start. A held substep whose final force
+    ///   pulls away is redone in free motion from its start: the pressure
+    ///   transient that flips the force is much shorter than a substep, so
+    ///   the release belongs at the start (interpolating the force would
+    ///   place it far too late). A release substep that ends a little beyond
+    ///   the stop but moving away from it is put on the stop, velocity kept;
     /// * a free substep that ends beyond a stop, or on it moving into it,
     ///   ends on it at rest (inelastic impact).
     ///
-    /// The cost is bounded: one scheme step per substep, two on the substep
-    /// of a release.
+    /// The cost is bounded: one scheme step per substep, two when a held
+    /// substep turns out to release (the quasi-steady test makes that rare).
     pub fn tick(&mut self) -> Result<TickReport, StepError> {
         let mut impact = false;
         for _ in 0..self.substeps {
@@ -153,7 +155,14 @@ impl<F: Float, T: Real> Twin<F, T> {
 
     fn substep(&self) -> Result<([T; 4], bool), StepError> {
         let c = &self.coefficients;
-        let contact = c.contact(&self.state);
+        let mut contact = c.contact(&self.state);
+        if contact != Contact::Free {
+            let [xi, w, ..] = self.state;
+            if contact_for(xi, w, c.quasi_steady_force(xi)) != contact {
+                contact = Contact::Free;
+            }
+        }
+        let held_at_start = c.contact(&self.state);
         if contact != Contact::Free {
             let held = Fsi {
                 coefficients: c,
@@ -173,7 +182,7 @@ impl<F: Float, T: Real> Twin<F, T> {
         };
         let mut next = self.stepper.step(&free, &self.state)?;
         let [xi, w, ..] = &mut next;
-        let leaving = match contact {
+        let leaving = match held_at_start {
             Contact::Closed => *xi < T::ZERO && *w > T::ZERO,
             Contact::Open => *xi > T::ONE && *w < T::ZERO,
             Contact::Free => false,
@@ -187,7 +196,7 @@ impl<F: Float, T: Real> Twin<F, T> {
     }
 
     /// The state in SI units.
-    pub fn state(&self) -> DynamicState {
+    pub fn state(&self) -> DynamicState<F> {
         self.model.scales.to_si(&self.state)
     }
 
@@ -197,7 +206,7 @@ impl<F: Float, T: Real> Twin<F, T> {
     }
 
     /// Replaces the state (SI units).
-    pub fn set_state(&mut self, s: &DynamicState) {
+    pub fn set_state(&mut self, s: &DynamicState<F>) {
         self.state = self.model.scales.from_si(s);
     }
 }

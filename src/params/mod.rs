@@ -1,16 +1,17 @@
 //! Validated parameters, converted to the scalar type of the computation.
 //!
+//! The file format itself (fields, units, rules) is the `compensator-params`
+//! crate, re-exported here.
+//!
 //! [`RawParams`] (plain `f64`, as read from a file) is checked by
 //! [`RawParams::validate`]; [`Params::new`] converts a valid set to `f32`,
 //! `f64` (or any [`Float`]) and checks that every value is representable
 //! there. A `Params<T>` therefore always describes a physical device: every
 //! function of the core may divide by its positive fields.
 
-mod raw;
-
-pub use raw::{
-    CORE_FIELDS, ESTIMATOR_FIELDS, Field, MACHINE_FIELDS, ParamError, Problem, RawCore,
-    RawEstimator, RawMachine, RawParams,
+pub use compensator_params::{
+    CORE_FIELDS, ESTIMATOR_FIELDS, Field, MACHINE_FIELDS, ParamError, Problem, RawCore, RawEstimator, RawMachine,
+    RawParams,
 };
 
 use crate::fluid::Oil;

@@ -1,12 +1,12 @@
 //! Reading the parameter file (MODEL.md section 8) into a validated
-//! [`RawParams`].
+//! [`RawParams`], and writing one back.
 //!
 //! Every key of the file must be known (a typo is an error, not a silently
 //! ignored value); numbers may be written as integers or floats; TOML's
 //! `nan` and `inf` are read and then rejected by validation with the field's
 //! name.
 
-use compensator::params::{CORE_FIELDS, ESTIMATOR_FIELDS, MACHINE_FIELDS, ParamError, RawParams};
+use crate::{CORE_FIELDS, ESTIMATOR_FIELDS, MACHINE_FIELDS, ParamError, RawParams};
 use std::fmt;
 use std::path::Path;
 
@@ -56,12 +56,7 @@ fn known(section: &str, key: &str) -> bool {
 /// Parses parameter-file text.
 pub fn parse(text: &str) -> Result<RawParams, LoadError> {
     let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
-        let msg = e
-            .message()
-            .lines()
-            .next()
-            .unwrap_or("invalid TOML")
-            .to_string();
+        let msg = e.message().lines().next().unwrap_or("invalid TOML").to_string();
         match e.span() {
             Some(span) => {
                 let line = text[..span.start.min(text.len())].lines().count().max(1);
@@ -99,18 +94,17 @@ pub fn parse(text: &str) -> Result<RawParams, LoadError> {
 
 /// Reads and validates a parameter file.
 pub fn load(path: &Path) -> Result<RawParams, LoadError> {
-    let text =
-        std::fs::read_to_string(path).map_err(|e| LoadError::Io(path.display().to_string(), e))?;
+    let text = std::fs::read_to_string(path).map_err(|e| LoadError::Io(path.display().to_string(), e))?;
     parse(&text)
 }
 
 /// Writes a parameter set back as TOML (core sections, then `[machine]` if
 /// present, then the `[estimator]` keys that differ from their defaults).
 pub fn to_toml(raw: &RawParams) -> String {
-    use compensator::params::RawEstimator;
+    use crate::RawEstimator;
     let mut out = String::new();
     let mut section = "";
-    let mut emit = |out: &mut String, field: &compensator::params::Field, v: f64| {
+    let mut emit = |out: &mut String, field: &crate::Field, v: f64| {
         if field.section != section {
             if !out.is_empty() {
                 out.push('\n');
@@ -118,12 +112,7 @@ pub fn to_toml(raw: &RawParams) -> String {
             out.push_str(&format!("[{}]\n", field.section));
             section = field.section;
         }
-        out.push_str(&format!(
-            "{} = {}    # {}\n",
-            field.key,
-            fmt_float(v),
-            field.unit
-        ));
+        out.push_str(&format!("{} = {}    # {}\n", field.key, fmt_float(v), field.unit));
     };
     for (f, v) in CORE_FIELDS.iter().zip(raw.core.to_array()) {
         emit(&mut out, f, v);
@@ -134,11 +123,7 @@ pub fn to_toml(raw: &RawParams) -> String {
         }
     }
     let defaults = RawEstimator::DEFAULT.to_array();
-    for ((f, v), d) in ESTIMATOR_FIELDS
-        .iter()
-        .zip(raw.estimator.to_array())
-        .zip(defaults)
-    {
+    for ((f, v), d) in ESTIMATOR_FIELDS.iter().zip(raw.estimator.to_array()).zip(defaults) {
         if v != d {
             emit(&mut out, f, v);
         }

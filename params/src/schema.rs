@@ -1,10 +1,5 @@
 //! The parameter file's schema and its validation, in plain `f64`.
 //!
-//! This file is dependency-free on purpose: the firmware's build script
-//! includes it (`#[path]`) to turn a TOML file into checked constants, and the
-//! host loader uses the same [`FIELDS`] tables, so the list of fields, their
-//! units and their rules exist exactly once.
-//!
 //! Units are SI, temperatures in degrees Celsius (MODEL.md section 8).
 
 use core::fmt;
@@ -118,7 +113,7 @@ schema! {
     valid_max: "estimator"."valid_max" ["C"] = Some(78.0), "Upper end of the validated temperature range.";
     oil_min: "estimator"."oil_min" ["C"] = Some(-20.0), "Coldest temperature the fluid model accepts.";
     oil_max: "estimator"."oil_max" ["C"] = Some(150.0), "Hottest temperature the fluid model accepts.";
-    telemetry_hz: "estimator"."telemetry_hz" ["Hz"] = Some(10.0), "Telemetry rate.";
+    telemetry_hz: "estimator"."telemetry_hz" ["Hz"] = Some(2.0), "Telemetry rate.";
     rtd_r0: "estimator"."rtd_r0" ["ohm"] = Some(100.0), "RTD resistance at 0 C (PT100).";
     rtd_reference: "estimator"."rtd_reference" ["ohm"] = Some(430.0), "MAX31865 reference resistor.";
 }
@@ -180,30 +175,18 @@ impl fmt::Display for ParamError {
             Problem::NotPositive => write!(f, "{} = {}: must be positive", self.field, self.value),
             Problem::Negative => write!(f, "{} = {}: must not be negative", self.field, self.value),
             Problem::OutOfRange { min, max } => {
-                write!(
-                    f,
-                    "{} = {}: must lie in [{}, {}]",
-                    self.field, self.value, min, max
-                )
+                write!(f, "{} = {}: must lie in [{}, {}]", self.field, self.value, min, max)
             }
             Problem::Inconsistent(why) => write!(f, "{} = {}: {}", self.field, self.value, why),
             Problem::NotRepresentable(ty) => {
-                write!(
-                    f,
-                    "{} = {}: not representable as {}",
-                    self.field, self.value, ty
-                )
+                write!(f, "{} = {}: not representable as {}", self.field, self.value, ty)
             }
         }
     }
 }
 
 fn err(field: &'static str, value: f64, problem: Problem) -> ParamError {
-    ParamError {
-        field,
-        value,
-        problem,
-    }
+    ParamError { field, value, problem }
 }
 
 /// Finite, else the matching error.
@@ -395,13 +378,11 @@ impl RawParams {
     pub fn from_lookup(mut get: impl FnMut(&str, &str) -> Option<f64>) -> Result<Self, ParamError> {
         let mut core = [0.0; CORE_FIELDS.len()];
         for (slot, field) in core.iter_mut().zip(CORE_FIELDS.iter()) {
-            *slot = get(field.section, field.key)
-                .or(field.default)
-                .ok_or(ParamError {
-                    field: field.path,
-                    value: f64::NAN,
-                    problem: Problem::Missing,
-                })?;
+            *slot = get(field.section, field.key).or(field.default).ok_or(ParamError {
+                field: field.path,
+                value: f64::NAN,
+                problem: Problem::Missing,
+            })?;
         }
         let mut machine = [0.0; MACHINE_FIELDS.len()];
         let mut present = 0;

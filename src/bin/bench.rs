@@ -1,0 +1,236 @@
+//! Cost benchmark on QEMU: `cargo xtask bench`.
+//!
+//! Instructions are counted with SysTick under `qemu -icount shift=0`: the
+//! emulated clock then advances exactly one nanosecond per instruction, so
+//! SysTick deltas are deterministic and proportional to the instructions
+//! executed. The ratio is calibrated at start-up with a loop of known
+//! length (`subs; bne`, two instructions per iteration), so the method
+//! does not depend on the board's clock settings.
+//!
+//! Every result line starts with `[measure]` and carries raw SysTick counts;
+//! `cargo xtask bench` converts them with the calibration line.
+//!
+//! * Cortex-M4F (`thumbv7em-none-eabihf`, netduinoplus2): the twin's tick in
+//!   `f32` and Q16.16 for every scheme and substep count, the estimator's
+//!   pieces, and the whole estimator tick (mean and worst, with telemetry).
+//! * Cortex-M3 (`thumbv7m-none-eabi`, netduino2): the twin's tick in
+//!   Q16.16 (and in soft-float `f32`, for comparison).
+#![no_std]
+#![no_main]
+
+use compensator::dynamics::{Scheme, Twin, TwinConfig};
+use compensator::scalar::Q16_16;
+use compensator::{Params, Real};
+use cortex_m::peripheral::{SYST, syst::SystClkSource};
+use cortex_m_rt::entry;
+use cortex_m_semihosting::debug;
+use defmt::{error, info};
+
+include!(concat!(env!("OUT_DIR"), "/params.rs"));
+
+/// Ticks per measured run.
+const TICKS: u32 = 200;
+
+/// Exactly `2 n` instructions.
+#[inline(always)]
+fn spin(n: u32) {
+    // SAFETY: a register-only countdown loop.
+    unsafe {
+        core::arch::asm!("2:", "subs {n}, #1", "bne 2b", n = inout(reg) n => _, options(nomem, nostack));
+    }
+}
+
+/// SysTick counts spent in `f` (SysTick counts down, 24 bits).
+#[inline(always)]
+fn counts<R>(f: impl FnOnce() -> R) -> (R, u32) {
+    let t0 = SYST::get_current();
+    let r = f();
+    let t1 = SYST::get_current();
+    (r, t0.wrapping_sub(t1) & 0x00FF_FFFF)
+}
+
+fn twin_cost<T: Real>(params: &Params<f32>, scheme: Scheme, substeps: u8, scalar: &str) {
+    let config = TwinConfig {
+        scheme,
+        tick: 1e-3,
+        substeps,
+    };
+    let Ok(mut twin) = Twin::<f32, T>::new(params, config, 30.0) else {
+        error!(
+            "twin {=str} {=str} x{=u8}: cannot start",
+            scheme.name(),
+            scalar,
+            substeps
+        );
+        return;
+    };
+    if twin.set_temperature(40.0).is_err() {
+        return;
+    }
+    // The first ticks after a temperature step are the most expensive
+    // (the release from the stop takes a second step); all are measured.
+    let mut total = 0u32;
+    let mut worst = 0u32;
+    let mut failed = false;
+    for _ in 0..TICKS {
+        let (r, c) = counts(|| twin.tick());
+        failed |= r.is_err();
+        total += c;
+        worst = worst.max(c);
+    }
+    info!(
+        "[measure] twin scheme={=str} substeps={=u8} scalar={=str} ticks={=u32} total={=u32} worst={=u32} ok={=bool}",
+        scheme.name(),
+        substeps,
+        scalar,
+        TICKS,
+        total,
+        worst,
+        !failed
+    );
+}
+
+#[cfg(target_abi = "eabihf")]
+fn pieces(params: &Params<f32>) {
+    use compensator::asymptotic::sensitivity_at;
+    use compensator::dynamics::fsi::{Contact, Fsi, Model};
+    use compensator::dynamics::linear::hurwitz_stable;
+    use compensator::dynamics::schemes::OdeSystem;
+    use compensator::equilibrium::{a_parameter, equilibrium_for};
+    use compensator::estimator::{Estimator, EstimatorConfig};
+    use core::hint::black_box;
+
+    let t = black_box(55.5f32);
+    let (point, c) = counts(|| params.oil.point(black_box(t)));
+    info!("[measure] piece name=fluid-point total={=u32}", c);
+    let Ok(point) = point else { return };
+    let (eq, c) = counts(|| equilibrium_for(params, point.state, a_parameter(params, &point.state)));
+    info!("[measure] piece name=equilibrium total={=u32}", c);
+    let (_, c) = counts(|| black_box(sensitivity_at(params, &point)));
+    info!("[measure] piece name=sensitivity total={=u32}", c);
+    let (Ok(model), Ok(eq)) = (Model::new(params), eq) else {
+        return;
+    };
+    let Ok(coef) = model.coefficients::<f32>(&point.state) else {
+        return;
+    };
+    let (_, c) = counts(|| {
+        let y: [f32; 4] = model.equilibrium_state(&eq);
+        black_box(hurwitz_stable(
+            &Fsi {
+                coefficients: &coef,
+                contact: Contact::Free,
+            }
+            .jacobian(&y),
+        ))
+    });
+    info!("[measure] piece name=stability total={=u32}", c);
+
+    // Telemetry packing alone: one estimate, encoded by defmt.
+    let Ok(config) = EstimatorConfig::new(&RAW_PARAMS.estimator) else {
+        return;
+    };
+    let Ok(mut est) = Estimator::new(params, config, TwinConfig::SHIPPED, 40.0) else {
+        return;
+    };
+    let e = est.tick(Ok(Some(40.0)));
+    let (_, c) = counts(|| info!("estimate {}", black_box(e)));
+    info!("[measure] piece name=telemetry total={=u32}", c);
+
+    // The whole estimator tick, as the firmware runs it: a sample every
+    // 20 ticks, a 30 -> 40 C step; with telemetry packed at its cadence
+    // (every 100 ticks here), then without telemetry.
+    let Ok(config) = EstimatorConfig::new(&RAW_PARAMS.estimator) else {
+        return;
+    };
+    for telemetry in [true, false] {
+        let mut config = config;
+        config.telemetry_every = if telemetry { 100 } else { 0 };
+        let Ok(mut est) = Estimator::new(params, config, TwinConfig::SHIPPED, 30.0) else {
+            return;
+        };
+        let (mut total, mut worst, mut worst_tick) = (0u32, 0u32, 0u32);
+        let n = 1000u32;
+        for k in 0..n {
+            let sample = if k % 20 == 0 { Ok(Some(40.0f32)) } else { Ok(None) };
+            let (_, c) = counts(|| {
+                let e = est.tick(black_box(sample));
+                if est.telemetry_due() {
+                    info!("estimate {}", e);
+                }
+            });
+            total += c;
+            if c > worst {
+                worst = c;
+                worst_tick = k;
+            }
+        }
+        info!(
+            "[measure] estimator scheme={=str} substeps={=u8} telemetry={=bool} ticks={=u32} total={=u32} worst={=u32} worst_tick={=u32}",
+            TwinConfig::SHIPPED.scheme.name(),
+            TwinConfig::SHIPPED.substeps,
+            telemetry,
+            n,
+            total,
+            worst,
+            worst_tick
+        );
+    }
+}
+
+#[entry]
+fn main() -> ! {
+    let Some(mut cp) = cortex_m::Peripherals::take() else {
+        exit(false)
+    };
+    cp.SYST.set_clock_source(SystClkSource::Core);
+    cp.SYST.set_reload(0x00FF_FFFF);
+    cp.SYST.clear_current();
+    cp.SYST.enable_counter();
+
+    let n = 100_000u32;
+    let (_, c) = counts(|| spin(core::hint::black_box(n)));
+    info!("[measure] calibration instructions={=u32} total={=u32}", 2 * n, c);
+
+    let Ok(params) = Params::<f32>::new(&RAW_PARAMS) else {
+        error!("parameters rejected");
+        exit(false)
+    };
+    let configs: [(Scheme, u8); 12] = [
+        (Scheme::LinearlyImplicitEuler, 1),
+        (Scheme::LinearlyImplicitEuler, 4),
+        (Scheme::Ros2, 1),
+        (Scheme::Ros2, 2),
+        (Scheme::Ros2, 4),
+        (Scheme::Ros3, 1),
+        (Scheme::Ros3, 2),
+        (Scheme::Ros3, 4),
+        (Scheme::Rodas3, 1),
+        (Scheme::Rodas3, 2),
+        (Scheme::Rk4, 32),
+        (Scheme::Rk4, 64),
+    ];
+    for (scheme, substeps) in configs {
+        #[cfg(target_abi = "eabihf")]
+        twin_cost::<f32>(&params, scheme, substeps, "f32");
+        twin_cost::<Q16_16>(&params, scheme, substeps, "q16.16");
+        #[cfg(not(target_abi = "eabihf"))]
+        if scheme == Scheme::Ros3 && substeps == 2 {
+            twin_cost::<f32>(&params, scheme, substeps, "f32-soft");
+        }
+    }
+    #[cfg(target_abi = "eabihf")]
+    pieces(&params);
+    exit(true)
+}
+
+fn exit(ok: bool) -> ! {
+    debug::exit(if ok { debug::EXIT_SUCCESS } else { debug::EXIT_FAILURE });
+    #[allow(clippy::empty_loop)]
+    loop {}
+}
+
+#[panic_handler]
+fn panic(_: &core::panic::PanicInfo) -> ! {
+    exit(false)
+}

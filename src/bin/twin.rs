@@ -1,0 +1,311 @@
+//! The QEMU twin (netduinoplus2, STM32F405 / Cortex-M4F): `cargo xtask run`.
+//!
+//! 1. Prints the quasi-static characteristic over 26-78 C (Eqs. 2-10):
+//!    temperature, `A`, chamber pressures, displacement and flows, with the
+//!    balance temperature, the Eq. (32) verdict and the linearisation.
+//! 2. Replays a temperature profile (holds, a 1 C/s ramp, steps, a trip
+//!    outside the validated range) through a simulated MAX31865 read by the
+//!    real driver, with injected sensor faults, and runs the estimator every
+//!    1 ms tick, printing its telemetry.
+//! 3. Checks itself against bounds computed on the host at build time (the
+//!    f64 reference's equilibrium at the end of every hold; the flags each
+//!    injected fault must raise; no NaN), reports the peak stack measured
+//!    by stack painting, and exits 0 (all checks pass) or 1.
+#![no_std]
+#![no_main]
+
+use compensator::dynamics::TwinConfig;
+use compensator::dynamics::linear::linearise;
+use compensator::equilibrium::{balance_temperature, equilibrium};
+use compensator::estimator::{Estimator, EstimatorConfig, Flags, StateEstimate};
+use compensator::sensor::TemperatureSource;
+use compensator::sensor::max31865::{Mains, Max31865, Settings, Wires, fault};
+use compensator::sensor::simulated::SimulatedMax31865;
+use compensator::{Params, asymptotic};
+use cortex_m as _; // links the critical-section implementation defmt needs
+use cortex_m_rt::entry;
+use cortex_m_semihosting::debug;
+use defmt::{error, info};
+
+include!(concat!(env!("OUT_DIR"), "/params.rs"));
+include!(concat!(env!("OUT_DIR"), "/replay.rs"));
+
+/// Conversion period of the MAX31865 with its 50 Hz filter [s].
+const SENSOR_PERIOD: f32 = 0.020;
+/// Numerical margin of the checkpoints beyond the reference's interval:
+/// displacement, as a fraction of the stroke (f32 steady state: ~2e-6).
+const X_TOLERANCE: f32 = 1e-5;
+/// Numerical margin of the checkpoints: pressures, as a fraction of the drop.
+const P_TOLERANCE: f32 = 1e-5;
+
+/// Oil temperature of the replay at `time` [s].
+fn temperature_at(time: f32) -> f32 {
+    for &(t0, t1, a, b) in REPLAY_PIECES.iter() {
+        if time >= t0 && time < t1 {
+            return a + (b - a) * (time - t0) / (t1 - t0);
+        }
+    }
+    REPLAY_PIECES[REPLAY_PIECES.len() - 1].3
+}
+
+/// The fault injected at `time` [s], if any (index into `REPLAY_FAULTS`).
+fn fault_at(time: f32) -> Option<usize> {
+    REPLAY_FAULTS.iter().position(|&(t0, t1, _, _)| time >= t0 && time < t1)
+}
+
+/// Counts passed and failed checks.
+struct Checks {
+    passed: u32,
+    failed: u32,
+}
+
+impl Checks {
+    fn check(&mut self, ok: bool, what: &str, time: f32) {
+        if ok {
+            self.passed += 1;
+        } else {
+            self.failed += 1;
+            error!("check failed at {=f32} s: {=str}", time, what);
+        }
+    }
+}
+
+fn finite_estimate(e: &StateEstimate) -> bool {
+    [
+        e.temperature,
+        e.x,
+        e.v,
+        e.p_a,
+        e.p_b,
+        e.q_a,
+        e.q_b,
+        e.q_throt,
+        e.q_total,
+        e.x_equilibrium,
+        e.dx_dt,
+    ]
+    .iter()
+    .all(|v| v.is_finite())
+}
+
+#[entry]
+fn main() -> ! {
+    let params = match Params::<f32>::new(&RAW_PARAMS) {
+        Ok(p) => p,
+        Err(e) => {
+            error!("parameters rejected: {=str}", e.field);
+            exit(false)
+        }
+    };
+    let config = match EstimatorConfig::new(&RAW_PARAMS.estimator) {
+        Ok(c) => c,
+        Err(e) => {
+            error!("estimator settings rejected: {=str}", e.field);
+            exit(false)
+        }
+    };
+    info!(
+        "compensator twin on the emulated Cortex-M4F; parameters {=str}",
+        PARAMS_SOURCE
+    );
+    static_characteristic(&params);
+    let ok = replay(&params, config);
+    let stack = stack_peak();
+    info!("[measure] peak stack {=u32} bytes (stack painting)", stack as u32);
+    exit(ok)
+}
+
+/// Part 1: the quasi-static model over 26-78 C.
+fn static_characteristic(params: &Params<f32>) {
+    info!(
+        "quasi-static equilibrium (Eqs. 2-10), dp = {=f32} bar",
+        params.pressure_drop * 1e-5
+    );
+    info!("  t[C]   A[sqrt(Pa)]  p_a[kPa]  p_b[kPa]  x[um]   Q_a[l/min] Q_throt[l/min] Q0[l/min]");
+    let mut t = 26.0f32;
+    while t <= 78.0 {
+        match equilibrium(params, t) {
+            Ok(e) => info!(
+                "  {=f32} {=f32} {=f32} {=f32} {=f32} {=f32} {=f32} {=f32}",
+                t,
+                e.a,
+                e.p_a * 1e-3,
+                e.p_b * 1e-3,
+                e.x * 1e6,
+                e.q_branch * 6e4,
+                e.q_throt * 6e4,
+                e.q_total * 6e4
+            ),
+            Err(e) => error!("  {=f32}: {}", t, e),
+        }
+        t += 4.0;
+    }
+    match balance_temperature(params, 0.0, 100.0) {
+        Ok(t0) => info!("balance temperature (p_a = p_b, Eq. 2): {=f32} C", t0),
+        Err(e) => info!("balance temperature: {}", e),
+    }
+    match asymptotic::monotonicity(params, 26.0, 78.0, 53) {
+        Ok(m) => info!(
+            "Eq. (32) over 26-78 C: monotonic = {=bool}, smallest dx/dt {=f32} um/K at {=f32} C",
+            m.monotonic,
+            m.worst_dx_dt * 1e6,
+            m.worst_temperature
+        ),
+        Err(e) => error!("Eq. (32): {}", e),
+    }
+    for t in [30.0f32, 80.0] {
+        match linearise(params, t) {
+            Ok(l) => info!(
+                "linearisation at {=f32} C: dominant eigenvalue {=f32} 1/s, stable = {=bool}, plunger damping ratio {=f32}",
+                t, l.dominant.re, l.stable, l.plunger_damping_ratio
+            ),
+            Err(e) => error!("linearisation at {=f32} C: {}", t, e),
+        }
+    }
+}
+
+/// Part 2: the estimator on the replayed profile; returns whether every
+/// check passed.
+fn replay(params: &Params<f32>, config: EstimatorConfig) -> bool {
+    let raw = &RAW_PARAMS.estimator;
+    let settings = Settings {
+        r0: raw.rtd_r0 as f32,
+        reference: raw.rtd_reference as f32,
+        wires: Wires::Three,
+        mains: Mains::Hz50,
+        fault_band: (-60.0, 250.0),
+    };
+    let start = temperature_at(0.0);
+    let mut sensor = Max31865::new(SimulatedMax31865::new(settings, start), settings);
+    let mut checks = Checks { passed: 0, failed: 0 };
+    checks.check(sensor.configure().is_ok(), "sensor configuration", 0.0);
+    let mut estimator = match Estimator::new(params, config, TwinConfig::SHIPPED, start) {
+        Ok(e) => e,
+        Err(e) => {
+            error!("estimator: {}", e);
+            return false;
+        }
+    };
+    let tick = config.tick;
+    let end = REPLAY_PIECES[REPLAY_PIECES.len() - 1].1;
+    let ticks = (end / tick) as u32;
+    let sensor_every = ((SENSOR_PERIOD / tick) as u32).max(1);
+    let mut seen = [Flags::empty(); REPLAY_FAULTS.len()];
+    let mut next_checkpoint = 0;
+    let mut out_of_range_seen = false;
+    let mut nan_ticks = 0u32;
+    info!(
+        "replaying {=f32} s: ticks of {=f32} ms, sensor every {=u32} ticks, telemetry every {=u32} ticks",
+        end,
+        tick * 1e3,
+        sensor_every,
+        config.telemetry_every
+    );
+    for k in 0..ticks {
+        let time = k as f32 * tick;
+        let fault_now = fault_at(time);
+        {
+            // Drive the simulated converter.
+            let sim = sensor_device(&mut sensor);
+            sim.temperature = temperature_at(time);
+            sim.bus_error = false;
+            sim.fault = 0;
+            sim.forced_code = None;
+            if let Some(i) = fault_now {
+                match REPLAY_FAULTS[i].2 {
+                    1 => sim.temperature += 40.0,
+                    2 => sim.bus_error = true,
+                    3 => sim.fault = fault::RTD_HIGH,
+                    _ => sim.forced_code = Some(0x7FFF),
+                }
+            }
+        }
+        let sample = if k % sensor_every == 0 { sensor.read() } else { Ok(None) };
+        let e = estimator.tick(sample);
+        if let Some(i) = fault_now {
+            seen[i].insert(e.flags);
+        }
+        if (66.5..68.0).contains(&time) && e.flags.contains(Flags::OUT_OF_RANGE) {
+            out_of_range_seen = true;
+        }
+        if !finite_estimate(&e) {
+            nan_ticks += 1;
+        }
+        if next_checkpoint < CHECKPOINTS.len() && time >= CHECKPOINTS[next_checkpoint].0 {
+            let (_, temp, half, [x_lo, x_hi, pa_lo, pa_hi, pb_lo, pb_hi]) = CHECKPOINTS[next_checkpoint];
+            let (dx, dp) = (X_TOLERANCE * params.plunger.stroke, P_TOLERANCE * params.pressure_drop);
+            let within = |v: f32, lo: f32, hi: f32, tol: f32| v >= lo - tol && v <= hi + tol;
+            let ok = within(e.temperature, temp - half, temp + half, 1e-3)
+                && within(e.x, x_lo, x_hi, dx)
+                && within(e.p_a, pa_lo, pa_hi, dp)
+                && within(e.p_b, pb_lo, pb_hi, dp);
+            info!(
+                "checkpoint {=f32} C: x {=f32} um in [{=f32}, {=f32}], p_a {=f32} kPa in [{=f32}, {=f32}], p_b {=f32} kPa in [{=f32}, {=f32}]",
+                temp,
+                e.x * 1e6,
+                x_lo * 1e6,
+                x_hi * 1e6,
+                e.p_a * 1e-3,
+                pa_lo * 1e-3,
+                pa_hi * 1e-3,
+                e.p_b * 1e-3,
+                pb_lo * 1e-3,
+                pb_hi * 1e-3
+            );
+            checks.check(ok, "estimate within the reference's bounds", time);
+            if x_hi == 0.0 {
+                checks.check(e.flags.contains(Flags::AT_STOP), "AT_STOP on the closed stop", time);
+            }
+            next_checkpoint += 1;
+        }
+        if estimator.telemetry_due() {
+            info!("{=f32} s {}", time, e);
+        }
+    }
+    checks.check(next_checkpoint == CHECKPOINTS.len(), "every checkpoint reached", end);
+    for (i, &(t0, _, kind, flag)) in REPLAY_FAULTS.iter().enumerate() {
+        let ok = seen[i].contains(Flags(flag));
+        info!("injected fault kind {=u8} at {=f32} s raised [{}]", kind, t0, seen[i]);
+        checks.check(ok, "the injected fault raised its flag", t0);
+    }
+    checks.check(out_of_range_seen, "OUT_OF_RANGE at 90 C", 67.0);
+    checks.check(nan_ticks == 0, "no NaN in any estimate", end);
+    info!("checks: {=u32} passed, {=u32} failed", checks.passed, checks.failed);
+    checks.failed == 0
+}
+
+/// The simulated converter behind the driver (the driver owns it).
+fn sensor_device(sensor: &mut Max31865<SimulatedMax31865>) -> &mut SimulatedMax31865 {
+    sensor.device_mut()
+}
+
+/// Peak stack use [bytes]: cortex-m-rt painted the stack with
+/// `0xCCCC_CCCC` at reset (feature `paint-stack`); the lowest word no longer
+/// painted marks the deepest the stack has been.
+fn stack_peak() -> usize {
+    unsafe extern "C" {
+        static _stack_start: u32;
+        static _stack_end: u32;
+    }
+    let (lo, hi) = (&raw const _stack_end as usize, &raw const _stack_start as usize);
+    let mut p = lo;
+    // SAFETY: [lo, hi) is the stack region, word-aligned, always mapped.
+    while p < hi && unsafe { (p as *const u32).read_volatile() } == 0xCCCC_CCCC {
+        p += 4;
+    }
+    hi - p
+}
+
+fn exit(ok: bool) -> ! {
+    debug::exit(if ok { debug::EXIT_SUCCESS } else { debug::EXIT_FAILURE });
+    #[allow(clippy::empty_loop)]
+    loop {}
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    if let Some(loc) = info.location() {
+        error!("panic at {=str}:{=u32}", loc.file(), loc.line());
+    }
+    exit(false)
+}

@@ -1,0 +1,547 @@
+//! The state estimator the firmware runs every tick: temperature sample ->
+//! filtered temperature -> fluid properties -> FSI twin step ->
+//! closed-form equilibrium, sensitivity and stability -> [`StateEstimate`].
+//!
+//! Per tick, in this order:
+//! 1. the latest sample (if any) is checked: not finite or outside the oil's
+//!    range is a fault; further than `spike_threshold` from the filtered
+//!    value is a spike and rejected, unless `spike_limit` consecutive
+//!    samples agree on it (a real step);
+//! 2. a first-order filter (time constant `filter_time_constant`) follows
+//!    the last accepted sample;
+//! 3. one temperature-only job runs, in turn: the oil's properties at the
+//!    filtered temperature (one Walther evaluation, handed to the twin and
+//!    the flow laws); the closed-form equilibrium with `dx/dt` (Eq. 31); the
+//!    Routh-Hurwitz stability of the linearisation at that equilibrium; the
+//!    machine's losses. None runs on a telemetry tick. Each result is thus
+//!    refreshed at least every 4 ms (fluid properties five times the
+//!    MAX31865's 50 Hz rate), while the oil's temperature changes over
+//!    seconds;
+//! 4. the twin advances one tick;
+//! 5. flows and the compensation error follow from the twin's state.
+//!
+//! The cost of a tick is bounded by the twin's step, the fluid properties
+//! and the larger of one job or the telemetry packing: what the firmware's
+//! budget measures. Nothing here allocates or panics; every failure becomes
+//! a flag.
+
+use crate::dynamics::fsi::{Contact, Fsi};
+use crate::dynamics::linear::hurwitz_stable;
+use crate::dynamics::schemes::OdeSystem;
+use crate::dynamics::{Twin, TwinConfig};
+use crate::equilibrium::{a_parameter, equilibrium_for};
+use crate::error::ModelError;
+use crate::fluid::FluidPoint;
+use crate::params::{ParamError, Params, RawEstimator};
+use crate::scalar::Real;
+use crate::sensor::SensorFault;
+use crate::{asymptotic, compensation};
+
+/// Estimator settings in `f32` (from the `[estimator]` section).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EstimatorConfig {
+    /// Tick [s].
+    pub tick: f32,
+    /// Filter gain per tick, `1 - exp(-tick / tau)`.
+    pub filter_gain: f32,
+    /// Spike threshold [C].
+    pub spike_threshold: f32,
+    /// Consecutive rejected samples accepted as a real step.
+    pub spike_limit: u16,
+    /// Validated temperature range [C].
+    pub valid: (f32, f32),
+    /// Range where the oil model is used at all [C].
+    pub oil: (f32, f32),
+    /// Ticks between telemetry records (0: never).
+    pub telemetry_every: u32,
+    /// Ticks without an accepted sample after which the estimate is degraded.
+    pub stale_after: u32,
+}
+
+impl EstimatorConfig {
+    /// From the parameter file's `[estimator]` section (validated).
+    pub fn new(raw: &RawEstimator) -> Result<Self, ParamError> {
+        raw.validate()?;
+        let tick = 1.0 / raw.tick_hz;
+        let telemetry_every = if raw.telemetry_hz > 0.0 {
+            libm::round(raw.tick_hz / raw.telemetry_hz).max(1.0) as u32
+        } else {
+            0
+        };
+        Ok(EstimatorConfig {
+            tick: tick as f32,
+            filter_gain: (1.0 - libm::exp(-tick / raw.filter_time_constant)) as f32,
+            spike_threshold: raw.spike_threshold as f32,
+            spike_limit: raw.spike_limit.min(u16::MAX as f64) as u16,
+            valid: (raw.valid_min as f32, raw.valid_max as f32),
+            oil: (raw.oil_min as f32, raw.oil_max as f32),
+            telemetry_every,
+            // Half a second without a usable sample (at least ten ticks).
+            stale_after: (libm::round(raw.tick_hz * 0.5) as u32).max(10),
+        })
+    }
+}
+
+/// Condition flags of an estimate (a bit set).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Flags(pub u16);
+
+impl Flags {
+    /// The plunger rests on a stop (window closed or fully open).
+    pub const AT_STOP: Flags = Flags(1 << 0);
+    /// The filtered temperature is outside the validated range.
+    pub const OUT_OF_RANGE: Flags = Flags(1 << 1);
+    /// Eq. (32) does not hold over the validated range: the equilibrium
+    /// branch may not be unique.
+    pub const NOT_UNIQUE: Flags = Flags(1 << 2);
+    /// The linearisation at the equilibrium is not Hurwitz-stable.
+    pub const UNSTABLE: Flags = Flags(1 << 3);
+    /// This tick's sample was missing or unusable (a sensor fault).
+    pub const SENSOR_FAULT: Flags = Flags(1 << 4);
+    /// This tick's sample was rejected as a spike.
+    pub const SPIKE: Flags = Flags(1 << 5);
+    /// The estimate is not trustworthy: no usable sample for a while, the
+    /// oil model refused the temperature, or the twin had to be reset.
+    pub const DEGRADED: Flags = Flags(1 << 6);
+
+    /// Names of the flags, in bit order.
+    pub const NAMES: [&'static str; 7] = [
+        "AT_STOP",
+        "OUT_OF_RANGE",
+        "NOT_UNIQUE",
+        "UNSTABLE",
+        "SENSOR_FAULT",
+        "SPIKE",
+        "DEGRADED",
+    ];
+
+    /// No flag set.
+    pub const fn empty() -> Self {
+        Flags(0)
+    }
+    /// All of `other`'s flags are set.
+    pub const fn contains(self, other: Flags) -> bool {
+        self.0 & other.0 == other.0
+    }
+    /// Sets `other`'s flags.
+    pub fn insert(&mut self, other: Flags) {
+        self.0 |= other.0;
+    }
+    /// No flag set.
+    pub const fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Flags {
+    /// Names as interned strings: two bytes each in the log stream, not the
+    /// name's bytes (what keeps a telemetry record cheap to pack).
+    fn format(&self, f: defmt::Formatter) {
+        if self.is_empty() {
+            defmt::write!(f, "-");
+            return;
+        }
+        let names = [
+            defmt::intern!("AT_STOP"),
+            defmt::intern!("OUT_OF_RANGE"),
+            defmt::intern!("NOT_UNIQUE"),
+            defmt::intern!("UNSTABLE"),
+            defmt::intern!("SENSOR_FAULT"),
+            defmt::intern!("SPIKE"),
+            defmt::intern!("DEGRADED"),
+        ];
+        let mut first = true;
+        for (i, name) in names.iter().enumerate() {
+            if self.0 & (1 << i) != 0 {
+                if first {
+                    defmt::write!(f, "{=istr}", *name);
+                } else {
+                    defmt::write!(f, "|{=istr}", *name);
+                }
+                first = false;
+            }
+        }
+    }
+}
+
+/// The estimator's output for one tick (SI units, `f32`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StateEstimate {
+    /// Tick counter.
+    pub tick: u32,
+    /// Filtered oil temperature [C].
+    pub temperature: f32,
+    /// Plunger displacement [m].
+    pub x: f32,
+    /// Plunger velocity [m/s].
+    pub v: f32,
+    /// Chamber (a) pressure [Pa].
+    pub p_a: f32,
+    /// Chamber (b) pressure [Pa].
+    pub p_b: f32,
+    /// Flow leaving chamber (a) through its capillary [m^3/s].
+    pub q_a: f32,
+    /// Flow leaving chamber (b) through its orifice [m^3/s].
+    pub q_b: f32,
+    /// Flow through the window [m^3/s].
+    pub q_throt: f32,
+    /// Total flow `Q0 = Q_a + Q_b + Q_throt` [m^3/s].
+    pub q_total: f32,
+    /// `Q0 - (Q_work + dQ_lost(t))` [m^3/s]; NaN without a `[machine]`.
+    pub compensation_error: f32,
+    /// Quasi-static equilibrium displacement at this temperature [m].
+    pub x_equilibrium: f32,
+    /// `dx/dt` of the equilibrium branch (Eq. 31) [m/K].
+    pub dx_dt: f32,
+    /// Conditions.
+    pub flags: Flags,
+}
+
+/// The telemetry record: the state estimate in engineering units. The
+/// equilibrium `x*` and `dx/dt` stay out of it (each float costs ~80
+/// instructions to pack); they are in the struct for whoever needs them.
+#[cfg(feature = "defmt")]
+impl defmt::Format for StateEstimate {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(
+            f,
+            "t={=f32} C x={=f32} um v={=f32} mm/s p_a={=f32} p_b={=f32} kPa Q_a={=f32} Q_b={=f32} Q_throt={=f32} Q0={=f32} err={=f32} l/min [{}]",
+            self.temperature,
+            self.x * 1e6,
+            self.v * 1e3,
+            self.p_a * 1e-3,
+            self.p_b * 1e-3,
+            self.q_a * 6e4,
+            self.q_b * 6e4,
+            self.q_throt * 6e4,
+            self.q_total * 6e4,
+            self.compensation_error * 6e4,
+            self.flags
+        )
+    }
+}
+
+/// The estimator.
+#[derive(Clone, Copy, Debug)]
+pub struct Estimator {
+    params: Params<f32>,
+    config: EstimatorConfig,
+    twin: Twin<f32, f32>,
+    /// Filtered temperature [C].
+    filtered: f32,
+    /// Last accepted sample [C] (the filter's input).
+    held: f32,
+    spikes: u16,
+    since_sample: u32,
+    tick: u32,
+    monotonic: bool,
+    /// Dynamic viscosity at the machine's reference temperature [Pa s].
+    machine_mu_ref: Option<f32>,
+    /// Temperature-only results, refreshed in rotation (see [`Job`]).
+    statics: Statics,
+    /// The job of the next tick that is not a telemetry tick.
+    next_job: Job,
+    last: Option<StateEstimate>,
+}
+
+/// Results that depend on the temperature only. Each tick refreshes one of
+/// them (none on a telemetry tick), so they are at most four ticks old,
+/// while the oil's temperature changes over seconds, and the cost of a
+/// tick stays bounded by the twin plus the largest single job.
+#[derive(Clone, Copy, Debug)]
+struct Statics {
+    /// Oil state and derivatives at `temperature`.
+    point: FluidPoint<f32>,
+    /// Capillary conductance `1 / R_l` [m^3/(s Pa)].
+    capillary_conductance: f32,
+    /// `C_d f sqrt(2 / rho)` of the orifice [m^3/(s sqrt(Pa))].
+    orifice_factor: f32,
+    /// `eta pi d sqrt(2 dp / rho)` of the window [m^2/s].
+    window_factor: f32,
+    x_equilibrium: f32,
+    dx_dt: f32,
+    /// The equilibrium in the twin's model units (for the linearisation).
+    y_equilibrium: [f32; 4],
+    stable: bool,
+    /// Machine losses at the last refreshed temperature [m^3/s].
+    losses: f32,
+}
+
+/// The temperature-only jobs, one per tick in turn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Job {
+    /// Oil properties (one Walther evaluation) for the twin and the flows:
+    /// the "fluid properties at the sensor rate", here at least
+    /// every 4 ms, five times the MAX31865's 50 Hz.
+    Fluid,
+    /// Closed-form equilibrium and `dx/dt` (Eqs. 5, 31).
+    Equilibrium,
+    /// Routh-Hurwitz stability of the linearisation at the equilibrium.
+    Stability,
+    /// The machine's losses (compensation error).
+    Losses,
+}
+
+impl Job {
+    const ALL: [Job; 4] = [Job::Fluid, Job::Equilibrium, Job::Stability, Job::Losses];
+
+    fn next(self) -> Job {
+        match self {
+            Job::Fluid => Job::Equilibrium,
+            Job::Equilibrium => Job::Stability,
+            Job::Stability => Job::Losses,
+            Job::Losses => Job::Fluid,
+        }
+    }
+}
+
+impl Estimator {
+    /// An estimator at rest in the equilibrium of `initial` [C], which must
+    /// be a temperature the oil model accepts. Eq. (32) is checked once here
+    /// over the validated range (201 samples).
+    pub fn new(
+        params: &Params<f32>,
+        config: EstimatorConfig,
+        twin: TwinConfig,
+        initial: f32,
+    ) -> Result<Self, ModelError> {
+        let (lo, hi) = config.valid;
+        let monotonic = asymptotic::monotonicity(params, lo, hi, 201)
+            .map(|m| m.monotonic)
+            .unwrap_or(false);
+        let twin = Twin::new(params, twin, initial)?;
+        let machine_mu_ref = match &params.machine {
+            Some(m) => Some(params.oil.state(m.leakage_temperature)?.dynamic_viscosity),
+            None => None,
+        };
+        let point = params.oil.point(initial)?;
+        let mut statics = Statics {
+            point,
+            capillary_conductance: 0.0,
+            orifice_factor: 0.0,
+            window_factor: 0.0,
+            x_equilibrium: f32::NAN,
+            dx_dt: f32::NAN,
+            y_equilibrium: [0.0; 4],
+            stable: true,
+            losses: f32::NAN,
+        };
+        let mut twin = twin;
+        for job in Job::ALL {
+            Self::run_job(job, params, &mut twin, machine_mu_ref, initial, &mut statics)?;
+        }
+        Ok(Estimator {
+            params: *params,
+            config,
+            twin,
+            filtered: initial,
+            held: initial,
+            spikes: 0,
+            since_sample: 0,
+            tick: 0,
+            monotonic,
+            machine_mu_ref,
+            statics,
+            next_job: Job::Fluid,
+            last: None,
+        })
+    }
+
+    /// The settings.
+    pub fn config(&self) -> &EstimatorConfig {
+        &self.config
+    }
+
+    /// The twin.
+    pub fn twin(&self) -> &Twin<f32, f32> {
+        &self.twin
+    }
+
+    /// One tick with this tick's sample (see the module docs).
+    pub fn tick(&mut self, sample: Result<Option<f32>, SensorFault>) -> StateEstimate {
+        let mut flags = Flags::empty();
+        if !self.monotonic {
+            flags.insert(Flags::NOT_UNIQUE);
+        }
+        self.tick = self.tick.wrapping_add(1);
+        self.since_sample = self.since_sample.saturating_add(1);
+        let (oil_lo, oil_hi) = self.config.oil;
+        match sample {
+            Ok(Some(t)) if t.is_finite() && t >= oil_lo && t <= oil_hi => {
+                if libm::fabsf(t - self.filtered) > self.config.spike_threshold && self.spikes < self.config.spike_limit
+                {
+                    self.spikes += 1;
+                    flags.insert(Flags::SPIKE);
+                } else {
+                    if self.spikes >= self.config.spike_limit && self.config.spike_limit > 0 {
+                        // Enough consecutive samples agree: a real step.
+                        self.filtered = t;
+                    }
+                    self.spikes = 0;
+                    self.held = t;
+                    self.since_sample = 0;
+                }
+            }
+            Ok(Some(_)) | Err(_) => flags.insert(Flags::SENSOR_FAULT),
+            Ok(None) => {}
+        }
+        if self.since_sample > self.config.stale_after {
+            flags.insert(Flags::DEGRADED);
+        }
+        self.filtered += self.config.filter_gain * (self.held - self.filtered);
+        let t = self.filtered;
+        let (lo, hi) = self.config.valid;
+        if !(t >= lo && t <= hi) {
+            flags.insert(Flags::OUT_OF_RANGE);
+        }
+        match self.update(t, &mut flags) {
+            Ok(e) => {
+                self.last = Some(e);
+                e
+            }
+            Err(_) => {
+                // The model cannot evaluate this temperature: keep the last
+                // estimate's physics, flagged.
+                flags.insert(Flags::DEGRADED);
+                let mut e = self.last.unwrap_or(StateEstimate {
+                    tick: 0,
+                    temperature: t,
+                    x: f32::NAN,
+                    v: f32::NAN,
+                    p_a: f32::NAN,
+                    p_b: f32::NAN,
+                    q_a: f32::NAN,
+                    q_b: f32::NAN,
+                    q_throt: f32::NAN,
+                    q_total: f32::NAN,
+                    compensation_error: f32::NAN,
+                    x_equilibrium: f32::NAN,
+                    dx_dt: f32::NAN,
+                    flags,
+                });
+                e.tick = self.tick;
+                e.temperature = t;
+                e.flags = flags;
+                e
+            }
+        }
+    }
+
+    /// Runs one temperature-only job at the filtered temperature `t` [C].
+    fn run_job(
+        job: Job,
+        p: &Params<f32>,
+        twin: &mut Twin<f32, f32>,
+        machine_mu_ref: Option<f32>,
+        t: f32,
+        statics: &mut Statics,
+    ) -> Result<(), ModelError> {
+        match job {
+            Job::Fluid => {
+                let point = p.oil.point(t)?;
+                twin.set_fluid(&point.state)?;
+                let rho = point.state.density;
+                let root = Real::sqrt(2.0 / rho);
+                statics.point = point;
+                statics.capillary_conductance = 1.0 / p.capillary.resistance(point.state.dynamic_viscosity);
+                statics.orifice_factor = p.orifice.discharge_coefficient * p.orifice.area() * root;
+                statics.window_factor = p.slot.discharge_coefficient
+                    * core::f32::consts::PI
+                    * p.slot.diameter
+                    * root
+                    * Real::sqrt(p.pressure_drop);
+            }
+            Job::Equilibrium => {
+                let point = &statics.point;
+                let eq = equilibrium_for(p, point.state, a_parameter(p, &point.state))?;
+                statics.dx_dt = asymptotic::sensitivity_at(p, point)?.dx_dt;
+                statics.x_equilibrium = eq.x;
+                statics.y_equilibrium = twin.model().equilibrium_state(&eq);
+            }
+            Job::Stability => {
+                let sys = Fsi {
+                    coefficients: twin.coefficients(),
+                    contact: Contact::Free,
+                };
+                statics.stable = hurwitz_stable(&sys.jacobian(&statics.y_equilibrium));
+            }
+            Job::Losses => {
+                statics.losses = match (&p.machine, machine_mu_ref) {
+                    (Some(m), Some(mu_ref)) => {
+                        compensation::losses_for(m, mu_ref, statics.point.state.dynamic_viscosity)?
+                    }
+                    _ => f32::NAN,
+                };
+            }
+        }
+        Ok(())
+    }
+
+    fn update(&mut self, t: f32, flags: &mut Flags) -> Result<StateEstimate, ModelError> {
+        if !self.telemetry_due() {
+            let job = self.next_job;
+            self.next_job = job.next();
+            // A temperature the oil model refuses leaves the previous
+            // properties in force; the estimate goes on, flagged.
+            if Self::run_job(
+                job,
+                &self.params,
+                &mut self.twin,
+                self.machine_mu_ref,
+                t,
+                &mut self.statics,
+            )
+            .is_err()
+            {
+                flags.insert(Flags::DEGRADED);
+            }
+        }
+        let p = &self.params;
+        if self.twin.tick().is_err() {
+            // A failed step (never seen with valid parameters): restart
+            // from the equilibrium rather than continue from garbage.
+            self.twin = Twin::new(p, self.twin.config(), self.statics.point.state.temperature)?;
+            flags.insert(Flags::DEGRADED);
+        }
+        if !self.statics.stable {
+            flags.insert(Flags::UNSTABLE);
+        }
+        let s = self.twin.state();
+        let [xi, ..] = self.twin.raw_state();
+        if xi <= 0.0 || xi >= 1.0 {
+            flags.insert(Flags::AT_STOP);
+        }
+        let st = &self.statics;
+        let q_a = (s.p_a - p.outlet_pressure) * st.capillary_conductance;
+        let drop_b = s.p_b - p.outlet_pressure;
+        let q_b = st.orifice_factor * libm::copysignf(Real::sqrt(libm::fabsf(drop_b)), drop_b);
+        let q_throt = st.window_factor * Real::max(s.x, 0.0);
+        let q_total = q_a + q_b + q_throt;
+        let compensation_error = match &p.machine {
+            Some(m) => q_total - (m.working_flow + st.losses),
+            None => f32::NAN,
+        };
+        Ok(StateEstimate {
+            tick: self.tick,
+            temperature: t,
+            x: s.x,
+            v: s.v,
+            p_a: s.p_a,
+            p_b: s.p_b,
+            q_a,
+            q_b,
+            q_throt,
+            q_total,
+            compensation_error,
+            x_equilibrium: st.x_equilibrium,
+            dx_dt: st.dx_dt,
+            flags: *flags,
+        })
+    }
+
+    /// `true` when this tick's estimate should be published.
+    pub fn telemetry_due(&self) -> bool {
+        self.config.telemetry_every > 0 && self.tick % self.config.telemetry_every == 0
+    }
+}

@@ -1,0 +1,116 @@
+//! `defmt` global logger for the QEMU images: each frame is encoded into a
+//! RAM buffer and written with one semihosting call when the frame ends.
+//!
+//! `defmt-semihosting` issues a semihosting call per encoder chunk (often a
+//! single byte), which costs the guest ~2,000 instructions per telemetry
+//! record; on a board, RTT's cost is a copy into a ring buffer. Buffering
+//! the frame gives the emulated firmware the same cost profile as the real
+//! one, so the measured per-tick budget means the same thing on both.
+//! Frames longer than the buffer are written in pieces (the stream stays
+//! valid). The semihosting write itself is done by QEMU, outside the guest.
+
+use core::cell::UnsafeCell;
+use core::sync::atomic::{AtomicBool, Ordering};
+use cortex_m_semihosting::hio::HostStream;
+
+/// Buffer for one frame (the longest telemetry frame is ~80 bytes).
+const BUFFER: usize = 256;
+
+#[defmt::global_logger]
+struct Logger;
+
+/// State touched only between `acquire` and `release`, inside a critical
+/// section, with `TAKEN` guarding against re-entry.
+struct Cell<T>(UnsafeCell<T>);
+
+// SAFETY: see the type's documentation.
+unsafe impl<T> Sync for Cell<T> {}
+
+struct Buffer {
+    bytes: [u8; BUFFER],
+    len: usize,
+    stdout: Option<HostStream>,
+}
+
+static TAKEN: AtomicBool = AtomicBool::new(false);
+static RESTORE: Cell<critical_section::RestoreState> = Cell(UnsafeCell::new(critical_section::RestoreState::invalid()));
+static ENCODER: Cell<defmt::Encoder> = Cell(UnsafeCell::new(defmt::Encoder::new()));
+static OUT: Cell<Buffer> = Cell(UnsafeCell::new(Buffer {
+    bytes: [0; BUFFER],
+    len: 0,
+    stdout: None,
+}));
+
+/// Writes the buffered bytes to the host (the handle is opened once).
+fn flush_buffer(out: &mut Buffer) {
+    if out.len == 0 {
+        return;
+    }
+    if out.stdout.is_none() {
+        out.stdout = cortex_m_semihosting::hio::hstdout().ok();
+    }
+    if let Some(h) = out.stdout.as_mut() {
+        let _ = h.write_all(&out.bytes[..out.len]);
+    }
+    out.len = 0;
+}
+
+/// Appends encoded bytes. The chunks are a few bytes long (a float is
+/// four): the common case, a chunk that fits, is one check and a tight copy
+/// with one length update; only a full buffer takes the per-byte path.
+fn push(bytes: &[u8]) {
+    // SAFETY: only called by the encoder inside acquire..release.
+    let out = unsafe { &mut *OUT.0.get() };
+    let start = out.len;
+    if let Some(dst) = out.bytes.get_mut(start..start + bytes.len()) {
+        for (d, s) in dst.iter_mut().zip(bytes) {
+            *d = *s;
+        }
+        out.len = start + bytes.len();
+        return;
+    }
+    for &b in bytes {
+        if out.len == BUFFER {
+            flush_buffer(out);
+        }
+        out.bytes[out.len] = b;
+        out.len += 1;
+    }
+}
+
+unsafe impl defmt::Logger for Logger {
+    fn acquire() {
+        // SAFETY: paired with the `release` below.
+        let restore = unsafe { critical_section::acquire() };
+        if TAKEN.swap(true, Ordering::Relaxed) {
+            panic!("defmt logger taken reentrantly");
+        }
+        // SAFETY: we hold the critical section and `TAKEN`.
+        unsafe {
+            *RESTORE.0.get() = restore;
+            (*ENCODER.0.get()).start_frame(push);
+        }
+    }
+
+    unsafe fn flush() {
+        // SAFETY: defmt calls this between acquire and release.
+        flush_buffer(unsafe { &mut *OUT.0.get() });
+    }
+
+    unsafe fn release() {
+        // SAFETY: between acquire and release; the restore state came from
+        // `acquire`.
+        unsafe {
+            (*ENCODER.0.get()).end_frame(push);
+            flush_buffer(&mut *OUT.0.get());
+            let restore = *RESTORE.0.get();
+            TAKEN.store(false, Ordering::Relaxed);
+            critical_section::release(restore);
+        }
+    }
+
+    unsafe fn write(bytes: &[u8]) {
+        // SAFETY: defmt calls this between acquire and release.
+        unsafe { (*ENCODER.0.get()).write(bytes, push) };
+    }
+}
