@@ -42,6 +42,10 @@ pub trait Real:
     const ZERO: Self;
     /// Multiplicative identity.
     const ONE: Self;
+    /// One half (a constant, so that fixed point never divides for it).
+    const HALF: Self;
+    /// Two.
+    const TWO: Self;
     /// A short name for reports (`"f32"`, `"I16F16"`...).
     const NAME: &'static str;
 
@@ -150,6 +154,8 @@ fn sqrt_f32(x: f32) -> f32 {
 impl Real for f32 {
     const ZERO: Self = 0.0;
     const ONE: Self = 1.0;
+    const HALF: Self = 0.5;
+    const TWO: Self = 2.0;
     const NAME: &'static str = "f32";
     #[inline]
     fn from_f64(v: f64) -> Self {
@@ -240,6 +246,8 @@ impl Float for f32 {
 impl Real for f64 {
     const ZERO: Self = 0.0;
     const ONE: Self = 1.0;
+    const HALF: Self = 0.5;
+    const TWO: Self = 2.0;
     const NAME: &'static str = "f64";
     #[inline]
     fn from_f64(v: f64) -> Self {
@@ -450,6 +458,14 @@ mod fixed_point {
             assert!(F::U32 <= 30, "fixed-point formats need at least two integer bits");
             Fix(FixedI32::<F>::from_bits(1i32 << F::U32))
         };
+        const HALF: Self = {
+            assert!(
+                F::U32 >= 1 && F::U32 <= 29,
+                "fixed-point formats need a fractional bit and three integer bits"
+            );
+            Fix(FixedI32::<F>::from_bits(1i32 << (F::U32 - 1)))
+        };
+        const TWO: Self = Fix(FixedI32::<F>::from_bits(2i32 << F::U32));
         const NAME: &'static str = "fixed-i32";
 
         #[inline]

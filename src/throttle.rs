@@ -94,7 +94,13 @@ impl<T: Float> Slot<T> {
 /// The value of [`regularised_root`] alone (no division for the slope).
 #[inline]
 pub fn regularised_root_value<T: Real>(u: T, u_tr: T) -> T {
-    u / (u * u + u_tr * u_tr).sqrt().sqrt()
+    let uu = u * u;
+    let r = uu + u_tr * u_tr;
+    if r == uu && uu > T::ZERO {
+        let s = u.abs().sqrt();
+        return if u < T::ZERO { -s } else { s };
+    }
+    u / r.sqrt().sqrt()
 }
 
 /// C1 square-root law `u / (u^2 + u_tr^2)^(1/4)` and its derivative.
@@ -102,16 +108,28 @@ pub fn regularised_root_value<T: Real>(u: T, u_tr: T) -> T {
 /// Equals `sign(u) sqrt(|u|)` to a relative `u_tr^2 / (4 u^2)` for
 /// `|u| >> u_tr`, has the finite slope `1 / sqrt(u_tr)` at zero, and is odd.
 /// Returns `(value, d value / du)`. Works in any [`Real`], including fixed
-/// point (where a `u_tr^2` below the resolution degrades to the plain root,
-/// with slope saturating rather than panicking).
+/// point.
+///
+/// Where `u_tr^2` is below the resolution of `u^2` (every operating point
+/// in `f32`; all of them in Q16.16, where `u_tr^2` underflows), the law is
+/// the plain root in the scalar's own arithmetic, and it is evaluated as
+/// such: one square root and one division for the slope, instead of two
+/// square roots and two divisions. The results are those of the general
+/// formula rounded the same way.
 #[inline]
 pub fn regularised_root<T: Real>(u: T, u_tr: T) -> (T, T) {
-    let r = u * u + u_tr * u_tr;
+    let uu = u * u;
+    let tt = u_tr * u_tr;
+    let r = uu + tt;
+    if r == uu && uu > T::ZERO {
+        let s = u.abs().sqrt();
+        let value = if u < T::ZERO { -s } else { s };
+        return (value, T::HALF / s);
+    }
     let r14 = r.sqrt().sqrt(); // r^(1/4)
     let value = u / r14;
     // d/du = (u^2 / 2 + u_tr^2) / r^(5/4)
-    let half = T::ONE / (T::ONE + T::ONE);
-    let slope = (half * u * u + u_tr * u_tr) / (r * r14);
+    let slope = (T::HALF * uu + tt) / (r * r14);
     (value, slope)
 }
 
@@ -129,6 +147,25 @@ mod tests {
         assert!((s0 - 100.0).abs() < 1e-9);
         let (vn, _) = regularised_root(-0.25f64, 1e-4);
         assert!((vn + 0.5).abs() < 1e-7);
+    }
+
+    #[test]
+    fn plain_root_branch_agrees_with_the_general_law() {
+        // f32 takes the plain-root branch at operating points; the f64
+        // general formula is the reference.
+        for i in 1..2000 {
+            let u = i as f32 * 5e-4 - 0.4;
+            let (v32, s32) = regularised_root(u, 1e-5f32);
+            let (v64, s64) = regularised_root(u as f64, 1e-5f64);
+            assert!(
+                ((v32 as f64) - v64).abs() <= 2.0 * f32::EPSILON as f64 * v64.abs(),
+                "value at {u}"
+            );
+            assert!(
+                ((s32 as f64) - s64).abs() <= 4.0 * f32::EPSILON as f64 * s64.abs(),
+                "slope at {u}"
+            );
+        }
     }
 
     #[test]

@@ -210,6 +210,8 @@ pub struct Stepper<T> {
     m: [T; MAX_STAGES],
     /// Stage `i` evaluates `f` at the same point as stage `i - 1`.
     reuse_f: [bool; MAX_STAGES],
+    /// `h / 6` for RK4.
+    rk4_sixth_h: T,
 }
 
 /// Why a step was not taken.
@@ -249,28 +251,13 @@ impl<T: Real> Stepper<T> {
             c_over_h,
             m,
             reuse_f,
+            rk4_sixth_h: T::from_f64(h / 6.0),
         }
     }
 
     /// The scheme.
     pub fn scheme(&self) -> Scheme {
         self.scheme
-    }
-
-    /// The same scheme for a step of `fraction` times this one's, computed
-    /// in `T` (a division and a dozen multiplications; no `f64`).
-    /// `fraction` must be positive.
-    pub fn scaled(&self, fraction: T) -> Self {
-        let inv = T::ONE / fraction;
-        let mut s = *self;
-        s.h = self.h * fraction;
-        s.inv_gamma_h = self.inv_gamma_h * inv;
-        for row in s.c_over_h.iter_mut() {
-            for c in row.iter_mut() {
-                *c *= inv;
-            }
-        }
-        s
     }
 
     /// Advances `y` by one step of `sys`.
@@ -327,8 +314,8 @@ impl<T: Real> Stepper<T> {
     }
 
     fn rk4<S: OdeSystem<T, N>, const N: usize>(&self, sys: &S, y: &[T; N]) -> [T; N] {
-        let half = self.h / (T::ONE + T::ONE);
-        let sixth = self.h / T::from_f64(6.0);
+        let half = self.h * T::HALF;
+        let sixth = self.rk4_sixth_h;
         let shifted = |base: &[T; N], k: &[T; N], s: T| {
             let mut out = *base;
             for i in 0..N {
@@ -341,9 +328,8 @@ impl<T: Real> Stepper<T> {
         let k3 = sys.rhs(&shifted(y, &k2, half));
         let k4 = sys.rhs(&shifted(y, &k3, self.h));
         let mut next = *y;
-        let two = T::ONE + T::ONE;
         for i in 0..N {
-            next[i] += sixth * (k1[i] + two * k2[i] + two * k3[i] + k4[i]);
+            next[i] += sixth * (k1[i] + T::TWO * k2[i] + T::TWO * k3[i] + k4[i]);
         }
         next
     }

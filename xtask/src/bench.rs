@@ -1,12 +1,311 @@
-//! Placeholder, replaced below.
+//! `cargo xtask bench`: cost, footprint and stack of the firmware on the
+//! emulated microcontrollers, and the budget check CI runs.
+//!
+//! * Instructions: the `bench` image runs under `qemu -icount shift=0`
+//!   (one nanosecond of emulated time per instruction) and reports SysTick
+//!   counts; its calibration loop of known length converts them (0.168
+//!   counts per instruction on the netduinoplus2 STM32F405, 0.120 on the
+//!   netduino2 STM32F205). Deterministic: the same image gives the same
+//!   numbers on every run and machine.
+//! * Flash and static RAM: the ELF sections of the images (`.vector_table`,
+//!   `.text`, `.rodata`, `.data` in flash; `.data`, `.bss`, `.uninit` in RAM).
+//! * Stack: the QEMU twin measures its own peak by stack painting.
+
+use crate::firmware::{self, Image};
+use crate::qemu;
+use crate::toolchain::Toolchain;
+use object::{Object, ObjectSection};
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-pub fn cmd(_root: &Path, _args: &[String]) -> Result<i32, String> {
-    Ok(0)
+use std::time::Duration;
+
+/// The budgets of the firmware issue.
+pub const BUDGET_INSTRUCTIONS: f64 = 3000.0;
+/// Flash budget [bytes].
+pub const BUDGET_FLASH: u64 = 64 * 1024;
+/// Static RAM budget [bytes].
+pub const BUDGET_RAM: u64 = 8 * 1024;
+/// Peak stack budget [bytes].
+pub const BUDGET_STACK: u64 = 4 * 1024;
+
+/// One `[measure] kind key=value ...` line.
+#[derive(Debug, Clone)]
+struct Measure {
+    kind: String,
+    fields: BTreeMap<String, String>,
 }
-pub fn check(
-    _tc: &crate::toolchain::Toolchain,
-    _root: &Path,
-    _elfs: &[(crate::firmware::Image, PathBuf)],
-) -> Result<(), String> {
-    Ok(())
+
+fn parse(lines: &[String]) -> Vec<Measure> {
+    lines
+        .iter()
+        .filter_map(|l| l.split("[measure] ").nth(1))
+        .map(|rest| {
+            let mut words = rest.split_whitespace();
+            let kind = words.next().unwrap_or_default().to_string();
+            let fields = words
+                .filter_map(|w| w.split_once('='))
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect();
+            Measure { kind, fields }
+        })
+        .collect()
+}
+
+impl Measure {
+    fn num(&self, key: &str) -> Result<f64, String> {
+        self.fields
+            .get(key)
+            .and_then(|v| v.parse().ok())
+            .ok_or_else(|| format!("{} line without {key}", self.kind))
+    }
+    fn str(&self, key: &str) -> &str {
+        self.fields.get(key).map(String::as_str).unwrap_or("?")
+    }
+}
+
+/// Instructions per SysTick count, from the calibration line.
+fn calibration(ms: &[Measure]) -> Result<f64, String> {
+    let c = ms
+        .iter()
+        .find(|m| m.kind == "calibration")
+        .ok_or("no calibration line")?;
+    Ok(c.num("instructions")? / c.num("total")?)
+}
+
+/// Results of one bench image.
+pub struct Costs {
+    /// `(scheme, substeps, scalar) -> (mean, worst)` instructions per tick.
+    pub twin: Vec<(String, u32, String, f64, f64)>,
+    /// `name -> instructions`.
+    pub pieces: Vec<(String, f64)>,
+    /// `(telemetry, mean, worst)` instructions per estimator tick.
+    pub estimator: Vec<(bool, f64, f64)>,
+    /// Instructions per SysTick count.
+    pub per_count: f64,
+}
+
+fn costs(lines: &[String]) -> Result<Costs, String> {
+    let ms = parse(lines);
+    let k = calibration(&ms)?;
+    let mut out = Costs {
+        twin: vec![],
+        pieces: vec![],
+        estimator: vec![],
+        per_count: k,
+    };
+    for m in &ms {
+        match m.kind.as_str() {
+            "twin" => {
+                let ticks = m.num("ticks")?;
+                out.twin.push((
+                    m.str("scheme").to_string(),
+                    m.num("substeps")? as u32,
+                    m.str("scalar").to_string(),
+                    m.num("total")? * k / ticks,
+                    m.num("worst")? * k,
+                ));
+            }
+            "piece" => out.pieces.push((m.str("name").to_string(), m.num("total")? * k)),
+            "estimator" => {
+                let ticks = m.num("ticks")?;
+                out.estimator.push((
+                    m.str("telemetry") == "true",
+                    m.num("total")? * k / ticks,
+                    m.num("worst")? * k,
+                ));
+            }
+            _ => {}
+        }
+    }
+    Ok(out)
+}
+
+/// Flash and static RAM of an ELF image [bytes].
+pub fn footprint(elf: &Path) -> Result<(u64, u64), String> {
+    let data = std::fs::read(elf).map_err(|e| format!("{}: {e}", elf.display()))?;
+    let file = object::File::parse(&*data).map_err(|e| format!("{}: {e}", elf.display()))?;
+    let (mut flash, mut ram) = (0, 0);
+    for s in file.sections() {
+        let name = s.name().unwrap_or_default();
+        let size = s.size();
+        match name {
+            ".vector_table" | ".text" | ".rodata" => flash += size,
+            ".data" => {
+                flash += size; // initial values, copied at reset
+                ram += size;
+            }
+            ".bss" | ".uninit" => ram += size,
+            _ => {}
+        }
+    }
+    Ok((flash, ram))
+}
+
+/// Peak stack [bytes] reported by the QEMU twin.
+fn stack_peak(lines: &[String]) -> Option<u64> {
+    lines.iter().find_map(|l| {
+        let rest = l.split("[measure] peak stack ").nth(1)?;
+        rest.split_whitespace().next()?.parse().ok()
+    })
+}
+
+/// Everything measured, as a Markdown report.
+pub struct Report {
+    /// The Markdown text.
+    pub text: String,
+    /// Budget violations (empty: all met).
+    pub over: Vec<String>,
+}
+
+fn run_image(elf: &Path, machine: qemu::Machine) -> Result<Vec<String>, String> {
+    let run = qemu::run(elf, machine, true, Duration::from_secs(600), qemu::Show::Quiet)?;
+    if run.code != 0 {
+        return Err(format!("{} exited with {}", elf.display(), run.code));
+    }
+    Ok(run.lines)
+}
+
+/// Measures the built images and writes the report.
+pub fn measure(elfs: &[(Image, PathBuf)]) -> Result<Report, String> {
+    let find = |img: Image| {
+        elfs.iter()
+            .find(|(i, _)| *i == img)
+            .map(|(_, p)| p.clone())
+            .ok_or("missing image")
+    };
+    let m4 = costs(&run_image(&find(Image::BENCH_M4)?, qemu::NETDUINO)?)?;
+    let m3 = costs(&run_image(&find(Image::BENCH_M3)?, qemu::NETDUINO2)?)?;
+    let twin_lines = run_image(&find(Image::TWIN)?, qemu::NETDUINO)?;
+    let stack = stack_peak(&twin_lines).ok_or("the twin reported no stack peak")?;
+
+    let mut t = String::new();
+    let mut over = Vec::new();
+    let _ = writeln!(t, "# Firmware cost, footprint and stack\n");
+    let _ = writeln!(
+        t,
+        "Measured by `cargo xtask bench` (deterministic: QEMU 7.2 `-icount shift=0`, SysTick"
+    );
+    let _ = writeln!(
+        t,
+        "calibrated against a loop of known length: {:.3} instructions per count on netduinoplus2,",
+        m4.per_count
+    );
+    let _ = writeln!(t, "{:.3} on netduino2).\n", m3.per_count);
+
+    let _ = writeln!(t, "## Budget (firmware issue)\n");
+    let _ = writeln!(t, "| what | measured | goal |\n| --- | --- | --- |");
+    for (telemetry, mean, worst) in &m4.estimator {
+        let what = if *telemetry {
+            "estimator tick with telemetry packing"
+        } else {
+            "estimator tick, no telemetry"
+        };
+        let _ = writeln!(
+            t,
+            "| {what}, Cortex-M4F f32 | mean {mean:.0}, worst {worst:.0} instructions | <= {BUDGET_INSTRUCTIONS:.0} |"
+        );
+        if *worst > BUDGET_INSTRUCTIONS {
+            over.push(format!(
+                "{what}: worst {worst:.0} instructions > {BUDGET_INSTRUCTIONS:.0}"
+            ));
+        }
+    }
+    for (img, label) in [(Image::BOARD, "board image"), (Image::TWIN, "QEMU twin image")] {
+        let (flash, ram) = footprint(&find(img)?)?;
+        let _ = writeln!(t, "| flash, {label} | {:.1} KiB | <= 64 KiB |", flash as f64 / 1024.0);
+        let _ = writeln!(t, "| static RAM, {label} | {ram} bytes | <= 8 KiB |");
+        if flash > BUDGET_FLASH {
+            over.push(format!("flash of the {label}: {flash} bytes"));
+        }
+        if ram > BUDGET_RAM {
+            over.push(format!("static RAM of the {label}: {ram} bytes"));
+        }
+    }
+    let _ = writeln!(
+        t,
+        "| peak stack, QEMU twin run (stack painting) | {stack} bytes | <= 4 KiB |"
+    );
+    if stack > BUDGET_STACK {
+        over.push(format!("peak stack {stack} bytes"));
+    }
+
+    let _ = writeln!(t, "\n## Estimator pieces (Cortex-M4F, f32, one call each)\n");
+    let _ = writeln!(t, "| piece | instructions |\n| --- | --- |");
+    for (name, n) in &m4.pieces {
+        let _ = writeln!(t, "| {name} | {n:.0} |");
+    }
+
+    let _ = writeln!(
+        t,
+        "\n## Twin tick by scheme (200 ticks of the 30 -> 40 C step from the closed stop)\n"
+    );
+    let _ = writeln!(
+        t,
+        "| scheme | steps per tick | Cortex-M4F f32 mean / worst | Cortex-M4F Q16.16 mean / worst | Cortex-M3 Q16.16 mean / worst |"
+    );
+    let _ = writeln!(t, "| --- | --- | --- | --- | --- |");
+    let get = |c: &Costs, s: &str, n: u32, scalar: &str| {
+        c.twin
+            .iter()
+            .find(|r| r.0 == s && r.1 == n && r.2 == scalar)
+            .map(|r| format!("{:.0} / {:.0}", r.3, r.4))
+            .unwrap_or_else(|| "-".into())
+    };
+    let mut configs: Vec<(String, u32)> = m4.twin.iter().map(|r| (r.0.clone(), r.1)).collect();
+    configs.dedup();
+    for (s, n) in &configs {
+        let _ = writeln!(
+            t,
+            "| {s} | {n} | {} | {} | {} |",
+            get(&m4, s, *n, "f32"),
+            get(&m4, s, *n, "q16.16"),
+            get(&m3, s, *n, "q16.16")
+        );
+        if (s.as_str(), *n) == ("ros3", 2) {
+            if let Some(r) = m4.twin.iter().find(|r| r.0 == *s && r.1 == *n && r.2 == "f32") {
+                if r.4 > BUDGET_INSTRUCTIONS {
+                    over.push(format!("shipped twin tick: worst {:.0} instructions", r.4));
+                }
+            }
+        }
+    }
+    if let Some(r) = m3.twin.iter().find(|r| r.2 == "f32-soft") {
+        let _ = writeln!(
+            t,
+            "\nFor comparison, {} x{} in soft-float f32 on the Cortex-M3: mean {:.0}, worst {:.0} instructions per tick.",
+            r.0, r.1, r.3, r.4
+        );
+    }
+    Ok(Report { text: t, over })
+}
+
+/// `cargo xtask bench [--write]`.
+pub fn cmd(root: &Path, args: &[String]) -> Result<i32, String> {
+    let tc = crate::toolchain::get(root, &firmware::TARGETS)?;
+    eprintln!("xtask: toolchain: {}", tc.description);
+    qemu::ensure()?;
+    let elfs = firmware::build_all_with(&tc, root)?;
+    let report = measure(&elfs)?;
+    print!("{}", report.text);
+    if args.iter().any(|a| a == "--write") {
+        let path = root.join("docs/bench.md");
+        std::fs::write(&path, &report.text).map_err(|e| e.to_string())?;
+        eprintln!("xtask: wrote {}", path.display());
+    }
+    for o in &report.over {
+        eprintln!("xtask: over budget: {o}");
+    }
+    Ok(if report.over.is_empty() { 0 } else { 1 })
+}
+
+/// The budget check of `cargo xtask test`.
+pub fn check(_tc: &Toolchain, _root: &Path, elfs: &[(Image, PathBuf)]) -> Result<(), String> {
+    let report = measure(elfs)?;
+    if report.over.is_empty() {
+        eprintln!("xtask: every budget met");
+        Ok(())
+    } else {
+        Err(format!("over budget: {}", report.over.join("; ")))
+    }
 }

@@ -34,6 +34,7 @@ fn usage() -> ExitCode {
          \n  test [--bless]        every check CI runs (host tests, clippy, cross builds, QEMU)\
          \n  bench [--write]       instructions per tick, flash, RAM and stack on the emulated MCUs\
          \n  build                 build every firmware image\
+         \n  target-tests          the core's tests on the emulated Cortex-M4F (defmt-test)\
          \n  toolchain             find or provision the thumbv7em/thumbv7m toolchain\
          \n  qemu-runner ELF       run an ELF on QEMU (netduinoplus2, or netduino2 for thumbv7m)"
     );
@@ -52,6 +53,9 @@ fn main() -> ExitCode {
             0
         }),
         Some("qemu-runner") => cmd_qemu_runner(&args[1..]),
+        Some("target-tests") => toolchain::get(&root(), &[firmware::M4])
+            .and_then(|tc| qemu::ensure().and_then(|_| firmware::on_target_tests(&tc, &root())))
+            .map(|_| 0),
         _ => return usage(),
     };
     match result {
