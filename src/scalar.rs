@@ -332,7 +332,16 @@ impl Float for f64 {
     }
 }
 
-pub use fixed_point::{Fix, Q12_20, Q16_16};
+pub use fixed_point::{Fix, Q8_24, Q12_20, Q16_16};
+
+/// The fixed-point format the project ships: Q12.20 (range +-2048,
+/// resolution 9.5e-7). With the FSI model's row-scaled stage equations
+/// every intermediate stays within +-2048 on the paper preset and on 50
+/// random designs, and the resolution keeps slow designs (time constants
+/// of seconds) moving to within ~1e-6 of the stroke; Q16.16 stalls up to
+/// 14 % of a step short on those, Q8.24 overflows on stiff designs
+/// (`docs/dynamics.md`, `cargo run --release -p host-tests --example accuracy_survey`).
+pub type Fixed = Q12_20;
 
 mod fixed_point {
     use super::*;
@@ -379,6 +388,8 @@ mod fixed_point {
     pub type Q16_16 = Fix<fixed::types::extra::U16>;
     /// 12 integer bits, 20 fractional bits: range +-2048, resolution 9.5e-7.
     pub type Q12_20 = Fix<fixed::types::extra::U20>;
+    /// 8 integer bits, 24 fractional bits: range +-128, resolution 6.0e-8.
+    pub type Q8_24 = Fix<fixed::types::extra::U24>;
 
     impl<F: LeEqU32> Debug for Fix<F> {
         fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {

@@ -8,7 +8,7 @@ use compensator::dynamics::linear::linearise;
 use compensator::dynamics::reduced::ReducedTwin;
 use compensator::dynamics::{DynamicState, Scheme, Twin, TwinConfig};
 use compensator::equilibrium::equilibrium;
-use compensator::scalar::Q16_16;
+use compensator::scalar::Fixed;
 use compensator::{Float, Params, RawParams, Real};
 use compensator_reference::dynamics::{self as reference, Method, Profile};
 use std::path::Path;
@@ -20,8 +20,13 @@ pub enum Precision {
     F32,
     /// The twin in `f64`.
     F64,
-    /// The twin in Q16.16 fixed point (fluid properties in `f32`).
+    /// The twin in the shipped fixed-point format, Q12.20 (fluid
+    /// properties in `f32`).
     Fixed,
+    /// The twin in Q16.16 (coarser resolution; for comparison).
+    FixedQ16,
+    /// The twin in Q8.24 (finer resolution, too little range; for comparison).
+    FixedQ24,
     /// The reduced (quasi-steady pressure) model in `f64`.
     Reduced,
     /// The adaptive stiff reference solver (Radau5, rtol 1e-12).
@@ -97,7 +102,9 @@ pub fn simulate(
     match precision {
         Precision::F64 => run_twin::<f64, f64>(&p64()?, config, prof, n),
         Precision::F32 => run_twin::<f32, f32>(&p32()?, config, prof, n),
-        Precision::Fixed => run_twin::<f32, Q16_16>(&p32()?, config, prof, n),
+        Precision::Fixed => run_twin::<f32, Fixed>(&p32()?, config, prof, n),
+        Precision::FixedQ16 => run_twin::<f32, compensator::scalar::Q16_16>(&p32()?, config, prof, n),
+        Precision::FixedQ24 => run_twin::<f32, compensator::scalar::Q8_24>(&p32()?, config, prof, n),
         Precision::Reduced => {
             let p = p64()?;
             let mut twin = ReducedTwin::<f64, f64>::new(&p, config.scheme, config.tick, config.substeps, prof.start())

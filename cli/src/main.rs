@@ -32,7 +32,12 @@ enum StaticPrecision {
 enum DynPrecision {
     F32,
     F64,
+    /// Q12.20, the shipped fixed-point format.
     Fixed,
+    /// Q16.16 (for comparison).
+    FixedQ16,
+    /// Q8.24 (for comparison).
+    FixedQ24,
     Reduced,
     Reference,
 }
@@ -197,6 +202,8 @@ fn run(cli: Cli) -> Result<String, CliError> {
                 DynPrecision::F32 => Precision::F32,
                 DynPrecision::F64 => Precision::F64,
                 DynPrecision::Fixed => Precision::Fixed,
+                DynPrecision::FixedQ16 => Precision::FixedQ16,
+                DynPrecision::FixedQ24 => Precision::FixedQ24,
                 DynPrecision::Reduced => Precision::Reduced,
                 DynPrecision::Reference => Precision::Reference,
             };

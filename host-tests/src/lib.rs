@@ -5,6 +5,7 @@
 //! from MODEL.md directly, so that an error in the core cannot hide in the
 //! reference.
 
+pub mod accuracy;
 pub mod random;
 pub use compensator_reference::statics as reference;
 

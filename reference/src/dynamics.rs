@@ -194,12 +194,17 @@ impl Solout<f64, [f64; 4]> for Phase<'_> {
         I: Interpolation<f64, [f64; 4]> + ?Sized,
     {
         let (gc, dir) = self.g(y_curr);
-        let Some(gp) = self.g_prev.replace(gc) else {
-            return ControlFlag::Continue; // first call, at the phase's start
-        };
+        // Seeded from the phase's initial state: a crossing within the
+        // solver's first step is caught whether or not the solver reports
+        // the start point first.
+        let gp = self.g_prev.replace(gc).unwrap_or(gc);
         let mut t_stop = t_curr;
         let mut terminate = false;
-        if dir * gp < 0.0 && dir * gc >= 0.0 {
+        // An event is a step that ends strictly beyond the surface from a
+        // point not beyond it: a phase that starts on the surface (free
+        // motion from a stop, a release at zero force) still sees the
+        // crossing that follows.
+        if dir * gp <= 0.0 && dir * gc > 0.0 {
             // Illinois regula falsi on the dense output, to adjacent doubles.
             let (mut a, mut fa, mut b, mut fb) = (t_prev, gp, t_curr, gc);
             let mut side = 0;
@@ -217,7 +222,7 @@ impl Solout<f64, [f64; 4]> for Phase<'_> {
                 }
                 let Ok(yc) = interp.interpolate(c) else { break };
                 let fc = self.g(&yc).0;
-                if dir * fc >= 0.0 {
+                if dir * fc > 0.0 {
                     (b, fb) = (c, fc);
                     if side == -1 {
                         fa *= 0.5;
@@ -350,6 +355,7 @@ pub fn simulate(
             phase_end,
             end_state: None,
         };
+        phase.g_prev = Some(phase.g(&y).0);
         let h_max = dt.min(phase_end - t);
         let steps = match method {
             Method::Radau5 => solve(

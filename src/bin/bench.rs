@@ -11,15 +11,15 @@
 //! `cargo xtask bench` converts them with the calibration line.
 //!
 //! * Cortex-M4F (`thumbv7em-none-eabihf`, netduinoplus2): the twin's tick in
-//!   `f32` and Q16.16 for every scheme and substep count, the estimator's
+//!   `f32` and Q12.20 for every scheme and substep count, the estimator's
 //!   pieces, and the whole estimator tick (mean and worst, with telemetry).
 //! * Cortex-M3 (`thumbv7m-none-eabi`, netduino2): the twin's tick in
-//!   Q16.16 (and in soft-float `f32`, for comparison).
+//!   Q12.20 (and in soft-float `f32`, for comparison).
 #![no_std]
 #![no_main]
 
 use compensator::dynamics::{Scheme, Twin, TwinConfig};
-use compensator::scalar::Q16_16;
+use compensator::scalar::Fixed;
 use compensator::{Params, Real};
 use cortex_m::peripheral::{SYST, syst::SystClkSource};
 use cortex_m_rt::entry;
@@ -213,7 +213,7 @@ fn main() -> ! {
     for (scheme, substeps) in configs {
         #[cfg(target_abi = "eabihf")]
         twin_cost::<f32>(&params, scheme, substeps, "f32");
-        twin_cost::<Q16_16>(&params, scheme, substeps, "q16.16");
+        twin_cost::<Fixed>(&params, scheme, substeps, "q12.20");
         #[cfg(not(target_abi = "eabihf"))]
         if scheme == Scheme::Ros3 && substeps == 2 {
             twin_cost::<f32>(&params, scheme, substeps, "f32-soft");

@@ -125,10 +125,14 @@ pub struct Coefficients<T> {
     pub xi0: T,
     /// `omega_a0 = T Q* beta / (dp V_a0)`.
     pub omega_a0: T,
+    /// `1 / omega_a0`.
+    pub inv_omega_a0: T,
     /// `eps_a = A_p L / V_a0`.
     pub eps_a: T,
     /// `omega_b0 = T Q* beta / (dp V_b0)`.
     pub omega_b0: T,
+    /// `1 / omega_b0`.
+    pub inv_omega_b0: T,
     /// `eps_b = A_p L / V_b0`.
     pub eps_b: T,
     /// `sigma = A_p V / Q*`.
@@ -233,8 +237,10 @@ impl<F: Float> Model<F> {
             )?,
             xi0: c(pl.preload.to_f64() / length, "preload")?,
             omega_a0: c(omega(p.volume_a.to_f64()), "omega_a")?,
+            inv_omega_a0: c(1.0 / omega(p.volume_a.to_f64()), "omega_a")?,
             eps_a: c(swept / p.volume_a.to_f64(), "eps_a")?,
             omega_b0: c(omega(p.volume_b.to_f64()), "omega_b")?,
+            inv_omega_b0: c(1.0 / omega(p.volume_b.to_f64()), "omega_b")?,
             eps_b: c(swept / p.volume_b.to_f64(), "eps_b")?,
             sigma: c(pl.area().to_f64() * velocity / self.q_star.to_f64(), "sigma")?,
             u_tr: c(TRANSITION_FRACTION, "u_tr")?,
@@ -335,7 +341,22 @@ impl<T: Real> Fsi<'_, T> {
         }
     }
 
-    /// `f(y)` from the net chamber inflows and `omega_a`, `omega_b`.
+    /// Net chamber inflows `F_a = q_t r(1 - pi_a) - g_l pi_a + sigma w`
+    /// and `F_b = g_l (1 - pi_b) - q_t r(pi_b) - sigma w` (values only).
+    #[inline]
+    fn inflows(&self, y: &[T; 4]) -> (T, T) {
+        let c = self.coefficients;
+        let ra = regularised_root_value(T::ONE - y[2], c.u_tr);
+        let rb = regularised_root_value(y[3], c.u_tr);
+        let sw = c.sigma * y[1];
+        (
+            c.q_t * ra - c.g_l * y[2] + sw,
+            c.g_l * (T::ONE - y[3]) - c.q_t * rb - sw,
+        )
+    }
+
+    /// `f(y)` (or a row-scaled `D f`) from the net chamber inflows and the
+    /// factors of the pressure rows.
     #[inline]
     fn rhs_from(&self, y: &[T; 4], oa: T, ob: T, fa: T, fb: T) -> [T; 4] {
         let c = self.coefficients;
@@ -348,24 +369,31 @@ impl<T: Real> Fsi<'_, T> {
     }
 }
 
-/// `shift I - J` of the FSI model, factorised by its structure: each
-/// chamber's pressure couples only to itself and to the plunger, so the
-/// pressures are eliminated analytically and a 2x2 system in `(xi, w)`
-/// remains. Three divisions to factorise, ~14 multiply-adds to solve (a
-/// pivoted 4x4 LU takes four divisions and ~50).
+/// `D (shift I - J)` of the FSI model, factorised by its structure, with
+/// the pressure rows scaled by `D = diag(1, 1, 1/omega_a, 1/omega_b)`.
 ///
-/// With `m = 1` in free motion and `0` while held, `s = shift`,
-/// `e2 = 1 / (s - J22)`, `e3 = 1 / (s - J33)` and `phi' = phi / a_x`:
+/// The scaling keeps every number bounded: `omega` (a chamber's pressure
+/// rate, up to 1e4 in the model's units for small, stiff chambers) only
+/// appears as `shift / omega` and as ratios of chamber compliances, so
+/// fixed point keeps both range and resolution.
+///
+/// Each chamber's pressure couples only to itself and to the plunger, so
+/// the pressures are eliminated analytically and a 2x2 system in
+/// `(xi, w)` remains: four divisions to factorise, ~14 multiply-adds to
+/// solve (a pivoted 4x4 LU takes four divisions and ~50). With `m = 1` in
+/// free motion and `0` while held, `s = shift`, `phi' = phi / a_x`, and the
+/// scaled rows `d2 = s / omega_a + q_t r'_a + g_l`, `J20 = eps_a F_a / (1 - eps_a xi)`,
+/// `J21 = sigma` (and their chamber (b) twins):
 ///
 /// ```text
-/// u2 = (r2 + J20 u0 + J21 u1) e2,   u3 = (r3 + J30 u0 + J31 u1) e3
-/// [ s     -a_x m ] [u0]   [ r0                          ]
-/// [ A10    A11   ] [u1] = [ r1 - phi' m (r2 e2 - r3 e3) ]
-/// A10 = m / a_x + phi' m (J20 e2 - J30 e3),  A11 = s + 2 zeta m + phi' m (J21 e2 - J31 e3)
+/// u2 = (r2 + J20 u0 + J21 u1) / d2,   u3 = (r3 + J30 u0 + J31 u1) / d3
+/// [ s     -a_x m ] [u0]   [ r0                            ]
+/// [ A10    A11   ] [u1] = [ r1 - phi' m (r2 / d2 - r3 / d3) ] = [r0, b1]
+/// A10 = m / a_x + phi' m (J20 / d2 - J30 / d3),  A11 = s + 2 zeta m + phi' m (J21 / d2 - J31 / d3)
+/// u1 = (b1 - A10 r0 / s) / (A11 + a_x m A10 / s),  u0 = (r0 + a_x m u1) / s
 /// ```
 #[derive(Clone, Copy, Debug)]
 pub struct FsiFactor<T> {
-    s: T,
     a_x_m: T,
     phi_m: T,
     j20: T,
@@ -375,8 +403,16 @@ pub struct FsiFactor<T> {
     e2: T,
     e3: T,
     a10: T,
-    a11: T,
-    inv_det: T,
+    /// `1 / s`.
+    inv_s: T,
+    /// `1 / (A11 + a_x m A10 / s)`.
+    inv_k: T,
+    /// `1 / omega_a`, `1 / omega_b` at the step's start.
+    inv_oa: T,
+    inv_ob: T,
+    /// `1 - eps_a xi`, `1 + eps_b xi` at the step's start.
+    da: T,
+    db: T,
 }
 
 impl<T: Real> ShiftedSolve<T, 4> for FsiFactor<T> {
@@ -384,11 +420,20 @@ impl<T: Real> ShiftedSolve<T, 4> for FsiFactor<T> {
     fn solve(&self, r: &[T; 4]) -> [T; 4] {
         let (r2e, r3e) = (r[2] * self.e2, r[3] * self.e3);
         let b1 = r[1] - self.phi_m * (r2e - r3e);
-        let u0 = (r[0] * self.a11 + self.a_x_m * b1) * self.inv_det;
-        let u1 = (self.s * b1 - self.a10 * r[0]) * self.inv_det;
+        // Row 0 gives u0 = (r0 + a_x m u1) / s; row 1 then gives u1. No
+        // product of two large entries is formed (s A11 would overflow
+        // Q12.20 on designs with slow mechanics, where s is large).
+        let r0s = r[0] * self.inv_s;
+        let u1 = (b1 - self.a10 * r0s) * self.inv_k;
+        let u0 = r0s + self.a_x_m * u1 * self.inv_s;
         let u2 = r2e + (self.j20 * u0 + self.j21 * u1) * self.e2;
         let u3 = r3e + (self.j30 * u0 + self.j31 * u1) * self.e3;
         [u0, u1, u2, u3]
+    }
+
+    #[inline]
+    fn scale(&self, v: &[T; 4]) -> [T; 4] {
+        [v[0], v[1], v[2] * self.inv_oa, v[3] * self.inv_ob]
     }
 }
 
@@ -396,18 +441,19 @@ impl<T: Real> OdeSystem<T, 4> for Fsi<'_, T> {
     type Factor = FsiFactor<T>;
 
     fn rhs(&self, y: &[T; 4]) -> [T; 4] {
-        // Values only: the slopes and the omega derivatives of `local` are
-        // needed by the Jacobian, not here (four divisions saved per stage).
         let c = self.coefficients;
-        let (xi, w, pa, pb) = (y[0], y[1], y[2], y[3]);
-        let oa = c.omega_a0 / (T::ONE - c.eps_a * xi);
-        let ob = c.omega_b0 / (T::ONE + c.eps_b * xi);
-        let ra = regularised_root_value(T::ONE - pa, c.u_tr);
-        let rb = regularised_root_value(pb, c.u_tr);
-        let sw = c.sigma * w;
-        let fa = c.q_t * ra - c.g_l * pa + sw;
-        let fb = c.g_l * (T::ONE - pb) - c.q_t * rb - sw;
-        self.rhs_from(y, oa, ob, fa, fb)
+        let (da, db) = (T::ONE - c.eps_a * y[0], T::ONE + c.eps_b * y[0]);
+        let (fa, fb) = self.inflows(y);
+        self.rhs_from(y, c.omega_a0 / da, c.omega_b0 / db, fa, fb)
+    }
+
+    fn scaled_rhs(&self, y: &[T; 4], factor: &FsiFactor<T>) -> [T; 4] {
+        // D f: the pressure rows are omega(y) F(y) / omega(y_n)
+        //      = F(y) (1 - eps_a xi_n) / (1 - eps_a xi), never forming omega.
+        let c = self.coefficients;
+        let (fa, fb) = self.inflows(y);
+        let (da, db) = (T::ONE - c.eps_a * y[0], T::ONE + c.eps_b * y[0]);
+        self.rhs_from(y, factor.da / da, factor.db / db, fa, fb)
     }
 
     fn jacobian(&self, y: &[T; 4]) -> [[T; 4]; 4] {
@@ -436,16 +482,24 @@ impl<T: Real> OdeSystem<T, 4> for Fsi<'_, T> {
 
     fn linearise(&self, y: &[T; 4], shift: T) -> Option<([T; 4], FsiFactor<T>)> {
         let c = self.coefficients;
-        let l = self.local(y);
-        let f = self.rhs_from(y, l.oa, l.ob, l.fa, l.fb);
-        let (j20, j21) = (l.doa * l.fa, l.oa * c.sigma);
-        let (j30, j31) = (l.dob * l.fb, -(l.ob * c.sigma));
-        let d2 = shift + l.oa * (c.q_t * l.sa + c.g_l);
-        let d3 = shift + l.ob * (c.g_l + c.q_t * l.sb);
+        let xi = y[0];
+        let (da, db) = (T::ONE - c.eps_a * xi, T::ONE + c.eps_b * xi);
+        let (ra, sa) = regularised_root(T::ONE - y[2], c.u_tr);
+        let (rb, sb) = regularised_root(y[3], c.u_tr);
+        let sw = c.sigma * y[1];
+        let fa = c.q_t * ra - c.g_l * y[2] + sw;
+        let fb = c.g_l * (T::ONE - y[3]) - c.q_t * rb - sw;
+        // Scaled rows: D f = (xi', w', F_a, F_b).
+        let f = self.rhs_from(y, T::ONE, T::ONE, fa, fb);
+        let (inv_oa, inv_ob) = (da * c.inv_omega_a0, db * c.inv_omega_b0);
+        let d2 = shift * inv_oa + c.q_t * sa + c.g_l;
+        let d3 = shift * inv_ob + c.g_l + c.q_t * sb;
         if !(d2 > T::ZERO && d3 > T::ZERO) {
             return None;
         }
         let (e2, e3) = (T::ONE / d2, T::ONE / d3);
+        let (j20, j21) = (c.eps_a * fa / da, c.sigma);
+        let (j30, j31) = (-(c.eps_b * fb / db), -c.sigma);
         let (a_x_m, phi_m, inv_a_x_m, two_zeta_m) = if self.moving() {
             (c.a_x, c.phi_over_a_x, c.inv_a_x, c.two_zeta)
         } else {
@@ -453,12 +507,15 @@ impl<T: Real> OdeSystem<T, 4> for Fsi<'_, T> {
         };
         let a10 = inv_a_x_m + phi_m * (j20 * e2 - j30 * e3);
         let a11 = shift + two_zeta_m + phi_m * (j21 * e2 - j31 * e3);
-        let det = shift * a11 + a_x_m * a10;
-        if !(det.abs() > T::tiny()) || !det.is_finite() {
+        if !(shift > T::ZERO) {
+            return None;
+        }
+        let inv_s = T::ONE / shift;
+        let k = a11 + a_x_m * a10 * inv_s;
+        if !(k.abs() > T::tiny()) || !k.is_finite() {
             return None;
         }
         let factor = FsiFactor {
-            s: shift,
             a_x_m,
             phi_m,
             j20,
@@ -468,8 +525,12 @@ impl<T: Real> OdeSystem<T, 4> for Fsi<'_, T> {
             e2,
             e3,
             a10,
-            a11,
-            inv_det: T::ONE / det,
+            inv_s,
+            inv_k: T::ONE / k,
+            inv_oa,
+            inv_ob,
+            da,
+            db,
         };
         Some((f, factor))
     }
@@ -521,8 +582,10 @@ mod tests {
             two_zeta: 0.09,
             xi0: 0.007,
             omega_a0: 13.4,
+            inv_omega_a0: 1.0 / 13.4,
             eps_a: 0.059,
             omega_b0: 13.4,
+            inv_omega_b0: 1.0 / 13.4,
             eps_b: 0.059,
             sigma: 1.02,
             u_tr: 1e-5,
@@ -546,9 +609,15 @@ mod tests {
                 let shift = 0.5 + k as f64;
                 let (f, structured) = sys.linearise(y, shift).unwrap();
                 let (f_dense, dense) = dense_linearisation(&sys, y, shift).unwrap();
-                assert_eq!(f, f_dense);
+                let scaled = structured.scale(&f_dense);
+                for i in 0..4 {
+                    assert!(
+                        (f[i] - scaled[i]).abs() <= 1e-13 * (1.0 + scaled[i].abs()),
+                        "{f:?} vs {scaled:?}"
+                    );
+                }
                 let r = [0.3, -1.2, 2.5, 0.7];
-                let (a, b) = (structured.solve(&r), dense.solve(&r));
+                let (a, b) = (structured.solve(&structured.scale(&r)), dense.solve(&r));
                 for i in 0..4 {
                     assert!(
                         (a[i] - b[i]).abs() <= 1e-12 * (1.0 + b[i].abs()),

@@ -27,7 +27,7 @@ use crate::linalg::Lu;
 use crate::scalar::Real;
 
 /// A system `y' = f(y)` with its Jacobian.
-pub trait OdeSystem<T, const N: usize> {
+pub trait OdeSystem<T: Copy, const N: usize> {
     /// How the system factorises `shift I - J` (a dense [`Lu`] through
     /// [`dense_linearisation`], or something exploiting its structure).
     type Factor: ShiftedSolve<T, N>;
@@ -35,15 +35,30 @@ pub trait OdeSystem<T, const N: usize> {
     fn rhs(&self, y: &[T; N]) -> [T; N];
     /// The Jacobian `df/dy` at `y`.
     fn jacobian(&self, y: &[T; N]) -> [[T; N]; N];
-    /// `f(y)` together with a factorisation of `shift I - J(y)` (one pass
-    /// can share the work of both); `None` when the matrix is singular.
+    /// `D f(y)` together with a factorisation of `D (shift I - J(y))`, for
+    /// the row scaling `D` the factor carries (one pass can share the work
+    /// of both); `None` when the matrix is singular.
     fn linearise(&self, y: &[T; N], shift: T) -> Option<([T; N], Self::Factor)>;
+    /// `D f(y)` with the scaling of `factor` (a system whose `f` has large
+    /// rows may compute the scaled rows without forming the large values).
+    fn scaled_rhs(&self, y: &[T; N], factor: &Self::Factor) -> [T; N] {
+        factor.scale(&self.rhs(y))
+    }
 }
 
-/// Solves `(shift I - J) u = r` with a factorised matrix.
-pub trait ShiftedSolve<T, const N: usize> {
-    /// The solution `u`.
+/// Solves `D (shift I - J) u = r` with a factorised, row-scaled matrix.
+///
+/// The diagonal row scaling `D` lets a system keep every number of the
+/// stage equations bounded (what fixed point needs): a row whose rate is
+/// large is divided by it. The stage equations are the same equations; the
+/// solution `u` is unchanged by the scaling.
+pub trait ShiftedSolve<T: Copy, const N: usize> {
+    /// The solution `u` for an already scaled right-hand side `r = D b`.
     fn solve(&self, r: &[T; N]) -> [T; N];
+    /// `D v` (the identity unless the factor scales rows).
+    fn scale(&self, v: &[T; N]) -> [T; N] {
+        *v
+    }
 }
 
 impl<T: Real, const N: usize> ShiftedSolve<T, N> for Lu<T, N> {
@@ -288,14 +303,15 @@ impl<T: Real> Stepper<T> {
                         }
                     }
                 }
-                f = sys.rhs(&yi);
+                f = sys.scaled_rhs(&yi, &lu);
             }
             let mut rhs = f;
             for (j, uj) in u.iter().enumerate().take(i) {
                 let cij = self.c_over_h[i][j];
                 if cij != T::ZERO {
+                    let su = lu.scale(uj);
                     for k in 0..N {
-                        rhs[k] += cij * uj[k];
+                        rhs[k] += cij * su[k];
                     }
                 }
             }

@@ -242,7 +242,7 @@ pub fn measure(elfs: &[(Image, PathBuf)]) -> Result<Report, String> {
     );
     let _ = writeln!(
         t,
-        "| scheme | steps per tick | Cortex-M4F f32 mean / worst | Cortex-M4F Q16.16 mean / worst | Cortex-M3 Q16.16 mean / worst |"
+        "| scheme | steps per tick | Cortex-M4F f32 mean / worst | Cortex-M4F Q12.20 mean / worst | Cortex-M3 Q12.20 mean / worst |"
     );
     let _ = writeln!(t, "| --- | --- | --- | --- | --- |");
     let get = |c: &Costs, s: &str, n: u32, scalar: &str| {
@@ -259,8 +259,8 @@ pub fn measure(elfs: &[(Image, PathBuf)]) -> Result<Report, String> {
             t,
             "| {s} | {n} | {} | {} | {} |",
             get(&m4, s, *n, "f32"),
-            get(&m4, s, *n, "q16.16"),
-            get(&m3, s, *n, "q16.16")
+            get(&m4, s, *n, "q12.20"),
+            get(&m3, s, *n, "q12.20")
         );
         if (s.as_str(), *n) == ("ros3", 2) {
             if let Some(r) = m4.twin.iter().find(|r| r.0 == *s && r.1 == *n && r.2 == "f32") {
