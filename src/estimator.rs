@@ -5,8 +5,9 @@
 //! Per tick, in this order:
 //! 1. the latest sample (if any) is checked: not finite or outside the oil's
 //!    range is a fault; further than `spike_threshold` from the filtered
-//!    value is a spike and rejected, unless `spike_limit` consecutive
-//!    samples agree on it (a real step);
+//!    value is a spike and rejected, unless it is the `spike_limit + 1`-th
+//!    consecutive out-of-band sample agreeing (within the threshold) with
+//!    the one before: then it is a real step and the filter jumps to it;
 //! 2. a first-order filter (time constant `filter_time_constant`) follows
 //!    the last accepted sample;
 //! 3. one temperature-only job runs, in turn: the oil's properties at the
@@ -232,7 +233,14 @@ pub struct Estimator {
     filtered: f32,
     /// Last accepted sample [C] (the filter's input).
     held: f32,
+    /// Consecutive out-of-band samples agreeing with each other.
     spikes: u16,
+    /// The last out-of-band sample [C].
+    candidate: f32,
+    /// The oil model refused the last temperature it was asked for (the
+    /// previous properties stay in force): the estimate is degraded until a
+    /// refresh succeeds.
+    model_refused: bool,
     since_sample: u32,
     tick: u32,
     monotonic: bool,
@@ -338,6 +346,8 @@ impl Estimator {
             filtered: initial,
             held: initial,
             spikes: 0,
+            candidate: initial,
+            model_refused: false,
             since_sample: 0,
             tick: 0,
             monotonic,
@@ -369,18 +379,22 @@ impl Estimator {
         let (oil_lo, oil_hi) = self.config.oil;
         match sample {
             Ok(Some(t)) if t.is_finite() && t >= oil_lo && t <= oil_hi => {
-                if libm::fabsf(t - self.filtered) > self.config.spike_threshold && self.spikes < self.config.spike_limit
-                {
-                    self.spikes += 1;
-                    flags.insert(Flags::SPIKE);
+                let threshold = self.config.spike_threshold;
+                if libm::fabsf(t - self.filtered) <= threshold {
+                    self.accept(t);
                 } else {
-                    if self.spikes >= self.config.spike_limit && self.config.spike_limit > 0 {
-                        // Enough consecutive samples agree: a real step.
+                    // Out of band: a spike, unless it is the
+                    // (spike_limit + 1)-th consecutive sample agreeing with
+                    // the previous out-of-band one: then a real step.
+                    let agrees = self.spikes > 0 && libm::fabsf(t - self.candidate) <= threshold;
+                    self.spikes = if agrees { self.spikes.saturating_add(1) } else { 1 };
+                    self.candidate = t;
+                    if self.spikes > self.config.spike_limit {
                         self.filtered = t;
+                        self.accept(t);
+                    } else {
+                        flags.insert(Flags::SPIKE);
                     }
-                    self.spikes = 0;
-                    self.held = t;
-                    self.since_sample = 0;
                 }
             }
             Ok(Some(_)) | Err(_) => flags.insert(Flags::SENSOR_FAULT),
@@ -483,19 +497,23 @@ impl Estimator {
             let job = self.next_job;
             self.next_job = job.next();
             // A temperature the oil model refuses leaves the previous
-            // properties in force; the estimate goes on, flagged.
-            if Self::run_job(
+            // properties in force; the estimate goes on, flagged, until a
+            // refresh of the fluid properties succeeds again.
+            match Self::run_job(
                 job,
                 &self.params,
                 &mut self.twin,
                 self.machine_mu_ref,
                 t,
                 &mut self.statics,
-            )
-            .is_err()
-            {
-                flags.insert(Flags::DEGRADED);
+            ) {
+                Ok(()) if job == Job::Fluid => self.model_refused = false,
+                Ok(()) => {}
+                Err(_) => self.model_refused = true,
             }
+        }
+        if self.model_refused {
+            flags.insert(Flags::DEGRADED);
         }
         let p = &self.params;
         if self.twin.tick().is_err() {
@@ -538,6 +556,13 @@ impl Estimator {
             dx_dt: st.dx_dt,
             flags: *flags,
         })
+    }
+
+    /// Takes `t` [C] as the filter's input.
+    fn accept(&mut self, t: f32) {
+        self.spikes = 0;
+        self.held = t;
+        self.since_sample = 0;
     }
 
     /// `true` when this tick's estimate should be published.

@@ -108,7 +108,7 @@ schema! {
     tick_hz: "estimator"."tick_hz" ["Hz"] = Some(1000.0), "Estimator tick rate.";
     filter_time_constant: "estimator"."filter_time_constant" ["s"] = Some(0.2), "First-order temperature filter time constant.";
     spike_threshold: "estimator"."spike_threshold" ["C"] = Some(5.0), "A sample further than this from the filtered value is a spike.";
-    spike_limit: "estimator"."spike_limit" ["-"] = Some(5.0), "Consecutive rejected spikes after which the sample is accepted as a real step.";
+    spike_limit: "estimator"."spike_limit" ["-"] = Some(5.0), "Consecutive agreeing out-of-band samples rejected before the next one is taken as a real step.";
     valid_min: "estimator"."valid_min" ["C"] = Some(26.0), "Lower end of the validated temperature range.";
     valid_max: "estimator"."valid_max" ["C"] = Some(78.0), "Upper end of the validated temperature range.";
     oil_min: "estimator"."oil_min" ["C"] = Some(-20.0), "Coldest temperature the fluid model accepts.";
