@@ -84,7 +84,7 @@ enum Command {
         #[arg(long, value_enum)]
         reading: ReadingArg,
         /// Reference temperature [C], or `balance` (where p_a = p_b, Eq. 2).
-        #[arg(long, default_value = "balance")]
+        #[arg(long, default_value = "balance", allow_hyphen_values = true)]
         t0: String,
         #[arg(long, default_value = "30:80:10")]
         temps: String,
@@ -101,19 +101,19 @@ enum Command {
         #[arg(long)]
         params: PathBuf,
         /// Initial temperature [C] (the twin starts at its equilibrium).
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true)]
         from: f64,
         /// Final temperature [C].
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_hyphen_values = true)]
         to: f64,
         /// Ramp rate [C/s]; without it, a step at t = 0.
-        #[arg(long)]
+        #[arg(long, allow_hyphen_values = true)]
         ramp: Option<f64>,
         /// Tick [s]: output interval and integration step.
-        #[arg(long, default_value = "0.001")]
+        #[arg(long, default_value = "0.001", allow_hyphen_values = true)]
         dt: f64,
         /// Simulated time [s] (default: ramp duration + 0.5 s).
-        #[arg(long)]
+        #[arg(long, allow_hyphen_values = true)]
         t_end: Option<f64>,
         /// Scalar type, the reduced model, or the adaptive reference solver.
         #[arg(long, value_enum, default_value = "f64")]
@@ -140,10 +140,10 @@ enum Command {
         #[arg(long, default_value = "30:40,40:50,50:60,60:70,70:80")]
         steps: String,
         /// Sampling interval [s].
-        #[arg(long, default_value = "0.0001")]
+        #[arg(long, default_value = "0.0001", allow_hyphen_values = true)]
         dt: f64,
         /// Simulated time per step [s].
-        #[arg(long, default_value = "1.0")]
+        #[arg(long, default_value = "1.0", allow_hyphen_values = true)]
         t_end: f64,
     },
     /// Fit a base parameter set to the paper's Tables 1 and 2; prints TOML.

@@ -37,3 +37,35 @@ pub fn assert_allclose(what: &str, actual: &[f64], expected: &[f64], rtol: f64, 
         );
     }
 }
+
+/// The `compensator` CLI binary, built once per test process (debug).
+pub fn cli_binary() -> &'static PathBuf {
+    static BIN: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    BIN.get_or_init(|| {
+        let root = repo_root();
+        let status = std::process::Command::new(env!("CARGO"))
+            .args(["build", "--quiet", "-p", "compensator-cli", "--bin", "compensator"])
+            .current_dir(&root)
+            .status()
+            .expect("cargo runs");
+        assert!(status.success(), "building the CLI failed");
+        let target = std::env::var_os("CARGO_TARGET_DIR")
+            .map(PathBuf::from)
+            .unwrap_or(root.join("target"));
+        target.join("debug").join("compensator")
+    })
+}
+
+/// Runs the CLI in the repository root: (exit code, stdout, stderr).
+pub fn run_cli(args: &[&str]) -> (i32, String, String) {
+    let out = std::process::Command::new(cli_binary())
+        .args(args)
+        .current_dir(repo_root())
+        .output()
+        .expect("the CLI runs");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8(out.stdout).expect("utf-8"),
+        String::from_utf8(out.stderr).expect("utf-8"),
+    )
+}

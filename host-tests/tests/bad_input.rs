@@ -7,9 +7,6 @@ use compensator::params::{ParamError, Problem};
 use compensator::{ModelError, Params};
 use compensator_cli::{LoadError, params_file};
 use host_tests::repo_root;
-use std::path::PathBuf;
-use std::process::Command;
-use std::sync::OnceLock;
 
 fn preset_text() -> String {
     std::fs::read_to_string(repo_root().join("presets/paper.toml")).unwrap()
@@ -172,34 +169,8 @@ fn temperatures_outside_the_oil_range_are_typed_errors() {
     }
 }
 
-fn cli() -> &'static PathBuf {
-    static BIN: OnceLock<PathBuf> = OnceLock::new();
-    BIN.get_or_init(|| {
-        let root = repo_root();
-        let status = Command::new(env!("CARGO"))
-            .args(["build", "--quiet", "-p", "compensator-cli", "--bin", "compensator"])
-            .current_dir(&root)
-            .status()
-            .expect("cargo runs");
-        assert!(status.success());
-        let target = std::env::var_os("CARGO_TARGET_DIR")
-            .map(PathBuf::from)
-            .unwrap_or(root.join("target"));
-        target.join("debug").join("compensator")
-    })
-}
-
 fn run(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(cli())
-        .args(args)
-        .current_dir(repo_root())
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8(out.stdout).unwrap(),
-        String::from_utf8(out.stderr).unwrap(),
-    )
+    host_tests::run_cli(args)
 }
 
 #[track_caller]

@@ -108,3 +108,43 @@ fn equation_1_gradient_is_bounded_by_the_drop() {
     // Symmetric branches: (a) falls exactly as (b) rises.
     assert!((mean_a - mean_b).abs() < 1e-9 * mean_a);
 }
+
+#[test]
+fn table3_trends_are_the_physics_not_the_paper() {
+    // The paper's Table 3 (illustrative) has the dominant eigenvalue's real
+    // part rising towards zero, settling times growing and overshoot
+    // growing with temperature. With the parameters that reproduce Tables
+    // 1-2 the chambers' hydraulic damping dominates: the response is
+    // overdamped (no overshoot), and it speeds up as the oil thins.
+    let root = repo_root();
+    let raw = params_file::load(&root.join("presets/paper.toml")).unwrap();
+    let p = preset();
+    let steps = [(30.0, 40.0), (40.0, 50.0), (50.0, 60.0), (60.0, 70.0), (70.0, 80.0)];
+    let ind: Vec<_> = steps
+        .iter()
+        .map(|&(a, b)| compensator_cli::dynamics::step_indicators(&raw, &p, a, b, 1e-4, 1.0).unwrap())
+        .collect();
+    for w in ind.windows(2) {
+        assert!(
+            w[1].dominant_re < w[0].dominant_re,
+            "the slow eigenvalue grows with temperature"
+        );
+        assert!(
+            w[1].settling_time < w[0].settling_time,
+            "settling shortens with temperature"
+        );
+    }
+    for i in &ind {
+        assert!(i.overshoot_pct < 0.01, "overdamped: {} %", i.overshoot_pct);
+        let lin = compensator::dynamics::linear::linearise(&p, i.to).unwrap();
+        assert!(
+            lin.plunger_damping_ratio > 1.0,
+            "hydraulic damping makes the plunger overdamped"
+        );
+    }
+    // x* is the quasi-static column of Table 2 (within 0.02 mm).
+    let (_, t2) = tables();
+    for (i, t) in ind.iter().zip(&t2.x_qs_mm[1..]) {
+        assert!((i.x_star * 1e3 - t).abs() <= 0.02);
+    }
+}
