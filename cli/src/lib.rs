@@ -10,6 +10,7 @@ pub mod csv;
 pub mod dynamics;
 pub mod lsq;
 pub mod paper;
+pub mod sizing;
 pub mod temps;
 
 pub use compensator_params::file as params_file;

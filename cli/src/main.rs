@@ -146,6 +146,27 @@ enum Command {
         #[arg(long, default_value = "1.0", allow_hyphen_values = true)]
         t_end: f64,
     },
+    /// Demand, supply, compensation error and the Eq. (9) window per temperature.
+    Compensation {
+        #[arg(long)]
+        params: PathBuf,
+        #[arg(long, default_value = "30:80:10")]
+        temps: String,
+    },
+    /// Design sizing: the machine a compensator serves best (`machine`), or
+    /// the window diameter a machine needs (`slot`); prints TOML.
+    Size {
+        #[arg(long)]
+        params: PathBuf,
+        /// What to size: machine or slot.
+        #[arg(long = "for")]
+        what: String,
+        #[arg(long, default_value = "30:80:1")]
+        temps: String,
+        /// Reference temperature of the fitted leakage [C].
+        #[arg(long, default_value = "40", allow_hyphen_values = true)]
+        reference: f64,
+    },
     /// Fit a base parameter set to the paper's Tables 1 and 2; prints TOML.
     Calibrate {
         /// Base parameter file whose geometry is kept.
@@ -223,6 +244,13 @@ fn run(cli: Cli) -> Result<String, CliError> {
             dt,
             t_end,
         } => compensator_cli::dynamics::indicators(&params, &steps, dt, t_end),
+        Command::Compensation { params, temps } => commands::compensation_table(&params, &temps),
+        Command::Size {
+            params,
+            what,
+            temps,
+            reference,
+        } => commands::size(&params, &what, &temps, reference),
         Command::Calibrate { base, data } => commands::calibrate(&base, &data),
         Command::Paper { params, data } => commands::paper(&params, &data),
     }

@@ -60,8 +60,14 @@ fn at_rest_the_estimate_is_the_equilibrium() {
     assert!((e.x_equilibrium - eq.x).abs() <= 1e-6 * p.plunger.stroke);
     assert!(e.dx_dt > 0.0);
     assert_eq!(e.flags, Flags::empty());
-    // No [machine] in the paper preset: no compensation error to report.
-    assert!(e.compensation_error.is_nan());
+    // The preset's [machine]: the error is the closed form's Q0 - demand.
+    let c = compensator::compensation::compensation(&p, 55.0).unwrap();
+    assert!(
+        (e.compensation_error - c.error).abs() <= 1e-4 * c.demand,
+        "{} vs {}",
+        e.compensation_error,
+        c.error
+    );
 }
 
 #[test]

@@ -148,3 +148,17 @@ fn table3_trends_are_the_physics_not_the_paper() {
         assert!((i.x_star * 1e3 - t).abs() <= 0.02);
     }
 }
+
+#[test]
+fn committed_machine_is_what_size_produces() {
+    let p = preset();
+    let temps: Vec<f64> = (26..=78).map(f64::from).collect();
+    let fit = compensator_cli::sizing::fit_machine(&p, &temps, 40.0).unwrap();
+    let m = p.machine.expect("presets/paper.toml has a [machine]");
+    assert!(
+        (m.working_flow - fit.working_flow).abs() <= 1e-9 * fit.leakage_reference,
+        "rerun `compensator size`"
+    );
+    assert!((m.leakage_reference - fit.leakage_reference).abs() <= 1e-9 * fit.leakage_reference);
+    assert_eq!(m.leakage_temperature, 40.0);
+}

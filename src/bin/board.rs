@@ -134,7 +134,7 @@ fn main() -> ! {
     cp.SYST.enable_interrupt();
     cp.SYST.enable_counter();
 
-    let sensor_every = ((SENSOR_PERIOD / config.tick) as u32).max(1);
+    let sensor_every = ((SENSOR_PERIOD / config.tick + 0.5) as u32).max(1);
     let mut done = TICKS.load(Ordering::Relaxed);
     loop {
         while TICKS.load(Ordering::Relaxed) == done {

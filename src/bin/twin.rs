@@ -189,7 +189,7 @@ fn replay(params: &Params<f32>, config: EstimatorConfig) -> bool {
     let tick = config.tick;
     let end = REPLAY_PIECES[REPLAY_PIECES.len() - 1].1;
     let ticks = (end / tick) as u32;
-    let sensor_every = ((SENSOR_PERIOD / tick) as u32).max(1);
+    let sensor_every = ((SENSOR_PERIOD / tick + 0.5) as u32).max(1);
     let mut seen = [Flags::empty(); REPLAY_FAULTS.len()];
     let mut next_checkpoint = 0;
     let mut out_of_range_seen = false;
@@ -259,7 +259,7 @@ fn replay(params: &Params<f32>, config: EstimatorConfig) -> bool {
             next_checkpoint += 1;
         }
         if estimator.telemetry_due() {
-            info!("{=f32} s {}", time, e);
+            info!("{=u32} ms {}", (k as f32 * tick * 1e3 + 0.5) as u32, e);
         }
     }
     checks.check(next_checkpoint == CHECKPOINTS.len(), "every checkpoint reached", end);

@@ -270,6 +270,56 @@ pub fn measure(elfs: &[(Image, PathBuf)]) -> Result<Report, String> {
             }
         }
     }
+    let _ = writeln!(t, "\n## Accuracy against cost: the choice of scheme\n");
+    let _ = writeln!(
+        t,
+        "Worst max |x - x_ref| over the paper preset's six steps and 1 C/s ramp, in % of the step \
+         (host simulation against the Radau5 reference, `host_tests::accuracy`), beside the \
+         Cortex-M4F f32 instructions per 1 ms tick. A configuration is on the Pareto front when no \
+         other is both more accurate and cheaper. Goals: f32 <= 1 %, fixed point <= 3 %, f64 <= 0.1 %.\n"
+    );
+    let _ = writeln!(
+        t,
+        "| scheme | steps per tick | f64 error | f32 error | Q12.20 error | M4 f32 instructions (mean) | Pareto (f32) |"
+    );
+    let _ = writeln!(t, "| --- | --- | --- | --- | --- | --- | --- |");
+    let points = accuracy_points(&configs)?;
+    let cost_of = |a: &Accuracy| {
+        m4.twin
+            .iter()
+            .find(|r| r.0 == a.scheme && r.1 == a.substeps && r.2 == "f32")
+            .map(|r| r.3)
+            .unwrap_or(f64::NAN)
+    };
+    for (i, a) in points.iter().enumerate() {
+        let cost = cost_of(a);
+        let dominated = points.iter().enumerate().any(|(j, b)| {
+            let c2 = cost_of(b);
+            j != i && b.f32 <= a.f32 && c2 <= cost && (b.f32 < a.f32 || c2 < cost)
+        });
+        let shipped = if (a.scheme.as_str(), a.substeps) == ("ros3", 2) {
+            " (shipped)"
+        } else {
+            ""
+        };
+        let fmt = |e: f64| {
+            if e.is_finite() {
+                format!("{e:.4} %")
+            } else {
+                "unstable".into()
+            }
+        };
+        let _ = writeln!(
+            t,
+            "| {} | {} | {} | {} | {} | {cost:.0} | {}{shipped} |",
+            a.scheme,
+            a.substeps,
+            fmt(a.f64),
+            fmt(a.f32),
+            fmt(a.fixed),
+            if dominated || !a.f32.is_finite() { "" } else { "yes" }
+        );
+    }
     if let Some(r) = m3.twin.iter().find(|r| r.2 == "f32-soft") {
         let _ = writeln!(
             t,
@@ -278,6 +328,56 @@ pub fn measure(elfs: &[(Image, PathBuf)]) -> Result<Report, String> {
         );
     }
     Ok(Report { text: t, over })
+}
+
+/// Worst error (% of the step) over the paper cases of one configuration;
+/// infinite where the scheme is unstable at that step.
+struct Accuracy {
+    scheme: String,
+    substeps: u32,
+    f64: f64,
+    f32: f64,
+    fixed: f64,
+}
+
+fn accuracy_points(configs: &[(String, u32)]) -> Result<Vec<Accuracy>, String> {
+    use compensator::dynamics::{Scheme, TwinConfig};
+    use compensator_cli::dynamics::Precision;
+    let root = crate::root();
+    let raw = compensator_cli::load(&root.join("presets/paper.toml")).map_err(|e| e.to_string())?;
+    let cases = host_tests::accuracy::paper_cases(&raw);
+    let mut out = Vec::new();
+    for (name, n) in configs {
+        let scheme = Scheme::from_name(name).ok_or_else(|| format!("unknown scheme {name}"))?;
+        let config = TwinConfig {
+            scheme,
+            tick: host_tests::accuracy::TICK,
+            substeps: *n as u8,
+        };
+        let worst = |p: Precision| {
+            cases
+                .iter()
+                .map(
+                    |c| match compensator_cli::dynamics::simulate(&c.raw, p, config, &c.profile, c.ticks) {
+                        Ok(r) => {
+                            let x: Vec<f64> = r.state.iter().map(|s| s.x).collect();
+                            let e = c.error_pct(&x);
+                            if e.is_finite() { e } else { f64::INFINITY }
+                        }
+                        Err(_) => f64::INFINITY,
+                    },
+                )
+                .fold(0.0, f64::max)
+        };
+        out.push(Accuracy {
+            scheme: name.clone(),
+            substeps: *n,
+            f64: worst(Precision::F64),
+            f32: worst(Precision::F32),
+            fixed: worst(Precision::Fixed),
+        });
+    }
+    Ok(out)
 }
 
 /// `cargo xtask bench [--write]`.

@@ -4,12 +4,14 @@
 //! cargo xtask run [--params FILE]   build the QEMU firmware and run it (the main job)
 //! cargo xtask test [--bless]        everything CI checks (the test command)
 //! cargo xtask bench [--write]       cost, footprint and stack on the emulated MCUs
+//! cargo xtask callgrind [--bless]   host instruction counts against the baseline
 //! cargo xtask build                 build every firmware image
 //! cargo xtask toolchain             find or provision the cross toolchain
 //! cargo xtask qemu-runner ELF       run an ELF on QEMU (cargo runner for on-target tests)
 //! ```
 
 mod bench;
+mod callgrind;
 mod firmware;
 mod process;
 mod qemu;
@@ -33,6 +35,7 @@ fn usage() -> ExitCode {
          \n  run [--params FILE]   build the QEMU firmware and run it (the main job)\
          \n  test [--bless]        every check CI runs (host tests, clippy, cross builds, QEMU)\
          \n  bench [--write]       instructions per tick, flash, RAM and stack on the emulated MCUs\
+         \n  callgrind [--bless]   host instruction counts (valgrind) against the baseline\
          \n  build                 build every firmware image\
          \n  target-tests          the core's tests on the emulated Cortex-M4F (defmt-test)\
          \n  toolchain             find or provision the thumbv7em/thumbv7m toolchain\
@@ -53,6 +56,7 @@ fn main() -> ExitCode {
             0
         }),
         Some("qemu-runner") => cmd_qemu_runner(&args[1..]),
+        Some("callgrind") => callgrind::check(&root(), args.iter().any(|a| a == "--bless")).map(|_| 0),
         Some("target-tests") => toolchain::get(&root(), &[firmware::M4])
             .and_then(|tc| qemu::ensure().and_then(|_| firmware::on_target_tests(&tc, &root())))
             .map(|_| 0),
@@ -149,6 +153,8 @@ fn cmd_test(args: &[String]) -> Result<i32, String> {
         ],
         minutes(10),
     )?;
+    step("host instruction counts (valgrind callgrind) against the baseline");
+    callgrind::check(&root, false)?;
     step("cross toolchain");
     let tc = toolchain::get(&root, &firmware::TARGETS)?;
     eprintln!("xtask: {}", tc.description);

@@ -1,0 +1,134 @@
+//! Design sizing: matching a compensator and the machine whose losses it
+//! covers (paper Eqs. 8-9).
+//!
+//! The machine's losses are laminar leakage, `dQ_lost(t) = L mu(t_ref) / mu(t)`,
+//! and it needs `Q_work + dQ_lost(t)`; the compensator supplies
+//! `Q0(t) = 2 Q_a(t) + eta pi d x(t) sqrt(2 dp / rho(t))`. Both fits below
+//! are linear least squares in closed form over a temperature list:
+//!
+//! * [`fit_machine`]: the `(Q_work, L)` a given compensator serves best;
+//! * [`fit_slot`]: the window diameter `d` that serves a given machine best
+//!   (`x(t)` does not depend on `d`, so `Q0` is linear in it).
+
+use compensator::Params;
+use compensator::compensation::compensation;
+use compensator::equilibrium::equilibrium;
+use compensator::params::Machine;
+
+/// A fitted design and how well it compensates.
+#[derive(Debug, Clone, Copy)]
+pub struct Fit {
+    /// Working flow `Q_work` [m^3/s] (machine fit) or unchanged.
+    pub working_flow: f64,
+    /// Leakage at the reference temperature [m^3/s] (machine fit) or unchanged.
+    pub leakage_reference: f64,
+    /// Reference temperature of the leakage [C].
+    pub leakage_temperature: f64,
+    /// Window diameter [m] (slot fit) or unchanged.
+    pub slot_diameter: f64,
+    /// RMS of `Q0 - demand` over the temperatures [m^3/s].
+    pub rms_error: f64,
+    /// Largest `|Q0 - demand|` [m^3/s].
+    pub max_error: f64,
+}
+
+fn errors(p: &Params<f64>, temps: &[f64]) -> Result<(f64, f64), String> {
+    let mut sum = 0.0;
+    let mut max = 0.0f64;
+    for &t in temps {
+        let c = compensation(p, t).map_err(|e| format!("{t} C: {e}"))?;
+        sum += c.error * c.error;
+        max = max.max(c.error.abs());
+    }
+    Ok(((sum / temps.len() as f64).sqrt(), max))
+}
+
+/// The machine (working flow and laminar leakage at `t_ref` [C]) that the
+/// compensator `p` serves best over `temps` [C], with both coefficients
+/// kept non-negative.
+pub fn fit_machine(p: &Params<f64>, temps: &[f64], t_ref: f64) -> Result<Fit, String> {
+    if temps.len() < 2 {
+        return Err("--temps: at least two temperatures are needed".into());
+    }
+    let mu_ref = p
+        .oil
+        .state(t_ref)
+        .map_err(|e| format!("--reference {t_ref} C: {e}"))?
+        .dynamic_viscosity;
+    // Rows (1, r(t)) against Q0(t), r = mu_ref / mu(t).
+    let (mut s11, mut s1r, mut srr, mut s1q, mut srq) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for &t in temps {
+        let e = equilibrium(p, t).map_err(|e| format!("{t} C: {e}"))?;
+        let r = mu_ref / e.fluid.dynamic_viscosity;
+        s11 += 1.0;
+        s1r += r;
+        srr += r * r;
+        s1q += e.q_total;
+        srq += r * e.q_total;
+    }
+    let det = s11 * srr - s1r * s1r;
+    let (mut qw, mut leak) = ((srr * s1q - s1r * srq) / det, (s11 * srq - s1r * s1q) / det);
+    if leak < 0.0 {
+        leak = 0.0;
+        qw = s1q / s11;
+    }
+    if qw < 0.0 {
+        qw = 0.0;
+        leak = srq / srr;
+    }
+    let machine = Machine {
+        working_flow: qw,
+        leakage_reference: leak,
+        leakage_temperature: t_ref,
+    };
+    let fitted = Params {
+        machine: Some(machine),
+        ..*p
+    };
+    let (rms_error, max_error) = errors(&fitted, temps)?;
+    Ok(Fit {
+        working_flow: qw,
+        leakage_reference: leak,
+        leakage_temperature: t_ref,
+        slot_diameter: p.slot.diameter,
+        rms_error,
+        max_error,
+    })
+}
+
+/// The window diameter that serves the parameter set's `[machine]` best
+/// over `temps` [C].
+pub fn fit_slot(p: &Params<f64>, temps: &[f64]) -> Result<Fit, String> {
+    let m = p
+        .machine
+        .ok_or("the parameter file has no [machine] section to size the slot for")?;
+    let (mut sgg, mut sgb) = (0.0, 0.0);
+    for &t in temps {
+        let c = compensation(p, t).map_err(|e| format!("{t} C: {e}"))?;
+        // Q_throt = d g(t): the window flow per metre of diameter.
+        let g = c.equilibrium.q_throt / p.slot.diameter;
+        let need = c.demand - 2.0 * c.equilibrium.q_branch;
+        sgg += g * g;
+        sgb += g * need;
+    }
+    if !(sgg > 0.0) {
+        return Err("the window never opens over --temps: no diameter changes the supply".into());
+    }
+    let d = sgb / sgg;
+    if !(d > 0.0) {
+        return Err(format!(
+            "the best diameter would be {d} m: the branches alone oversupply this machine"
+        ));
+    }
+    let mut fitted = *p;
+    fitted.slot.diameter = d;
+    let (rms_error, max_error) = errors(&fitted, temps)?;
+    Ok(Fit {
+        working_flow: m.working_flow,
+        leakage_reference: m.leakage_reference,
+        leakage_temperature: m.leakage_temperature,
+        slot_diameter: d,
+        rms_error,
+        max_error,
+    })
+}
