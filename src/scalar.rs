@@ -8,14 +8,14 @@
 //!   fluid properties are evaluated in floating point at the sensor rate and
 //!   handed to the fixed-point integrator as dimensionless coefficients.
 //!
-//! Cost notes (Cortex-M4F): `f32` square roots use the FPU's `VSQRT.F32`
-//! through inline assembly (five instructions); `libm::sqrtf` would be a
-//! software routine. `f32` exponentials and logarithms come from
-//! [`crate::mathf`] (native `f32`, within 2 ulp, 30-40 instructions):
-//! `libm`'s `f32` versions compute in double precision internally, which
-//! the single-precision FPU runs in software (~1,000 instructions).
-//! `micromath`'s approximations are not used for the fluid laws: Walther's
-//! double exponential amplifies their ~1e-4 relative error about tenfold.
+//! Cost notes (Cortex-M4F, measured by `cargo xtask bench`): `f32` square
+//! roots use the FPU's `VSQRT.F32` through inline assembly (five
+//! instructions); `libm::sqrtf` would be a software routine. `expf`,
+//! `logf`, `log1pf`, `log10f` come from `libm` (60-80 instructions);
+//! `10^x` from [`crate::mathf`] (~95), because `libm::exp10f` computes in
+//! double precision (~1,230). `micromath`'s approximations are not used for
+//! the fluid laws: Walther's double exponential amplifies their ~1e-4
+//! relative error about tenfold (`mathf` tests).
 
 use core::fmt::Debug;
 use core::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
@@ -197,25 +197,25 @@ impl Real for f32 {
     }
 }
 
-/// `f32` transcendentals come from [`crate::mathf`] (native single
-/// precision); `libm`'s would compute in software double precision on the
-/// Cortex-M4F.
+/// `f32` transcendentals from `libm` (native single precision), except
+/// `10^x` from [`crate::mathf`]: `libm::exp10f` computes in double
+/// precision, ~1,220 instructions on a Cortex-M4F against ~85.
 impl Float for f32 {
     #[inline]
     fn ln(self) -> Self {
-        crate::mathf::ln(self)
+        libm::logf(self)
     }
     #[inline]
     fn log10(self) -> Self {
-        crate::mathf::log10(self)
+        libm::log10f(self)
     }
     #[inline]
     fn ln_1p(self) -> Self {
-        crate::mathf::ln_1p(self)
+        libm::log1pf(self)
     }
     #[inline]
     fn exp(self) -> Self {
-        crate::mathf::exp(self)
+        libm::expf(self)
     }
     #[inline]
     fn exp10(self) -> Self {
@@ -223,7 +223,7 @@ impl Float for f32 {
     }
     #[inline]
     fn powf(self, p: Self) -> Self {
-        crate::mathf::powf(self, p)
+        libm::powf(self, p)
     }
     #[inline]
     fn nan() -> Self {

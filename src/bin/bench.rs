@@ -126,6 +126,23 @@ fn pieces(params: &Params<f32>) {
     });
     info!("[measure] piece name=stability total={=u32}", c);
 
+    // The f32 elementary functions the fluid laws use: the crate's own
+    // kernels against libm's and micromath's.
+    let x = black_box(1.234f32);
+    let pieces: [(&str, fn(f32) -> f32); 7] = [
+        ("exp10-mathf", compensator::mathf::exp10),
+        ("exp10-libm", libm::exp10f),
+        ("exp2-libm", libm::exp2f),
+        ("exp-libm", libm::expf),
+        ("exp-micromath", micromath::F32Ext::exp),
+        ("ln1p-libm", libm::log1pf),
+        ("ln-micromath", micromath::F32Ext::ln),
+    ];
+    for (name, f) in pieces {
+        let (_, c) = counts(|| black_box(f(black_box(x))));
+        info!("[measure] piece name={=str} total={=u32}", name, c);
+    }
+
     // Telemetry packing alone: one estimate, encoded by defmt.
     let Ok(config) = EstimatorConfig::new(&RAW_PARAMS.estimator) else {
         return;
