@@ -199,6 +199,29 @@ pub struct StateEstimate {
     pub flags: Flags,
 }
 
+impl StateEstimate {
+    /// Whether every state, flow and equilibrium field is finite (the
+    /// estimator's promise on any input). `compensation_error` is left out:
+    /// it is NaN by design without a `[machine]`.
+    pub fn is_finite(&self) -> bool {
+        [
+            self.temperature,
+            self.x,
+            self.v,
+            self.p_a,
+            self.p_b,
+            self.q_a,
+            self.q_b,
+            self.q_throt,
+            self.q_total,
+            self.x_equilibrium,
+            self.dx_dt,
+        ]
+        .iter()
+        .all(|v| v.is_finite())
+    }
+}
+
 /// The telemetry record: the state estimate in engineering units. The
 /// equilibrium `x*` and `dx/dt` stay out of it (each float costs ~80
 /// instructions to pack); they are in the struct for whoever needs them.

@@ -14,7 +14,7 @@ use compensator_reference::dynamics::{self as reference, Method, Profile};
 use std::path::Path;
 
 /// Scalar type (or solver) of a dynamic computation.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Precision {
     /// The twin in `f32`.
     F32,

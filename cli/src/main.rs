@@ -27,21 +27,6 @@ enum StaticPrecision {
     F32,
 }
 
-/// Scalar type or solver of a dynamic computation.
-#[derive(Copy, Clone, Debug, ValueEnum, PartialEq, Eq)]
-enum DynPrecision {
-    F32,
-    F64,
-    /// Q12.20, the shipped fixed-point format.
-    Fixed,
-    /// Q16.16 (for comparison).
-    FixedQ16,
-    /// Q8.24 (for comparison).
-    FixedQ24,
-    Reduced,
-    Reference,
-}
-
 /// One-step scheme.
 #[derive(Copy, Clone, Debug, ValueEnum, PartialEq, Eq)]
 enum SchemeArg {
@@ -117,7 +102,7 @@ enum Command {
         t_end: Option<f64>,
         /// Scalar type, the reduced model, or the adaptive reference solver.
         #[arg(long, value_enum, default_value = "f64")]
-        precision: DynPrecision,
+        precision: compensator_cli::dynamics::Precision,
         /// One-step scheme of the twin.
         #[arg(long, value_enum, default_value = "ros2")]
         scheme: SchemeArg,
@@ -218,16 +203,6 @@ fn run(cli: Cli) -> Result<String, CliError> {
             substeps,
         } => {
             use compensator::dynamics::Scheme;
-            use compensator_cli::dynamics::Precision;
-            let precision = match precision {
-                DynPrecision::F32 => Precision::F32,
-                DynPrecision::F64 => Precision::F64,
-                DynPrecision::Fixed => Precision::Fixed,
-                DynPrecision::FixedQ16 => Precision::FixedQ16,
-                DynPrecision::FixedQ24 => Precision::FixedQ24,
-                DynPrecision::Reduced => Precision::Reduced,
-                DynPrecision::Reference => Precision::Reference,
-            };
             let scheme = match scheme {
                 SchemeArg::Rk4 => Scheme::Rk4,
                 SchemeArg::LinearlyImplicitEuler => Scheme::LinearlyImplicitEuler,

@@ -12,8 +12,7 @@ use compensator::{Params, equilibrium::equilibrium};
 use std::hint::black_box;
 use std::time::Instant;
 
-/// Operations per workload.
-pub const COUNT: u32 = 20_000;
+use host_tests::bench::{COUNT, WORKLOADS};
 
 fn params<T: compensator::Float>() -> (compensator::RawParams, Params<T>) {
     let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
@@ -69,17 +68,6 @@ fn run(name: &str) -> bool {
     }
     true
 }
-
-/// Workload names, in report order ("setup" is subtracted by xtask).
-pub const WORKLOADS: [&str; 7] = [
-    "twin-f32",
-    "twin-f64",
-    "twin-q12.20",
-    "twin-ros2-f32",
-    "equilibrium-f32",
-    "fluid-f32",
-    "estimator-f32",
-];
 
 fn main() {
     // `cargo bench` passes `--bench`; a workload name selects one.

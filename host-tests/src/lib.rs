@@ -6,6 +6,7 @@
 //! reference.
 
 pub mod accuracy;
+pub mod bench;
 pub mod random;
 pub use compensator_reference::statics as reference;
 

@@ -26,24 +26,6 @@ fn run(est: &mut Estimator, ticks: usize, sample: Result<Option<f32>, SensorFaul
     last.unwrap()
 }
 
-fn finite(e: &StateEstimate) -> bool {
-    [
-        e.temperature,
-        e.x,
-        e.v,
-        e.p_a,
-        e.p_b,
-        e.q_a,
-        e.q_b,
-        e.q_throt,
-        e.q_total,
-        e.x_equilibrium,
-        e.dx_dt,
-    ]
-    .iter()
-    .all(|v| v.is_finite())
-}
-
 #[test]
 fn at_rest_the_estimate_is_the_equilibrium() {
     let (p, _, mut est) = setup(55.0);
@@ -136,11 +118,11 @@ fn bad_samples_are_flags_and_never_numbers() {
     for s in garbage {
         let e = est.tick(s);
         assert!(e.flags.contains(Flags::SENSOR_FAULT), "{s:?}");
-        assert!(finite(&e), "{s:?}: {e:?}");
+        assert!(e.is_finite(), "{s:?}: {e:?}");
     }
     // Half a second without a usable sample: degraded, then recovered.
     let e = run(&mut est, cfg.stale_after as usize + 10, Err(SensorFault::Bus));
-    assert!(e.flags.contains(Flags::DEGRADED) && finite(&e));
+    assert!(e.flags.contains(Flags::DEGRADED) && e.is_finite());
     let e = run(&mut est, 40, Ok(Some(45.0)));
     assert!(!e.flags.contains(Flags::DEGRADED));
 }
@@ -169,7 +151,7 @@ fn a_temperature_the_oil_model_refuses_degrades_without_nan() {
     }
     let e2 = run(&mut est, 500, Ok(Some(140.0)));
     assert!(e2.flags.contains(Flags::DEGRADED), "{:?}", e2.flags);
-    assert!(finite(&e2) && finite(&e));
+    assert!(e2.is_finite() && e.is_finite());
 }
 
 #[test]

@@ -17,7 +17,7 @@
 use compensator::dynamics::TwinConfig;
 use compensator::dynamics::linear::linearise;
 use compensator::equilibrium::{balance_temperature, equilibrium};
-use compensator::estimator::{Estimator, EstimatorConfig, Flags, StateEstimate};
+use compensator::estimator::{Estimator, EstimatorConfig, Flags};
 use compensator::sensor::TemperatureSource;
 use compensator::sensor::max31865::{Mains, Max31865, Settings, Wires, fault};
 use compensator::sensor::simulated::SimulatedMax31865;
@@ -76,24 +76,6 @@ impl Checks {
     fn failures(&self) -> u32 {
         self.failed.len() as u32 + self.overflow
     }
-}
-
-fn finite_estimate(e: &StateEstimate) -> bool {
-    [
-        e.temperature,
-        e.x,
-        e.v,
-        e.p_a,
-        e.p_b,
-        e.q_a,
-        e.q_b,
-        e.q_throt,
-        e.q_total,
-        e.x_equilibrium,
-        e.dx_dt,
-    ]
-    .iter()
-    .all(|v| v.is_finite())
 }
 
 #[entry]
@@ -240,7 +222,7 @@ fn replay(params: &Params<f32>, config: EstimatorConfig) -> bool {
         if (66.5..68.0).contains(&time) && e.flags.contains(Flags::OUT_OF_RANGE) {
             out_of_range_seen = true;
         }
-        if !finite_estimate(&e) {
+        if !e.is_finite() {
             nan_ticks += 1;
         }
         if next_checkpoint < CHECKPOINTS.len() && time >= CHECKPOINTS[next_checkpoint].0 {

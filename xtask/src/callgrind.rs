@@ -8,23 +8,13 @@
 //! [`TOLERANCE`] off its baseline fails the check.
 
 use crate::process;
+use host_tests::bench::{COUNT, WORKLOADS};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
 
 /// Allowed relative change against the baseline.
 pub const TOLERANCE: f64 = 0.05;
-/// Operations per workload (`COUNT` in the bench).
-const COUNT: f64 = 20_000.0;
-const WORKLOADS: [&str; 7] = [
-    "twin-f32",
-    "twin-f64",
-    "twin-q12.20",
-    "twin-ros2-f32",
-    "equilibrium-f32",
-    "fluid-f32",
-    "estimator-f32",
-];
 
 fn baseline_path(root: &Path) -> PathBuf {
     root.join("host-tests/benches/callgrind-baseline.txt")
@@ -95,7 +85,7 @@ pub fn measure(root: &Path) -> Result<Vec<(String, f64)>, String> {
     let setup = instructions(&exe, "setup", &dir)?;
     WORKLOADS
         .iter()
-        .map(|w| Ok((w.to_string(), (instructions(&exe, w, &dir)? - setup) / COUNT)))
+        .map(|w| Ok((w.to_string(), (instructions(&exe, w, &dir)? - setup) / f64::from(COUNT))))
         .collect()
 }
 
