@@ -15,6 +15,8 @@ pub enum ModelError {
     OutOfRange(&'static str),
     /// A bounded iteration did not converge within its budget.
     NoConvergence(&'static str),
+    /// A finite value the scalar type cannot hold (fixed-point saturation).
+    NotRepresentable(&'static str),
 }
 
 impl core::fmt::Display for ModelError {
@@ -23,6 +25,7 @@ impl core::fmt::Display for ModelError {
             ModelError::NonFinite(what) => write!(f, "{what} is not finite"),
             ModelError::OutOfRange(what) => write!(f, "{what} is out of the model's range"),
             ModelError::NoConvergence(what) => write!(f, "{what} did not converge"),
+            ModelError::NotRepresentable(what) => write!(f, "{what} does not fit the scalar type"),
         }
     }
 }
@@ -34,5 +37,22 @@ pub(crate) fn finite<T: crate::Real>(v: T, what: &'static str) -> Result<T, Mode
         Ok(v)
     } else {
         Err(ModelError::NonFinite(what))
+    }
+}
+
+/// `v` converted to `T`: `NonFinite(what)` if either side is not finite,
+/// `NotRepresentable(what)` if `T` saturated it (the round trip is off by
+/// more than 1e-3 relative plus `T`'s resolution).
+#[inline]
+pub(crate) fn represent<S: crate::Float, T: crate::Real>(v: S, what: &'static str) -> Result<T, ModelError> {
+    let t: T = v.to_real();
+    if !(v.is_finite() && t.is_finite()) {
+        return Err(ModelError::NonFinite(what));
+    }
+    let tolerance = S::from_f64(1e-3) * v.abs() + S::from_real(T::tiny());
+    if (S::from_real(t) - v).abs() <= tolerance {
+        Ok(t)
+    } else {
+        Err(ModelError::NotRepresentable(what))
     }
 }

@@ -14,10 +14,12 @@
 //!    filtered temperature (one Walther evaluation, handed to the twin and
 //!    the flow laws); the closed-form equilibrium with `dx/dt` (Eq. 31); the
 //!    Routh-Hurwitz stability of the linearisation at that equilibrium; the
-//!    machine's losses. None runs on a telemetry tick. Each result is thus
-//!    refreshed at least every 4 ms (fluid properties five times the
-//!    MAX31865's 50 Hz rate), while the oil's temperature changes over
-//!    seconds;
+//!    machine's losses. None runs on a telemetry tick (at most every second
+//!    tick). Each result is thus refreshed every four non-telemetry ticks
+//!    (4 ms at the default 1 kHz and 2 Hz telemetry: fluid properties five
+//!    times the MAX31865's 50 Hz rate), while the oil's temperature changes
+//!    over seconds. A job the model refuses keeps its previous results and
+//!    flags the estimate `DEGRADED` until it succeeds again;
 //! 4. the twin advances one tick;
 //! 5. flows and the compensation error follow from the twin's state.
 //!
@@ -41,14 +43,16 @@ use crate::{asymptotic, compensation};
 /// Estimator settings in `f32` (from the `[estimator]` section).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EstimatorConfig {
-    /// Tick [s].
-    pub tick: f32,
+    /// The twin's integrator. Its tick is the estimator's (`1 / tick_hz`);
+    /// scheme and steps per tick are [`TwinConfig::SHIPPED`]'s unless
+    /// changed before [`Estimator::new`].
+    pub twin: TwinConfig,
     /// Filter gain per tick, `1 - exp(-tick / tau)`.
     pub filter_gain: f32,
     /// Spike threshold [C].
     pub spike_threshold: f32,
     /// Consecutive rejected samples accepted as a real step.
-    pub spike_limit: u16,
+    pub spike_limit: u32,
     /// Validated temperature range [C].
     pub valid: (f32, f32),
     /// Range where the oil model is used at all [C].
@@ -70,16 +74,32 @@ impl EstimatorConfig {
             0
         };
         Ok(EstimatorConfig {
-            tick: tick as f32,
+            twin: TwinConfig {
+                tick,
+                ..TwinConfig::SHIPPED
+            },
             filter_gain: (1.0 - libm::exp(-tick / raw.filter_time_constant)) as f32,
             spike_threshold: raw.spike_threshold as f32,
-            spike_limit: raw.spike_limit.min(u16::MAX as f64) as u16,
+            // A whole number of at most 65,534 (validated).
+            spike_limit: raw.spike_limit as u32,
             valid: (raw.valid_min as f32, raw.valid_max as f32),
             oil: (raw.oil_min as f32, raw.oil_max as f32),
             telemetry_every,
             // Half a second without a usable sample (at least ten ticks).
             stale_after: (libm::round(raw.tick_hz * 0.5) as u32).max(10),
         })
+    }
+
+    /// Tick [s].
+    pub fn tick(&self) -> f32 {
+        self.twin.tick as f32
+    }
+
+    /// Ticks between samples of a source that delivers one every `period`
+    /// [s] (at least one).
+    pub fn ticks_per(&self, period: f32) -> u32 {
+        let n = period / self.tick() + 0.5;
+        if n >= 1.0 { n as u32 } else { 1 }
     }
 }
 
@@ -257,13 +277,13 @@ pub struct Estimator {
     /// Last accepted sample [C] (the filter's input).
     held: f32,
     /// Consecutive out-of-band samples agreeing with each other.
-    spikes: u16,
+    spikes: u32,
     /// The last out-of-band sample [C].
     candidate: f32,
-    /// The oil model refused the last temperature it was asked for (the
-    /// previous properties stay in force): the estimate is degraded until a
-    /// refresh succeeds.
-    model_refused: bool,
+    /// Jobs whose last run failed, one bit per [`Job`] (the oil model
+    /// refused the temperature: the previous results stay in force). The
+    /// estimate is degraded until each of them succeeds again.
+    failed_jobs: u8,
     since_sample: u32,
     tick: u32,
     monotonic: bool,
@@ -276,10 +296,11 @@ pub struct Estimator {
     last: Option<StateEstimate>,
 }
 
-/// Results that depend on the temperature only. Each tick refreshes one of
-/// them (none on a telemetry tick), so they are at most four ticks old,
-/// while the oil's temperature changes over seconds, and the cost of a
-/// tick stays bounded by the twin plus the largest single job.
+/// Results that depend on the temperature only. Each tick that is not a
+/// telemetry tick refreshes one of them, so each is refreshed every four
+/// such ticks (telemetry is at most every second tick, validated), while
+/// the oil's temperature changes over seconds, and the cost of a tick stays
+/// bounded by the twin plus the largest single job.
 #[derive(Clone, Copy, Debug)]
 struct Statics {
     /// Oil state and derivatives at `temperature`.
@@ -303,8 +324,9 @@ struct Statics {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Job {
     /// Oil properties (one Walther evaluation) for the twin and the flows:
-    /// the "fluid properties at the sensor rate", here at least
-    /// every 4 ms, five times the MAX31865's 50 Hz.
+    /// the "fluid properties at the sensor rate", here every four
+    /// non-telemetry ticks (4 ms at the defaults), five times the
+    /// MAX31865's 50 Hz.
     Fluid,
     /// Closed-form equilibrium and `dx/dt` (Eqs. 5, 31).
     Equilibrium,
@@ -325,23 +347,23 @@ impl Job {
             Job::Losses => Job::Fluid,
         }
     }
+
+    /// This job's bit in `Estimator::failed_jobs`.
+    fn bit(self) -> u8 {
+        1 << (self as u8)
+    }
 }
 
 impl Estimator {
     /// An estimator at rest in the equilibrium of `initial` [C], which must
     /// be a temperature the oil model accepts. Eq. (32) is checked once here
     /// over the validated range (201 samples).
-    pub fn new(
-        params: &Params<f32>,
-        config: EstimatorConfig,
-        twin: TwinConfig,
-        initial: f32,
-    ) -> Result<Self, ModelError> {
+    pub fn new(params: &Params<f32>, config: EstimatorConfig, initial: f32) -> Result<Self, ModelError> {
         let (lo, hi) = config.valid;
         let monotonic = asymptotic::monotonicity(params, lo, hi, 201)
             .map(|m| m.monotonic)
             .unwrap_or(false);
-        let twin = Twin::new(params, twin, initial)?;
+        let twin = Twin::new(params, config.twin, initial)?;
         let machine_mu_ref = match &params.machine {
             Some(m) => Some(params.oil.state(m.leakage_temperature)?.dynamic_viscosity),
             None => None,
@@ -370,7 +392,7 @@ impl Estimator {
             held: initial,
             spikes: 0,
             candidate: initial,
-            model_refused: false,
+            failed_jobs: 0,
             since_sample: 0,
             tick: 0,
             monotonic,
@@ -519,9 +541,9 @@ impl Estimator {
         if !self.telemetry_due() {
             let job = self.next_job;
             self.next_job = job.next();
-            // A temperature the oil model refuses leaves the previous
-            // properties in force; the estimate goes on, flagged, until a
-            // refresh of the fluid properties succeeds again.
+            // A temperature the model refuses leaves the job's previous
+            // results in force; the estimate goes on, flagged, until the
+            // job succeeds again.
             match Self::run_job(
                 job,
                 &self.params,
@@ -530,12 +552,11 @@ impl Estimator {
                 t,
                 &mut self.statics,
             ) {
-                Ok(()) if job == Job::Fluid => self.model_refused = false,
-                Ok(()) => {}
-                Err(_) => self.model_refused = true,
+                Ok(()) => self.failed_jobs &= !job.bit(),
+                Err(_) => self.failed_jobs |= job.bit(),
             }
         }
-        if self.model_refused {
+        if self.failed_jobs != 0 {
             flags.insert(Flags::DEGRADED);
         }
         let p = &self.params;

@@ -476,7 +476,10 @@ mod fixed_point {
             );
             Fix(FixedI32::<F>::from_bits(1i32 << (F::U32 - 1)))
         };
-        const TWO: Self = Fix(FixedI32::<F>::from_bits(2i32 << F::U32));
+        const TWO: Self = {
+            assert!(F::U32 <= 29, "fixed-point formats need three integer bits to hold 2");
+            Fix(FixedI32::<F>::from_bits(2i32 << F::U32))
+        };
         const NAME: &'static str = "fixed-i32";
 
         #[inline]

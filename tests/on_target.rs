@@ -151,7 +151,7 @@ mod tests {
         sensor.device_mut().bus_error = true;
         assert!(sensor.read() == Err(SensorFault::Bus));
         let config = EstimatorConfig::new(&RAW_PARAMS.estimator).unwrap();
-        let mut est = Estimator::new(p, config, TwinConfig::SHIPPED, 45.0).unwrap();
+        let mut est = Estimator::new(p, config, 45.0).unwrap();
         for sample in [
             Err(SensorFault::Bus),
             Ok(Some(f32::NAN)),

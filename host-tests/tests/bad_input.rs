@@ -124,6 +124,32 @@ fn non_physical_values_name_the_field_and_the_rule() {
 }
 
 #[test]
+fn estimator_settings_the_loop_cannot_honour_are_rejected() {
+    let cases: &[(&str, &str)] = &[
+        // Counted samples.
+        ("spike_limit = 2.5", "estimator.spike_limit = 2.5: must be a whole number"),
+        // The counter must be able to exceed the limit.
+        (
+            "spike_limit = 65535",
+            "estimator.spike_limit = 65535: must lie in [0, 65534]",
+        ),
+        // Telemetry every tick would starve the rotating jobs.
+        (
+            "telemetry_hz = 1000",
+            "estimator.telemetry_hz = 1000: must lie in [0, 500]",
+        ),
+        (
+            "tick_hz = 100\ntelemetry_hz = 60",
+            "estimator.telemetry_hz = 60: must lie in [0, 50]",
+        ),
+    ];
+    for (lines, message) in cases {
+        let text = format!("{}\n[estimator]\n{lines}\n", preset_text());
+        assert_eq!(param_error(&text).to_string(), *message, "{lines}");
+    }
+}
+
+#[test]
 fn unknown_keys_wrong_types_and_partial_sections_are_errors() {
     let typo = preset_text().replace("spring_rate", "spring_rat");
     assert!(matches!(params_file::parse(&typo), Err(LoadError::UnknownKey(k)) if k == "plunger.spring_rat"));

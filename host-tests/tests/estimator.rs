@@ -13,7 +13,7 @@ fn setup(initial: f32) -> (Params<f32>, EstimatorConfig, Estimator) {
     let raw = compensator_cli::load(&repo_root().join("presets/paper.toml")).unwrap();
     let p = Params::<f32>::new(&raw).unwrap();
     let cfg = EstimatorConfig::new(&raw.estimator).unwrap();
-    let est = Estimator::new(&p, cfg, TwinConfig::SHIPPED, initial).unwrap();
+    let est = Estimator::new(&p, cfg, initial).unwrap();
     (p, cfg, est)
 }
 
@@ -78,7 +78,7 @@ fn the_estimate_follows_the_twin_driven_directly() {
 fn the_filter_has_the_configured_time_constant() {
     let (_, cfg, mut est) = setup(50.0);
     // A 4 C step (below the 5 C spike threshold): 63 % after tau = 0.2 s.
-    let ticks = (0.2 / cfg.tick).round() as usize;
+    let ticks = (0.2 / cfg.tick()).round() as usize;
     let e = run(&mut est, ticks, Ok(Some(54.0)));
     let frac = (e.temperature - 50.0) / 4.0;
     assert!((frac - 0.632).abs() < 0.01, "{frac}");
@@ -152,6 +152,20 @@ fn a_temperature_the_oil_model_refuses_degrades_without_nan() {
     let e2 = run(&mut est, 500, Ok(Some(140.0)));
     assert!(e2.flags.contains(Flags::DEGRADED), "{:?}", e2.flags);
     assert!(e2.is_finite() && e.is_finite());
+}
+
+#[test]
+fn the_twin_steps_at_the_configured_tick() {
+    let raw = compensator_cli::load(&repo_root().join("presets/paper.toml")).unwrap();
+    let p = Params::<f32>::new(&raw).unwrap();
+    let mut settings = raw.estimator;
+    settings.tick_hz = 250.0;
+    let cfg = EstimatorConfig::new(&settings).unwrap();
+    assert_eq!(cfg.tick(), 0.004);
+    assert_eq!(cfg.ticks_per(0.02), 5);
+    let est = Estimator::new(&p, cfg, 40.0).unwrap();
+    assert_eq!(est.twin().config().tick, 0.004);
+    assert_eq!(est.twin().config().scheme, TwinConfig::SHIPPED.scheme);
 }
 
 #[test]

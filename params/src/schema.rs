@@ -108,12 +108,12 @@ schema! {
     tick_hz: "estimator"."tick_hz" ["Hz"] = Some(1000.0), "Estimator tick rate.";
     filter_time_constant: "estimator"."filter_time_constant" ["s"] = Some(0.2), "First-order temperature filter time constant.";
     spike_threshold: "estimator"."spike_threshold" ["C"] = Some(5.0), "A sample further than this from the filtered value is a spike.";
-    spike_limit: "estimator"."spike_limit" ["-"] = Some(5.0), "Consecutive agreeing out-of-band samples rejected before the next one is taken as a real step.";
+    spike_limit: "estimator"."spike_limit" ["-"] = Some(5.0), "Consecutive agreeing out-of-band samples rejected before the next one is taken as a real step (a whole number, at most 65534).";
     valid_min: "estimator"."valid_min" ["C"] = Some(26.0), "Lower end of the validated temperature range.";
     valid_max: "estimator"."valid_max" ["C"] = Some(78.0), "Upper end of the validated temperature range.";
     oil_min: "estimator"."oil_min" ["C"] = Some(-20.0), "Coldest temperature the fluid model accepts.";
     oil_max: "estimator"."oil_max" ["C"] = Some(150.0), "Hottest temperature the fluid model accepts.";
-    telemetry_hz: "estimator"."telemetry_hz" ["Hz"] = Some(2.0), "Telemetry rate.";
+    telemetry_hz: "estimator"."telemetry_hz" ["Hz"] = Some(2.0), "Telemetry rate (0: none; at most tick_hz / 2).";
     rtd_r0: "estimator"."rtd_r0" ["ohm"] = Some(100.0), "RTD resistance at 0 C (PT100).";
     rtd_reference: "estimator"."rtd_reference" ["ohm"] = Some(430.0), "MAX31865 reference resistor.";
 }
@@ -153,6 +153,8 @@ pub enum Problem {
     Inconsistent(&'static str),
     /// Representable in `f64` but not in the scalar type asked for.
     NotRepresentable(&'static str),
+    /// A fraction where a count is needed.
+    NotWhole,
 }
 
 /// A rejected parameter: which field (`section.key`), its value, and why.
@@ -181,6 +183,7 @@ impl fmt::Display for ParamError {
             Problem::NotRepresentable(ty) => {
                 write!(f, "{} = {}: not representable as {}", self.field, self.value, ty)
             }
+            Problem::NotWhole => write!(f, "{} = {}: must be a whole number", self.field, self.value),
         }
     }
 }
@@ -224,6 +227,17 @@ fn within(field: &'static str, v: f64, min: f64, max: f64) -> Result<f64, ParamE
         Ok(v)
     } else {
         Err(err(field, v, Problem::OutOfRange { min, max }))
+    }
+}
+
+/// A whole number (counts).
+fn whole(field: &'static str, v: f64) -> Result<f64, ParamError> {
+    let v = finite(field, v)?;
+    // Exact for |v| < 2^63 (the saturating cast changes any fraction).
+    if v as i64 as f64 == v {
+        Ok(v)
+    } else {
+        Err(err(field, v, Problem::NotWhole))
     }
 }
 
@@ -337,7 +351,8 @@ impl RawEstimator {
         within(p(0), self.tick_hz, 1.0, 100_000.0)?;
         positive(p(1), self.filter_time_constant)?;
         positive(p(2), self.spike_threshold)?;
-        within(p(3), self.spike_limit, 0.0, 1.0e6)?;
+        within(p(3), self.spike_limit, 0.0, 65_534.0)?;
+        whole(p(3), self.spike_limit)?;
         within(p(6), self.oil_min, -60.0, 300.0)?;
         within(p(7), self.oil_max, -60.0, 300.0)?;
         if self.oil_max <= self.oil_min {
@@ -356,7 +371,9 @@ impl RawEstimator {
                 Problem::Inconsistent("not above estimator.valid_min"),
             ));
         }
-        within(p(8), self.telemetry_hz, 0.0, self.tick_hz)?;
+        // A telemetry tick runs none of the estimator's rotating jobs: at
+        // most every second tick, so that they keep being refreshed.
+        within(p(8), self.telemetry_hz, 0.0, self.tick_hz / 2.0)?;
         positive(p(9), self.rtd_r0)?;
         positive(p(10), self.rtd_reference)?;
         Ok(())

@@ -147,7 +147,7 @@ fn pieces(params: &Params<f32>) {
     let Ok(config) = EstimatorConfig::new(&RAW_PARAMS.estimator) else {
         return;
     };
-    let Ok(mut est) = Estimator::new(params, config, TwinConfig::SHIPPED, 40.0) else {
+    let Ok(mut est) = Estimator::new(params, config, 40.0) else {
         return;
     };
     let e = est.tick(Ok(Some(40.0)));
@@ -163,7 +163,7 @@ fn pieces(params: &Params<f32>) {
     for telemetry in [true, false] {
         let mut config = config;
         config.telemetry_every = if telemetry { 100 } else { 0 };
-        let Ok(mut est) = Estimator::new(params, config, TwinConfig::SHIPPED, 30.0) else {
+        let Ok(mut est) = Estimator::new(params, config, 30.0) else {
             return;
         };
         let (mut total, mut worst, mut worst_tick) = (0u32, 0u32, 0u32);

@@ -29,7 +29,6 @@
 #![no_main]
 
 use compensator::Params;
-use compensator::dynamics::TwinConfig;
 use compensator::estimator::{Estimator, EstimatorConfig};
 use compensator::sensor::TemperatureSource;
 use compensator::sensor::max31865::{Mains, Max31865, Settings, Wires};
@@ -59,8 +58,6 @@ fn SysTick() {
 
 defmt::timestamp!("{=u32:ms}", TICKS.load(Ordering::Relaxed));
 
-/// Conversion period of the MAX31865 with its 50 Hz filter [s].
-const SENSOR_PERIOD: f32 = 0.020;
 
 #[entry]
 fn main() -> ! {
@@ -116,7 +113,7 @@ fn main() -> ! {
             config.valid.0
         }
     };
-    let mut estimator = match Estimator::new(&params, config, TwinConfig::SHIPPED, start) {
+    let mut estimator = match Estimator::new(&params, config, start) {
         Ok(e) => e,
         Err(e) => defmt::panic!("estimator: {}", e),
     };
@@ -124,17 +121,21 @@ fn main() -> ! {
         "compensator estimator: parameters {=str}, start {=f32} C, tick {=f32} ms",
         PARAMS_SOURCE,
         start,
-        config.tick * 1e3
+        config.tick() * 1e3
     );
 
-    let tick_hz = 1.0 / config.tick;
+    // SysTick counts 24 bits: at 168 MHz a tick of at most ~99.8 ms.
+    let reload = (sysclk as f32 * config.tick()) as u32 - 1;
+    if reload > 0x00FF_FFFF {
+        defmt::panic!("estimator.tick_hz: below what SysTick can time at {=u32} Hz", sysclk);
+    }
     cp.SYST.set_clock_source(SystClkSource::Core);
-    cp.SYST.set_reload((sysclk as f32 / tick_hz) as u32 - 1);
+    cp.SYST.set_reload(reload);
     cp.SYST.clear_current();
     cp.SYST.enable_interrupt();
     cp.SYST.enable_counter();
 
-    let sensor_every = ((SENSOR_PERIOD / config.tick + 0.5) as u32).max(1);
+    let sensor_every = config.ticks_per(settings.mains.conversion_period());
     let mut done = TICKS.load(Ordering::Relaxed);
     loop {
         while TICKS.load(Ordering::Relaxed) == done {

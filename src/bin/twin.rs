@@ -14,7 +14,6 @@
 #![no_std]
 #![no_main]
 
-use compensator::dynamics::TwinConfig;
 use compensator::dynamics::linear::linearise;
 use compensator::equilibrium::{balance_temperature, equilibrium};
 use compensator::estimator::{Estimator, EstimatorConfig, Flags};
@@ -30,8 +29,6 @@ use defmt::{error, info};
 include!(concat!(env!("OUT_DIR"), "/params.rs"));
 include!(concat!(env!("OUT_DIR"), "/replay.rs"));
 
-/// Conversion period of the MAX31865 with its 50 Hz filter [s].
-const SENSOR_PERIOD: f32 = 0.020;
 /// Numerical margin of the checkpoints beyond the reference's interval:
 /// displacement, as a fraction of the stroke (f32 steady state: ~2e-6).
 const X_TOLERANCE: f32 = 1e-5;
@@ -173,17 +170,17 @@ fn replay(params: &Params<f32>, config: EstimatorConfig) -> bool {
         overflow: 0,
     };
     checks.check(sensor.configure().is_ok(), "sensor configuration", 0.0);
-    let mut estimator = match Estimator::new(params, config, TwinConfig::SHIPPED, start) {
+    let mut estimator = match Estimator::new(params, config, start) {
         Ok(e) => e,
         Err(e) => {
             error!("estimator: {}", e);
             return false;
         }
     };
-    let tick = config.tick;
+    let tick = config.tick();
     let end = REPLAY_PIECES[REPLAY_PIECES.len() - 1].1;
     let ticks = (end / tick) as u32;
-    let sensor_every = ((SENSOR_PERIOD / tick + 0.5) as u32).max(1);
+    let sensor_every = config.ticks_per(settings.mains.conversion_period());
     let mut seen = [Flags::empty(); REPLAY_FAULTS.len()];
     let mut next_checkpoint = 0;
     let mut out_of_range_seen = false;

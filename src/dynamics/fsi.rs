@@ -38,7 +38,7 @@
 
 use super::schemes::{OdeSystem, ShiftedSolve};
 use crate::equilibrium::Equilibrium;
-use crate::error::{ModelError, finite};
+use crate::error::{ModelError, finite, represent};
 use crate::fluid::FluidState;
 use crate::params::Params;
 use crate::scalar::{Float, Real};
@@ -123,13 +123,17 @@ pub struct Coefficients<T> {
     pub two_zeta: T,
     /// `xi0 = x0 / L` (preload).
     pub xi0: T,
-    /// `omega_a0 = T Q* beta / (dp V_a0)`.
+    /// `omega_a0 = T Q* beta / (dp V_a0)`. The one coefficient allowed to
+    /// saturate in fixed point (above 2,048 in Q12.20, stiff chambers): only
+    /// the unscaled [`OdeSystem::rhs`] and [`OdeSystem::jacobian`] use it
+    /// (explicit schemes, the `f32` linearisation); the Rosenbrock stage
+    /// equations are row-scaled and use `inv_omega_a0` instead.
     pub omega_a0: T,
     /// `1 / omega_a0`.
     pub inv_omega_a0: T,
     /// `eps_a = A_p L / V_a0`.
     pub eps_a: T,
-    /// `omega_b0 = T Q* beta / (dp V_b0)`.
+    /// `omega_b0 = T Q* beta / (dp V_b0)` (may saturate, as `omega_a0`).
     pub omega_b0: T,
     /// `1 / omega_b0`.
     pub inv_omega_b0: T,
@@ -219,14 +223,8 @@ impl<F: Float> Model<F> {
         let omega = |v: f64| time * self.q_star.to_f64() * p.oil.bulk_modulus.to_f64() / (pressure * v);
         let a_x = self.a_x.to_f64();
         let phi = pl.area().to_f64() * pressure / (pl.spring_rate.to_f64() * length);
-        let c = |v: f64, what: &'static str| -> Result<T, ModelError> {
-            let t = T::from_f64(v);
-            if v.is_finite() && t.is_finite() {
-                Ok(t)
-            } else {
-                Err(ModelError::NonFinite(what))
-            }
-        };
+        let c = |v: f64, what: &'static str| represent::<f64, T>(v, what);
+        let saturating = |v: f64, what: &'static str| finite(T::from_f64(finite(v, what)?), what);
         Ok(Coefficients {
             a_x: c(a_x, "a_x")?,
             inv_a_x: c(1.0 / a_x, "1/a_x")?,
@@ -236,10 +234,10 @@ impl<F: Float> Model<F> {
                 "zeta",
             )?,
             xi0: c(pl.preload.to_f64() / length, "preload")?,
-            omega_a0: c(omega(p.volume_a.to_f64()), "omega_a")?,
+            omega_a0: saturating(omega(p.volume_a.to_f64()), "omega_a")?,
             inv_omega_a0: c(1.0 / omega(p.volume_a.to_f64()), "omega_a")?,
             eps_a: c(swept / p.volume_a.to_f64(), "eps_a")?,
-            omega_b0: c(omega(p.volume_b.to_f64()), "omega_b")?,
+            omega_b0: saturating(omega(p.volume_b.to_f64()), "omega_b")?,
             inv_omega_b0: c(1.0 / omega(p.volume_b.to_f64()), "omega_b")?,
             eps_b: c(swept / p.volume_b.to_f64(), "eps_b")?,
             sigma: c(pl.area().to_f64() * velocity / self.q_star.to_f64(), "sigma")?,

@@ -8,7 +8,7 @@
 //!   eigenvalue (120 in all), else [`ModelError::NoConvergence`].
 //! * [`hurwitz_stable`]: the same stability verdict from the characteristic
 //!   polynomial's Routh-Hurwitz conditions, ~100 multiplications, no
-//!   iteration: what the estimator evaluates every tick.
+//!   iteration: what the estimator evaluates (one of its rotating jobs).
 //!
 //! The Jacobian is taken in the model's units (better conditioned than SI);
 //! eigenvalues are invariant under the diagonal change of units, and are

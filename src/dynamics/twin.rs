@@ -14,7 +14,7 @@
 use super::fsi::{Coefficients, Contact, DynamicState, Fsi, Model, apply_stops, contact_for};
 use super::schemes::{Scheme, StepError, Stepper};
 use crate::equilibrium::equilibrium;
-use crate::error::ModelError;
+use crate::error::{ModelError, represent};
 use crate::fluid::FluidState;
 use crate::params::Params;
 use crate::scalar::{Float, Real};
@@ -113,12 +113,8 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// As [`Twin::set_temperature`] from an already evaluated fluid state.
     pub fn set_fluid(&mut self, fluid: &FluidState<F>) -> Result<(), ModelError> {
         let (q_t, g_l) = self.model.hydraulic(fluid)?;
-        let (q_t, g_l) = (q_t.to_real::<T>(), g_l.to_real::<T>());
-        if !(q_t.is_finite() && g_l.is_finite()) {
-            return Err(ModelError::NonFinite("hydraulic coefficients"));
-        }
-        self.coefficients.q_t = q_t;
-        self.coefficients.g_l = g_l;
+        self.coefficients.q_t = represent(q_t, "q_t")?;
+        self.coefficients.g_l = represent(g_l, "g_l")?;
         Ok(())
     }
 

@@ -84,6 +84,16 @@ pub enum Mains {
     Hz60,
 }
 
+impl Mains {
+    /// Time between two readings in automatic conversion mode [s].
+    pub fn conversion_period(self) -> f32 {
+        match self {
+            Mains::Hz50 => 1.0 / 50.0,
+            Mains::Hz60 => 1.0 / 60.0,
+        }
+    }
+}
+
 /// Driver errors.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

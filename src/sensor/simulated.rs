@@ -117,7 +117,7 @@ impl SpiDevice for SimulatedMax31865 {
                                 if a & 0x80 != 0 {
                                     self.write_register(a, b);
                                 }
-                                addr = Some((a & 0x80) | ((a + 1) & 0x07));
+                                addr = Some((a & 0x80) | (a.wrapping_add(1) & 0x07));
                             }
                         }
                     }
@@ -126,7 +126,7 @@ impl SpiDevice for SimulatedMax31865 {
                     for byte in buf.iter_mut() {
                         let a = addr.unwrap_or(0);
                         *byte = self.register(a);
-                        addr = Some((a + 1) & 0x07);
+                        addr = Some(a.wrapping_add(1) & 0x07);
                     }
                 }
                 Operation::Transfer(_, _) | Operation::TransferInPlace(_) => return Err(BusError),
