@@ -127,7 +127,10 @@ fn non_physical_values_name_the_field_and_the_rule() {
 fn estimator_settings_the_loop_cannot_honour_are_rejected() {
     let cases: &[(&str, &str)] = &[
         // Counted samples.
-        ("spike_limit = 2.5", "estimator.spike_limit = 2.5: must be a whole number"),
+        (
+            "spike_limit = 2.5",
+            "estimator.spike_limit = 2.5: must be a whole number",
+        ),
         // The counter must be able to exceed the limit.
         (
             "spike_limit = 65535",

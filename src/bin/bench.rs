@@ -49,24 +49,16 @@ fn counts<R>(f: impl FnOnce() -> R) -> (R, u32) {
     (r, t0.wrapping_sub(t1) & 0x00FF_FFFF)
 }
 
-fn twin_cost<T: Real>(params: &Params<f32>, scheme: Scheme, substeps: u8, scalar: &str) {
+/// Measures 200 ticks of one configuration. An error stops the image with
+/// a failure: a missing row must never pass for a cheap one.
+fn twin_cost<T: Real>(params: &Params<f32>, scheme: Scheme, substeps: u8, scalar: &str) -> Result<(), &'static str> {
     let config = TwinConfig {
         scheme,
         tick: 1e-3,
         substeps,
     };
-    let Ok(mut twin) = Twin::<f32, T>::new(params, config, 30.0) else {
-        error!(
-            "twin {=str} {=str} x{=u8}: cannot start",
-            scheme.name(),
-            scalar,
-            substeps
-        );
-        return;
-    };
-    if twin.set_temperature(40.0).is_err() {
-        return;
-    }
+    let mut twin = Twin::<f32, T>::new(params, config, 30.0).map_err(|_| "twin cannot start")?;
+    twin.set_temperature(40.0).map_err(|_| "twin refuses 40 C")?;
     // The first ticks after a temperature step are the most expensive
     // (the release from the stop takes a second step); all are measured.
     let mut total = 0u32;
@@ -88,10 +80,11 @@ fn twin_cost<T: Real>(params: &Params<f32>, scheme: Scheme, substeps: u8, scalar
         worst,
         !failed
     );
+    Ok(())
 }
 
 #[cfg(target_abi = "eabihf")]
-fn pieces(params: &Params<f32>) {
+fn pieces(params: &Params<f32>) -> Result<(), &'static str> {
     use compensator::asymptotic::sensitivity_at;
     use compensator::dynamics::fsi::{Contact, Fsi, Model};
     use compensator::dynamics::linear::hurwitz_stable;
@@ -103,17 +96,14 @@ fn pieces(params: &Params<f32>) {
     let t = black_box(55.5f32);
     let (point, c) = counts(|| params.oil.point(black_box(t)));
     info!("[measure] piece name=fluid-point total={=u32}", c);
-    let Ok(point) = point else { return };
+    let point = point.map_err(|_| "fluid point")?;
     let (eq, c) = counts(|| equilibrium_for(params, point.state, a_parameter(params, &point.state)));
     info!("[measure] piece name=equilibrium total={=u32}", c);
     let (_, c) = counts(|| black_box(sensitivity_at(params, &point)));
     info!("[measure] piece name=sensitivity total={=u32}", c);
-    let (Ok(model), Ok(eq)) = (Model::new(params), eq) else {
-        return;
-    };
-    let Ok(coef) = model.coefficients::<f32>(&point.state) else {
-        return;
-    };
+    let eq = eq.map_err(|_| "equilibrium")?;
+    let model = Model::new(params).map_err(|_| "model")?;
+    let coef = model.coefficients::<f32>(&point.state).map_err(|_| "coefficients")?;
     let (_, c) = counts(|| {
         let y: [f32; 4] = model.equilibrium_state(&eq);
         black_box(hurwitz_stable(
@@ -144,12 +134,8 @@ fn pieces(params: &Params<f32>) {
     }
 
     // Telemetry packing alone: one estimate, encoded by defmt.
-    let Ok(config) = EstimatorConfig::new(&RAW_PARAMS.estimator) else {
-        return;
-    };
-    let Ok(mut est) = Estimator::new(params, config, 40.0) else {
-        return;
-    };
+    let config = EstimatorConfig::new(&RAW_PARAMS.estimator).map_err(|_| "estimator settings")?;
+    let mut est = Estimator::new(params, config, 40.0).map_err(|_| "estimator cannot start")?;
     let e = est.tick(Ok(Some(40.0)));
     let (_, c) = counts(|| info!("estimate {}", black_box(e)));
     info!("[measure] piece name=telemetry total={=u32}", c);
@@ -157,15 +143,10 @@ fn pieces(params: &Params<f32>) {
     // The whole estimator tick, as the firmware runs it: a sample every
     // 20 ticks, a 30 -> 40 C step; with telemetry packed at its cadence
     // (every 100 ticks here), then without telemetry.
-    let Ok(config) = EstimatorConfig::new(&RAW_PARAMS.estimator) else {
-        return;
-    };
     for telemetry in [true, false] {
         let mut config = config;
         config.telemetry_every = if telemetry { 100 } else { 0 };
-        let Ok(mut est) = Estimator::new(params, config, 30.0) else {
-            return;
-        };
+        let mut est = Estimator::new(params, config, 30.0).map_err(|_| "estimator cannot start")?;
         let (mut total, mut worst, mut worst_tick) = (0u32, 0u32, 0u32);
         let n = 1000u32;
         for k in 0..n {
@@ -193,6 +174,7 @@ fn pieces(params: &Params<f32>) {
             worst_tick
         );
     }
+    Ok(())
 }
 
 #[entry]
@@ -227,18 +209,27 @@ fn main() -> ! {
         (Scheme::Rk4, 32),
         (Scheme::Rk4, 64),
     ];
-    for (scheme, substeps) in configs {
+    let run = || -> Result<(), &'static str> {
+        for (scheme, substeps) in configs {
+            #[cfg(target_abi = "eabihf")]
+            twin_cost::<f32>(&params, scheme, substeps, "f32")?;
+            twin_cost::<Fixed>(&params, scheme, substeps, "q12.20")?;
+            #[cfg(not(target_abi = "eabihf"))]
+            if scheme == Scheme::Ros3 && substeps == 2 {
+                twin_cost::<f32>(&params, scheme, substeps, "f32-soft")?;
+            }
+        }
         #[cfg(target_abi = "eabihf")]
-        twin_cost::<f32>(&params, scheme, substeps, "f32");
-        twin_cost::<Fixed>(&params, scheme, substeps, "q12.20");
-        #[cfg(not(target_abi = "eabihf"))]
-        if scheme == Scheme::Ros3 && substeps == 2 {
-            twin_cost::<f32>(&params, scheme, substeps, "f32-soft");
+        pieces(&params)?;
+        Ok(())
+    };
+    match run() {
+        Ok(()) => exit(true),
+        Err(what) => {
+            error!("bench: {=str}", what);
+            exit(false)
         }
     }
-    #[cfg(target_abi = "eabihf")]
-    pieces(&params);
-    exit(true)
 }
 
 fn exit(ok: bool) -> ! {

@@ -58,7 +58,6 @@ fn SysTick() {
 
 defmt::timestamp!("{=u32:ms}", TICKS.load(Ordering::Relaxed));
 
-
 #[entry]
 fn main() -> ! {
     let (Some(dp), Some(mut cp)) = (pac::Peripherals::take(), cortex_m::Peripherals::take()) else {

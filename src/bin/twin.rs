@@ -45,6 +45,19 @@ fn temperature_at(time: f32) -> f32 {
     REPLAY_PIECES[REPLAY_PIECES.len() - 1].3
 }
 
+/// What the replay does to the simulated converter.
+#[derive(Clone, Copy, PartialEq, Eq, defmt::Format)]
+enum Injected {
+    /// +40 C on one sample.
+    Spike,
+    /// The SPI transaction fails.
+    BusError,
+    /// The converter's RTD-high fault (an open RTD).
+    OpenRtd,
+    /// A full-scale code.
+    SaturatedCode,
+}
+
 /// The fault injected at `time` [s], if any (index into `REPLAY_FAULTS`).
 fn fault_at(time: f32) -> Option<usize> {
     REPLAY_FAULTS.iter().position(|&(t0, t1, _, _)| time >= t0 && time < t1)
@@ -204,10 +217,10 @@ fn replay(params: &Params<f32>, config: EstimatorConfig) -> bool {
             sim.forced_code = None;
             if let Some(i) = fault_now {
                 match REPLAY_FAULTS[i].2 {
-                    1 => sim.temperature += 40.0,
-                    2 => sim.bus_error = true,
-                    3 => sim.fault = fault::RTD_HIGH,
-                    _ => sim.forced_code = Some(0x7FFF),
+                    Injected::Spike => sim.temperature += 40.0,
+                    Injected::BusError => sim.bus_error = true,
+                    Injected::OpenRtd => sim.fault = fault::RTD_HIGH,
+                    Injected::SaturatedCode => sim.forced_code = Some(0x7FFF),
                 }
             }
         }
@@ -216,7 +229,7 @@ fn replay(params: &Params<f32>, config: EstimatorConfig) -> bool {
         if let Some(i) = fault_now {
             seen[i].insert(e.flags);
         }
-        if (66.5..68.0).contains(&time) && e.flags.contains(Flags::OUT_OF_RANGE) {
+        if (OUT_OF_RANGE_HOLD.0..OUT_OF_RANGE_HOLD.1).contains(&time) && e.flags.contains(Flags::OUT_OF_RANGE) {
             out_of_range_seen = true;
         }
         if !e.is_finite() {
@@ -255,11 +268,15 @@ fn replay(params: &Params<f32>, config: EstimatorConfig) -> bool {
     }
     checks.check(next_checkpoint == CHECKPOINTS.len(), "every checkpoint reached", end);
     for (i, &(t0, _, kind, flag)) in REPLAY_FAULTS.iter().enumerate() {
-        let ok = seen[i].contains(Flags(flag));
-        info!("injected fault kind {=u8} at {=f32} s raised [{}]", kind, t0, seen[i]);
+        let ok = seen[i].contains(flag);
+        info!("injected {} at {=f32} s raised [{}]", kind, t0, seen[i]);
         checks.check(ok, "the injected fault raised its flag", t0);
     }
-    checks.check(out_of_range_seen, "OUT_OF_RANGE at 90 C", 67.0);
+    checks.check(
+        out_of_range_seen,
+        "OUT_OF_RANGE outside the validated range",
+        OUT_OF_RANGE_HOLD.0,
+    );
     checks.check(nan_ticks == 0, "no NaN in any estimate", end);
     info!("checks: {=u32} passed, {=u32} failed", checks.passed, checks.failures());
     for what in checks.failed.iter() {

@@ -178,7 +178,7 @@ fn cmd_test(args: &[String]) -> Result<i32, String> {
     step("QEMU: the core's tests on the emulated Cortex-M4F");
     firmware::on_target_tests(&tc, &root)?;
     step("QEMU: cost, footprint and stack budgets");
-    bench::check(&tc, &root, &elfs)?;
+    bench::check(&elfs, &run.lines)?;
     eprintln!("\nxtask: all checks passed");
     Ok(0)
 }
