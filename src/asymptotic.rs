@@ -189,10 +189,7 @@ impl<T: Float> Expansion<T> {
         let h2 = T::from_f64(0.75) * h0 / (rho * rho);
 
         // Window flow: eta pi d sqrt(2 dp) x rho^(-1/2)  (Eqs. 22-26).
-        let w = p.slot.discharge_coefficient
-            * T::from_f64(core::f64::consts::PI)
-            * p.slot.diameter
-            * (T::from_f64(2.0) * p.pressure_drop).sqrt();
+        let w = p.slot.window_factor(p.pressure_drop);
         let qt0 = w * x0 * h0;
         let qt1 = w * (x1 * h0 + x0 * h1 * r1);
         let qt2 = w * (x2 * h0 + x1 * h1 * r1 + x0 * (h1 * r2 + half * h2 * r1 * r1));
@@ -258,10 +255,7 @@ pub fn sensitivity_at<T: Float>(params: &Params<T>, point: &FluidPoint<T>) -> Re
     let dx_branch = ph.d1 * a.d1;
     let (x, stop) = clamp_to_stops(ph.value - params.plunger.preload, params.plunger.stroke);
     let dx = if stop == Stop::Free { dx_branch } else { T::ZERO };
-    let w = params.slot.discharge_coefficient
-        * T::from_f64(core::f64::consts::PI)
-        * params.slot.diameter
-        * (T::from_f64(2.0) * params.pressure_drop).sqrt();
+    let w = params.slot.window_factor(params.pressure_drop);
     let inv_sqrt_rho = T::ONE / rho.value.sqrt();
     // Eq. (30): eta pi d sqrt(2 dp / rho) dx/dt - eta pi d x sqrt(2 dp) rho^(-3/2) rho' / 2
     let dq = w * inv_sqrt_rho * dx - w * x * T::from_f64(0.5) * inv_sqrt_rho / rho.value * rho.d1;

@@ -500,16 +500,12 @@ impl Estimator {
             Job::Fluid => {
                 let point = p.oil.point(t)?;
                 twin.set_fluid(&point.state)?;
-                let rho = point.state.density;
-                let root = Real::sqrt(2.0 / rho);
+                let inv_sqrt_rho = 1.0 / Real::sqrt(point.state.density);
                 statics.point = point;
                 statics.capillary_conductance = 1.0 / p.capillary.resistance(point.state.dynamic_viscosity);
-                statics.orifice_factor = p.orifice.discharge_coefficient * p.orifice.area() * root;
-                statics.window_factor = p.slot.discharge_coefficient
-                    * core::f32::consts::PI
-                    * p.slot.diameter
-                    * root
-                    * Real::sqrt(p.pressure_drop);
+                statics.orifice_factor =
+                    p.orifice.discharge_coefficient * p.orifice.area() * core::f32::consts::SQRT_2 * inv_sqrt_rho;
+                statics.window_factor = p.slot.window_factor(p.pressure_drop) * inv_sqrt_rho;
             }
             Job::Equilibrium => {
                 let point = &statics.point;

@@ -10,8 +10,9 @@
 //! [`ModelError::OutOfRange`], as it is where the double exponential
 //! overflows (very cold oil).
 //!
-//! Cost (f32, Cortex-M4F): one `log10`, two `exp10`, a handful of
-//! multiplications: about 250 instructions.
+//! Cost (f32, Cortex-M4F): one `ln_1p`, two `exp10`, a handful of
+//! multiplications: about 300 instructions with the derivatives
+//! (`FluidPoint`, `cargo xtask bench`).
 
 use crate::error::{ModelError, finite};
 use crate::scalar::Float;
@@ -34,13 +35,12 @@ pub const WALTHER_REFERENCE_C: f64 = 40.0;
 /// evaluation therefore uses `u_ref - b log10(1 + (t - t_ref) / T_ref)`
 /// with `u_ref = a - b log10(T_ref)` computed once in `f64` by
 /// [`Oil::new`], and `log1p` for the small logarithm: the `f32` viscosity
-/// is then good to about 3e-7.
+/// is then good to about 3e-7. Walther's constants are therefore private:
+/// `u_ref` is derived from them once.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Oil<T> {
-    /// Walther constant `a` [-].
-    pub walther_a: T,
     /// Walther slope `b` [-].
-    pub walther_b: T,
+    walther_b: T,
     /// Density at 15 C [kg/m^3].
     pub density_15: T,
     /// Volumetric expansion coefficient `e` [1/K].
@@ -94,7 +94,6 @@ impl<T: Float> Oil<T> {
     pub fn new(walther_a: f64, walther_b: f64, density_15: f64, expansion: f64, bulk_modulus: f64) -> Self {
         let u_ref = walther_a - walther_b * libm::log10(WALTHER_REFERENCE_C + KELVIN_OFFSET);
         Oil {
-            walther_a: T::from_f64(walther_a),
             walther_b: T::from_f64(walther_b),
             density_15: T::from_f64(density_15),
             expansion: T::from_f64(expansion),

@@ -84,10 +84,21 @@ impl<T: Float> Slot<T> {
         T::from_f64(core::f64::consts::PI) * self.diameter * x.max(T::ZERO)
     }
 
+    /// `eta pi d sqrt(2 dp)` [m^2/s (kg/m^3)^(1/2)]: the window flow per
+    /// metre of opening times `sqrt(rho)`, so that
+    /// `Q_throt = window_factor(dp) x / sqrt(rho)` (Eq. 7).
+    #[inline]
+    pub fn window_factor(&self, dp: T) -> T {
+        self.discharge_coefficient
+            * T::from_f64(core::f64::consts::PI)
+            * self.diameter
+            * (T::from_f64(2.0) * dp.max(T::ZERO)).sqrt()
+    }
+
     /// Flow through the window (Eq. 7): `eta pi d x sqrt(2 dp / rho)` [m^3/s].
     #[inline]
     pub fn flow(&self, x: T, dp: T, density: T) -> T {
-        self.discharge_coefficient * self.area(x) * (T::from_f64(2.0) * dp.max(T::ZERO) / density).sqrt()
+        self.window_factor(dp) * x.max(T::ZERO) / density.sqrt()
     }
 }
 

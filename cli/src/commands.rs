@@ -269,7 +269,7 @@ pub fn paper(path: &Path, data: &Path) -> Result<String, CliError> {
         o,
         "RMS {:.4} bar, max {:.4} bar over {} points",
         crate::lsq::rms(&r1),
-        r1.iter().fold(0.0f64, |m, v| m.max(v.abs())),
+        crate::lsq::max_abs(&r1),
         r1.len()
     );
 
@@ -291,11 +291,11 @@ pub fn paper(path: &Path, data: &Path) -> Result<String, CliError> {
         o,
         "RMS {:.4} mm, max {:.4} mm",
         crate::lsq::rms(&r2),
-        r2.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+        crate::lsq::max_abs(&r2)
     );
 
-    let (best, at_balance) = paper::asymptotic_search(&p, &t2, 26.0, 80.0);
     let balance = find_balance(&raw, &p).ok();
+    let (best, at_balance) = paper::asymptotic_search(&p, &t2, 26.0, 80.0, balance);
     let _ = writeln!(o, "\n## Table 2 \"asym\" column: which expansion reproduces it");
     if let Some(tb) = balance {
         let _ = writeln!(o, "balance temperature (p_a = p_b, Eq. 2): {tb:.2} C");

@@ -4,8 +4,10 @@
 use crate::commands::{CliError, load_params};
 use crate::csv::Table;
 use crate::temps;
+use compensator::ModelError;
 use compensator::dynamics::linear::linearise;
 use compensator::dynamics::reduced::ReducedTwin;
+use compensator::dynamics::schemes::StepError;
 use compensator::dynamics::{DynamicState, Scheme, Twin, TwinConfig};
 use compensator::equilibrium::equilibrium;
 use compensator::scalar::Fixed;
@@ -65,28 +67,70 @@ fn widen<F: Float>(s: DynamicState<F>) -> DynamicState<f64> {
     }
 }
 
+/// What [`run`] drives: the full twin or the reduced one.
+trait Ticking<F> {
+    fn set_temperature(&mut self, temperature: F) -> Result<(), ModelError>;
+    fn tick(&mut self) -> Result<(), StepError>;
+    fn state(&self) -> DynamicState<F>;
+}
+
+impl<F: Float, T: Real> Ticking<F> for Twin<F, T> {
+    fn set_temperature(&mut self, temperature: F) -> Result<(), ModelError> {
+        Twin::set_temperature(self, temperature)
+    }
+    fn tick(&mut self) -> Result<(), StepError> {
+        Twin::tick(self).map(|_| ())
+    }
+    fn state(&self) -> DynamicState<F> {
+        Twin::state(self)
+    }
+}
+
+impl<F: Float, T: Real> Ticking<F> for ReducedTwin<F, T> {
+    fn set_temperature(&mut self, temperature: F) -> Result<(), ModelError> {
+        ReducedTwin::set_temperature(self, temperature)
+    }
+    fn tick(&mut self) -> Result<(), StepError> {
+        ReducedTwin::tick(self)
+    }
+    fn state(&self) -> DynamicState<F> {
+        ReducedTwin::state(self)
+    }
+}
+
+/// `n` ticks of `config.tick` along `prof`, from a twin at rest at its
+/// start, with the coefficients at each tick's midpoint (a ramp followed
+/// to second order).
+fn run<F: Float>(
+    twin: Result<impl Ticking<F>, ModelError>,
+    tick: f64,
+    prof: &Profile,
+    n: usize,
+) -> Result<Response, CliError> {
+    let mut twin = twin.map_err(|e| CliError::Input(format!("--from: {e}")))?;
+    let mut out = Response {
+        time: vec![0.0],
+        state: vec![widen(twin.state())],
+    };
+    for k in 0..n {
+        let t_mid = prof.temperature((k as f64 + 0.5) * tick);
+        twin.set_temperature(F::from_f64(t_mid))
+            .map_err(|e| CliError::Input(format!("temperature {t_mid} C: {e}")))?;
+        twin.tick().map_err(|e| CliError::Failed(format!("tick {k}: {e:?}")))?;
+        out.time.push((k + 1) as f64 * tick);
+        out.state.push(widen(twin.state()));
+    }
+    Ok(out)
+}
+
 fn run_twin<F: Float, T: Real>(
     params: &Params<F>,
     config: TwinConfig,
     prof: &Profile,
     n: usize,
 ) -> Result<Response, CliError> {
-    let mut twin = Twin::<F, T>::new(params, config, F::from_f64(prof.start()))
-        .map_err(|e| CliError::Input(format!("--from: {e}")))?;
-    let mut out = Response {
-        time: vec![0.0],
-        state: vec![widen(twin.state())],
-    };
-    for k in 0..n {
-        // Coefficients at the tick's midpoint follow a ramp to second order.
-        let t_mid = prof.temperature((k as f64 + 0.5) * config.tick);
-        twin.set_temperature(F::from_f64(t_mid))
-            .map_err(|e| CliError::Input(format!("temperature {t_mid} C: {e}")))?;
-        twin.tick().map_err(|e| CliError::Failed(format!("tick {k}: {e:?}")))?;
-        out.time.push((k + 1) as f64 * config.tick);
-        out.state.push(widen(twin.state()));
-    }
-    Ok(out)
+    let twin = Twin::<F, T>::new(params, config, F::from_f64(prof.start()));
+    run(twin, config.tick, prof, n)
 }
 
 /// Simulates `prof` for `n` ticks of `config.tick` with the chosen precision.
@@ -106,22 +150,8 @@ pub fn simulate(
         Precision::FixedQ16 => run_twin::<f32, compensator::scalar::Q16_16>(&p32()?, config, prof, n),
         Precision::FixedQ24 => run_twin::<f32, compensator::scalar::Q8_24>(&p32()?, config, prof, n),
         Precision::Reduced => {
-            let p = p64()?;
-            let mut twin = ReducedTwin::<f64, f64>::new(&p, config.scheme, config.tick, config.substeps, prof.start())
-                .map_err(|e| CliError::Input(format!("--from: {e}")))?;
-            let mut out = Response {
-                time: vec![0.0],
-                state: vec![twin.state()],
-            };
-            for k in 0..n {
-                let t_mid = prof.temperature((k as f64 + 0.5) * config.tick);
-                twin.set_temperature(t_mid)
-                    .map_err(|e| CliError::Input(format!("temperature {t_mid} C: {e}")))?;
-                twin.tick().map_err(|e| CliError::Failed(format!("tick {k}: {e:?}")))?;
-                out.time.push((k + 1) as f64 * config.tick);
-                out.state.push(twin.state());
-            }
-            Ok(out)
+            let twin = ReducedTwin::<f64, f64>::new(&p64()?, config, prof.start());
+            run(twin, config.tick, prof, n)
         }
         Precision::Reference => {
             // The profile's temperatures must be evaluable before the solver runs.
@@ -170,13 +200,18 @@ pub fn tick_count(t_end: f64, dt: f64) -> Result<usize, CliError> {
     if !(t_end > 0.0 && t_end.is_finite()) {
         return Err(CliError::Input(format!("--t-end: {t_end} must be positive")));
     }
+    if dt > t_end {
+        return Err(CliError::Input(format!(
+            "--dt: {dt} s is longer than --t-end {t_end} s"
+        )));
+    }
     let n = (t_end / dt).round();
     if n > 10_000_000.0 {
         return Err(CliError::Input(format!(
             "--t-end / --dt: {n} ticks is more than 10,000,000"
         )));
     }
-    Ok((n as usize).max(1))
+    Ok(n as usize)
 }
 
 /// `step`: response table.
@@ -195,7 +230,10 @@ pub fn step(
     let (raw, _) = load_params::<f64>(path)?;
     let prof = profile(from, to, ramp)?;
     if substeps == 0 || substeps > compensator::dynamics::twin::MAX_SUBSTEPS {
-        return Err(CliError::Input(format!("--substeps: {substeps} is not in 1..=16")));
+        return Err(CliError::Input(format!(
+            "--substeps: {substeps} is not in 1..={}",
+            compensator::dynamics::twin::MAX_SUBSTEPS
+        )));
     }
     let n = tick_count(t_end.unwrap_or_else(|| default_t_end(&prof)), dt)?;
     let config = TwinConfig {

@@ -21,13 +21,18 @@ impl Fit {
     }
     /// Largest absolute residual.
     pub fn max_abs(&self) -> f64 {
-        self.residuals.iter().fold(0.0, |m, r| m.max(r.abs()))
+        max_abs(&self.residuals)
     }
 }
 
 /// Root-mean-square of a slice (NaN for an empty one).
 pub fn rms(r: &[f64]) -> f64 {
     (r.iter().map(|v| v * v).sum::<f64>() / r.len() as f64).sqrt()
+}
+
+/// Largest absolute value (0 for none).
+pub fn max_abs(r: &[f64]) -> f64 {
+    r.iter().fold(0.0, |m, v| m.max(v.abs()))
 }
 
 fn cost(r: &[f64]) -> f64 {

@@ -5,6 +5,7 @@
 //! naming the field; nothing is written to stdout then.
 
 use clap::{Parser, Subcommand, ValueEnum};
+use compensator::dynamics::{Scheme, TwinConfig};
 use compensator_cli::commands::{self, CliError};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -27,14 +28,11 @@ enum StaticPrecision {
     F32,
 }
 
-/// One-step scheme.
-#[derive(Copy, Clone, Debug, ValueEnum, PartialEq, Eq)]
-enum SchemeArg {
-    Rk4,
-    LinearlyImplicitEuler,
-    Ros2,
-    Ros3,
-    Rodas3,
+/// The core's one-step schemes, by name.
+fn scheme_parser() -> impl clap::builder::TypedValueParser<Value = Scheme> {
+    use clap::builder::{PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new(Scheme::ALL.map(Scheme::name))
+        .try_map(|name| Scheme::from_name(&name).ok_or("unknown scheme"))
 }
 
 /// Reading of the asymptotic expansion.
@@ -52,7 +50,7 @@ enum Command {
         #[arg(long)]
         params: PathBuf,
         /// Temperatures [C]: start:end:step or a comma list.
-        #[arg(long, default_value = "30:80:10")]
+        #[arg(long, default_value = "30:80:10", allow_hyphen_values = true)]
         temps: String,
         /// Scalar type of the computation.
         #[arg(long, value_enum, default_value = "f64")]
@@ -71,14 +69,14 @@ enum Command {
         /// Reference temperature [C], or `balance` (where p_a = p_b, Eq. 2).
         #[arg(long, default_value = "balance", allow_hyphen_values = true)]
         t0: String,
-        #[arg(long, default_value = "30:80:10")]
+        #[arg(long, default_value = "30:80:10", allow_hyphen_values = true)]
         temps: String,
     },
     /// Temperature sensitivities (Eqs. 30-31) and the Eq. (32) verdict.
     Sensitivity {
         #[arg(long)]
         params: PathBuf,
-        #[arg(long, default_value = "26:78:2")]
+        #[arg(long, default_value = "26:78:2", allow_hyphen_values = true)]
         temps: String,
     },
     /// Response to a temperature step or ramp (FSI model, Eqs. 33-36).
@@ -103,18 +101,18 @@ enum Command {
         /// Scalar type, the reduced model, or the adaptive reference solver.
         #[arg(long, value_enum, default_value = "f64")]
         precision: compensator_cli::dynamics::Precision,
-        /// One-step scheme of the twin.
-        #[arg(long, value_enum, default_value = "ros2")]
-        scheme: SchemeArg,
-        /// Steps per tick.
-        #[arg(long, default_value = "1")]
+        /// One-step scheme of the twin (default: the shipped one).
+        #[arg(long, default_value = TwinConfig::SHIPPED.scheme.name(), value_parser = scheme_parser())]
+        scheme: Scheme,
+        /// Steps per tick (default: the shipped number).
+        #[arg(long, default_value_t = TwinConfig::SHIPPED.substeps)]
         substeps: u8,
     },
     /// Eigenvalues of the linearisation at the equilibrium (Eq. 37).
     Eigen {
         #[arg(long)]
         params: PathBuf,
-        #[arg(long, default_value = "30:80:10")]
+        #[arg(long, default_value = "30:80:10", allow_hyphen_values = true)]
         temps: String,
     },
     /// Step-response indicators of Table 3 (reference solver).
@@ -122,7 +120,7 @@ enum Command {
         #[arg(long)]
         params: PathBuf,
         /// Steps as from:to pairs.
-        #[arg(long, default_value = "30:40,40:50,50:60,60:70,70:80")]
+        #[arg(long, default_value = "30:40,40:50,50:60,60:70,70:80", allow_hyphen_values = true)]
         steps: String,
         /// Sampling interval [s].
         #[arg(long, default_value = "0.0001", allow_hyphen_values = true)]
@@ -135,7 +133,7 @@ enum Command {
     Compensation {
         #[arg(long)]
         params: PathBuf,
-        #[arg(long, default_value = "30:80:10")]
+        #[arg(long, default_value = "30:80:10", allow_hyphen_values = true)]
         temps: String,
     },
     /// Design sizing: the machine a compensator serves best (`machine`), or
@@ -146,7 +144,7 @@ enum Command {
         /// What to size: machine or slot.
         #[arg(long = "for")]
         what: String,
-        #[arg(long, default_value = "30:80:1")]
+        #[arg(long, default_value = "30:80:1", allow_hyphen_values = true)]
         temps: String,
         /// Reference temperature of the fitted leakage [C].
         #[arg(long, default_value = "40", allow_hyphen_values = true)]
@@ -201,17 +199,7 @@ fn run(cli: Cli) -> Result<String, CliError> {
             precision,
             scheme,
             substeps,
-        } => {
-            use compensator::dynamics::Scheme;
-            let scheme = match scheme {
-                SchemeArg::Rk4 => Scheme::Rk4,
-                SchemeArg::LinearlyImplicitEuler => Scheme::LinearlyImplicitEuler,
-                SchemeArg::Ros2 => Scheme::Ros2,
-                SchemeArg::Ros3 => Scheme::Ros3,
-                SchemeArg::Rodas3 => Scheme::Rodas3,
-            };
-            compensator_cli::dynamics::step(&params, from, to, ramp, dt, t_end, precision, scheme, substeps)
-        }
+        } => compensator_cli::dynamics::step(&params, from, to, ramp, dt, t_end, precision, scheme, substeps),
         Command::Eigen { params, temps } => compensator_cli::dynamics::eigen(&params, &temps),
         Command::Indicators {
             params,

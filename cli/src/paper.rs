@@ -17,7 +17,7 @@ use crate::csv;
 use crate::lsq::{Fit, levenberg_marquardt, rms};
 use compensator::Params;
 use compensator::asymptotic::{Expansion, Reading};
-use compensator::equilibrium::{balance_temperature, equilibrium, pressure_difference};
+use compensator::equilibrium::{equilibrium, pressure_difference};
 use compensator::params::{RawCore, RawParams};
 use std::path::Path;
 
@@ -46,15 +46,34 @@ pub struct Table2 {
     pub x_asym_mm: Vec<f64>,
 }
 
+/// A table of finite numbers whose first column is `t_c`, with at least two
+/// rows (the fits and the Walther start need two temperatures).
 fn read(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), String> {
     let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    csv::parse(&text).map_err(|e| format!("{}: {e}", path.display()))
+    let (header, rows) = csv::parse(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    if header.first().map(String::as_str) != Some("t_c") {
+        return Err(format!("{}: the first column must be t_c", path.display()));
+    }
+    if rows.len() < 2 {
+        return Err(format!(
+            "{}: at least two rows needed, found {}",
+            path.display(),
+            rows.len()
+        ));
+    }
+    if let Some(i) = rows.iter().position(|r| r.iter().any(|v| !v.is_finite())) {
+        return Err(format!("{}: row {}: not a finite number", path.display(), i + 1));
+    }
+    Ok((header, rows))
 }
 
 impl Table1 {
     /// Reads `t_c,dp_ab_<N>bar,...`.
     pub fn load(path: &Path) -> Result<Self, String> {
         let (header, rows) = read(path)?;
+        if header.len() < 2 {
+            return Err(format!("{}: no dp_ab_<N>bar column", path.display()));
+        }
         let drops_bar = header[1..]
             .iter()
             .map(|h| {
@@ -308,17 +327,18 @@ pub fn asymptotic_errors(
 
 /// For each reading and order 1, 2: the reference temperature on a 0.1 C
 /// grid over `[t_lo, t_hi]` that best reproduces Table 2's asymptotic
-/// column, plus the balance temperature's result for comparison.
+/// column, plus the result at the balance temperature `balance` (if any,
+/// from `commands::find_balance`) for comparison.
 /// Returns (best per reading and order, balance-temperature results).
 pub fn asymptotic_search(
     params: &Params<f64>,
     t2: &Table2,
     t_lo: f64,
     t_hi: f64,
+    balance: Option<f64>,
 ) -> (Vec<AsymptoticMatch>, Vec<AsymptoticMatch>) {
     let mut best = Vec::new();
     let mut at_balance = Vec::new();
-    let balance = balance_temperature(params, t_lo, t_hi).ok();
     for reading in [Reading::Temperature, Reading::Property] {
         for order in [1, 2] {
             let score = |t0: f64| {
@@ -327,7 +347,7 @@ pub fn asymptotic_search(
                     order,
                     t0,
                     rms_mm: rms(&e),
-                    max_mm: e.iter().fold(0.0, |m, v| m.max(v.abs())),
+                    max_mm: crate::lsq::max_abs(&e),
                 })
             };
             let n = ((t_hi - t_lo) / 0.1).round() as usize;

@@ -15,8 +15,7 @@ use std::time::Instant;
 use host_tests::bench::{COUNT, WORKLOADS};
 
 fn params<T: compensator::Float>() -> (compensator::RawParams, Params<T>) {
-    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
-    let raw = compensator_cli::load(&root.join("presets/paper.toml")).expect("preset");
+    let raw = compensator_cli::load(&host_tests::repo_root().join("presets/paper.toml")).expect("preset");
     let p = Params::new(&raw).expect("valid");
     (raw, p)
 }

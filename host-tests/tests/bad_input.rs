@@ -339,3 +339,64 @@ fn cli_equilibrium_and_asymptotic_write_the_documented_columns() {
     assert_eq!(lines[0], "t_c,x_qs_m,x_asym_m");
     assert_eq!(lines.len(), 7);
 }
+
+#[test]
+fn malformed_paper_tables_exit_2_naming_the_file() {
+    let table2 = std::fs::read_to_string(repo_root().join("data/paper/table2.csv")).unwrap();
+    let cases: &[(&str, &str, &str)] = &[
+        // Only the temperature column.
+        ("t_c\n30\n40\n", "no dp_ab_<N>bar column", "table1.csv"),
+        // A header and no rows.
+        ("t_c,dp_ab_4bar\n", "at least two rows", "table1.csv"),
+        // A NaN.
+        ("t_c,dp_ab_4bar\n30,1.0\n40,nan\n", "not a finite number", "table1.csv"),
+        // The first column is not the temperature.
+        (
+            "dp_ab_4bar,t_c\n1.0,30\n1.0,40\n",
+            "first column must be t_c",
+            "table1.csv",
+        ),
+    ];
+    for (i, (table1, why, file)) in cases.iter().enumerate() {
+        let dir = std::env::temp_dir().join(format!("compensator-bad-tables-{}-{i}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("table1.csv"), table1).unwrap();
+        std::fs::write(dir.join("table2.csv"), &table2).unwrap();
+        let data = dir.to_string_lossy().into_owned();
+        for command in ["calibrate", "paper"] {
+            let params = if command == "calibrate" { "--base" } else { "--params" };
+            let args = [command, params, "presets/paper.toml", "--data", &data];
+            assert_bad_input(&args, file);
+            let (_, _, stderr) = run(&args);
+            assert!(stderr.contains(why), "{command} {table1:?}: {stderr}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
+
+#[test]
+fn negative_temperatures_are_values_not_flags() {
+    // -10 C is inside the oil model's range of the preset only if Walther
+    // accepts it; either way the argument must parse as a number.
+    let (_, _, stderr) = run(&["eigen", "--params", "presets/paper.toml", "--temps", "-10"]);
+    assert!(!stderr.contains("unexpected argument"), "{stderr}");
+    let (code, out, err) = run(&["equilibrium", "--params", "presets/paper.toml", "--temps", "-10,30"]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(out.lines().count(), 3, "{out}");
+}
+
+#[test]
+fn toml_syntax_errors_name_their_line() {
+    for (text, line) in [
+        // A duplicate key: the error starts at the beginning of line 3.
+        ("[plunger]\nmass = 0.01\nmass = 0.02\n", 3),
+        // A value missing at the end of line 2.
+        ("[plunger]\nmass =\n", 2),
+        ("mass = 0.01 0.02\n", 1),
+    ] {
+        match params_file::parse(text) {
+            Err(LoadError::Syntax(m)) => assert!(m.starts_with(&format!("line {line}:")), "{text:?}: {m}"),
+            other => panic!("{text:?}: {other:?}"),
+        }
+    }
+}

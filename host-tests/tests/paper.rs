@@ -76,7 +76,7 @@ fn table2_asym_column_is_the_property_reading_at_second_order_about_the_balance_
     let p = preset();
     let raw = params_file::load(&repo_root().join("presets/paper.toml")).unwrap();
     let balance = commands::find_balance(&raw, &p).unwrap();
-    let (best, at_balance) = paper::asymptotic_search(&p, &t2, 26.0, 80.0);
+    let (best, at_balance) = paper::asymptotic_search(&p, &t2, 26.0, 80.0, Some(balance));
     let closest = best.iter().min_by(|a, b| a.rms_mm.total_cmp(&b.rms_mm)).unwrap();
     assert_eq!((closest.reading, closest.order), (Reading::Property, 2));
     assert!(

@@ -59,7 +59,8 @@ pub fn parse(text: &str) -> Result<RawParams, LoadError> {
         let msg = e.message().lines().next().unwrap_or("invalid TOML").to_string();
         match e.span() {
             Some(span) => {
-                let line = text[..span.start.min(text.len())].lines().count().max(1);
+                let before = &text.as_bytes()[..span.start.min(text.len())];
+                let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
                 LoadError::Syntax(format!("line {line}: {msg}"))
             }
             None => LoadError::Syntax(msg),

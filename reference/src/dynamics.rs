@@ -303,9 +303,10 @@ pub fn equilibrium(p: &RawCore, t: f64) -> ([f64; 4], Mode) {
     (y, mode)
 }
 
-/// Integrates from the equilibrium at the profile's start over `[0, t_end]`,
-/// sampling every `dt` [s], with relative tolerance `rtol` (absolute
-/// tolerances scaled to the stroke, its speed over a millisecond, and `dp`).
+/// Integrates from the equilibrium at the profile's start, sampling every
+/// `dt` [s] up to `round(t_end / dt) dt` (the last sample, where the
+/// integration ends), with relative tolerance `rtol` (absolute tolerances
+/// scaled to the stroke, its speed over a millisecond, and `dp`).
 pub fn simulate(
     p: &RawCore,
     profile: Profile,
@@ -318,6 +319,10 @@ pub fn simulate(
         return Err("t_end, dt and rtol must be positive".into());
     }
     let n = (t_end / dt).round() as usize;
+    if n == 0 {
+        return Err(format!("dt = {dt} s is more than twice t_end = {t_end} s"));
+    }
+    let t_end = n as f64 * dt;
     let grid: Vec<f64> = (0..=n).map(|k| k as f64 * dt).collect();
     let (mut y, mut mode) = equilibrium(p, profile.start());
     let mut out = Trajectory {

@@ -277,6 +277,16 @@ impl<T: Real> Coefficients<T> {
         self.phi_over_a_x * (two * s0 * s0 - T::ONE) - (self.xi0 + xi) * self.inv_a_x
     }
 
+    /// Sets the temperature-dependent `q_t`, `g_l` for a fluid state; on
+    /// error (not finite, or saturating `T`) nothing changes.
+    pub fn set_hydraulic<F: Float>(&mut self, model: &Model<F>, fluid: &FluidState<F>) -> Result<(), ModelError> {
+        let (q_t, g_l) = model.hydraulic(fluid)?;
+        let (q_t, g_l) = (represent(q_t, "q_t")?, represent(g_l, "g_l")?);
+        self.q_t = q_t;
+        self.g_l = g_l;
+        Ok(())
+    }
+
     /// The contact state for `y` (see [`contact_for`]).
     #[inline]
     pub fn contact(&self, y: &[T; 4]) -> Contact {

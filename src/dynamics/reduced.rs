@@ -16,8 +16,9 @@
 //! It is valid while `sigma w < g_l` (the plunger does not outrun the
 //! capillaries' flow); beyond, `s` is held at zero.
 
+use super::TwinConfig;
 use super::fsi::{Coefficients, Contact, DynamicState, Model, apply_stops, contact_for};
-use super::schemes::{OdeSystem, Scheme, StepError, Stepper, dense_linearisation};
+use super::schemes::{OdeSystem, StepError, Stepper, dense_linearisation};
 use crate::equilibrium::equilibrium;
 use crate::error::ModelError;
 use crate::linalg::Lu;
@@ -48,11 +49,9 @@ pub struct ReducedFsi<'a, T> {
 }
 
 impl<T: Real> ReducedFsi<'_, T> {
-    /// Net static force (as in [`Coefficients::static_force`]) at rest.
+    /// Net static force at rest: [`Coefficients::quasi_steady_force`].
     pub fn static_force(&self, xi: T) -> T {
-        let c = self.coefficients;
-        let (s, _) = quasi_steady(c, T::ZERO);
-        c.phi_over_a_x * (s * s + s * s - T::ONE) - (c.xi0 + xi) * c.inv_a_x
+        self.coefficients.quasi_steady_force(xi)
     }
 }
 
@@ -87,7 +86,8 @@ impl<T: Real> OdeSystem<T, 2> for ReducedFsi<'_, T> {
     }
 }
 
-/// The reduced model as a fixed-step twin (same ticks as [`super::Twin`]).
+/// The reduced model as a fixed-step twin (same configuration and ticks as
+/// [`super::Twin`]).
 #[derive(Clone, Copy, Debug)]
 pub struct ReducedTwin<F, T> {
     model: Model<F>,
@@ -99,24 +99,15 @@ pub struct ReducedTwin<F, T> {
 
 impl<F: Float, T: Real> ReducedTwin<F, T> {
     /// At rest in the equilibrium of `temperature` [C].
-    pub fn new(
-        params: &Params<F>,
-        scheme: Scheme,
-        tick: f64,
-        substeps: u8,
-        temperature: F,
-    ) -> Result<Self, ModelError> {
-        if substeps == 0 || !(tick > 0.0) {
-            return Err(ModelError::OutOfRange("tick"));
-        }
+    pub fn new(params: &Params<F>, config: TwinConfig, temperature: F) -> Result<Self, ModelError> {
+        config.validate()?;
         let model = Model::new(params)?;
-        let fluid = params.oil.state(temperature)?;
         let eq = equilibrium(params, temperature)?;
         let y: [T; 4] = model.equilibrium_state(&eq);
         Ok(ReducedTwin {
-            coefficients: model.coefficients(&fluid)?,
-            stepper: Stepper::new(scheme, tick / substeps as f64 / model.scales.time.to_f64()),
-            substeps,
+            coefficients: model.coefficients(&eq.fluid)?,
+            stepper: Stepper::new(config.scheme, config.step(model.scales.time.to_f64())),
+            substeps: config.substeps,
             state: [y[0], T::ZERO],
             model,
         })
@@ -125,13 +116,14 @@ impl<F: Float, T: Real> ReducedTwin<F, T> {
     /// Sets the oil temperature [C] for the following ticks.
     pub fn set_temperature(&mut self, temperature: F) -> Result<(), ModelError> {
         let fluid = self.model.params().oil.state(temperature)?;
-        let (q_t, g_l) = self.model.hydraulic(&fluid)?;
-        self.coefficients.q_t = q_t.to_real();
-        self.coefficients.g_l = g_l.to_real();
-        Ok(())
+        self.coefficients.set_hydraulic(&self.model, &fluid)
     }
 
-    /// Advances one tick (same stop handling as [`super::Twin::tick`]).
+    /// Advances one tick. Stops are simpler than [`super::Twin::tick`]'s:
+    /// a substep starting on a stop with the quasi-steady force pushing
+    /// into it stays there, otherwise it moves freely and a substep ending
+    /// beyond a stop ends on it at rest (no release redo: the pressures
+    /// have no transient here).
     pub fn tick(&mut self) -> Result<(), StepError> {
         for _ in 0..self.substeps {
             let probe = ReducedFsi {

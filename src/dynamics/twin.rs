@@ -14,7 +14,7 @@
 use super::fsi::{Coefficients, Contact, DynamicState, Fsi, Model, apply_stops, contact_for};
 use super::schemes::{Scheme, StepError, Stepper};
 use crate::equilibrium::equilibrium;
-use crate::error::{ModelError, represent};
+use crate::error::ModelError;
 use crate::fluid::FluidState;
 use crate::params::Params;
 use crate::scalar::{Float, Real};
@@ -34,6 +34,22 @@ pub struct TwinConfig {
 }
 
 impl TwinConfig {
+    /// A positive, finite tick and `1..=MAX_SUBSTEPS` steps per tick.
+    pub fn validate(&self) -> Result<(), ModelError> {
+        if !(self.tick > 0.0 && self.tick.is_finite()) {
+            return Err(ModelError::OutOfRange("tick"));
+        }
+        if self.substeps == 0 || self.substeps > MAX_SUBSTEPS {
+            return Err(ModelError::OutOfRange("substeps"));
+        }
+        Ok(())
+    }
+
+    /// The step length in the model's time unit `time_unit` [s].
+    pub fn step(&self, time_unit: f64) -> f64 {
+        self.tick / self.substeps as f64 / time_unit
+    }
+
     /// What the firmware ships: ROS3 (three-stage, L-stable, order 3), two
     /// steps per 1 ms tick. The accuracy/cost trade-off against the other
     /// schemes is in the project's `docs/dynamics.md`.
@@ -68,19 +84,12 @@ pub struct Twin<F, T> {
 impl<F: Float, T: Real> Twin<F, T> {
     /// A twin at rest in the quasi-static equilibrium of `temperature` [C].
     pub fn new(params: &Params<F>, config: TwinConfig, temperature: F) -> Result<Self, ModelError> {
-        if !(config.tick > 0.0 && config.tick.is_finite()) {
-            return Err(ModelError::OutOfRange("tick"));
-        }
-        if config.substeps == 0 || config.substeps > MAX_SUBSTEPS {
-            return Err(ModelError::OutOfRange("substeps"));
-        }
+        config.validate()?;
         let model = Model::new(params)?;
-        let fluid = params.oil.state(temperature)?;
         let eq = equilibrium(params, temperature)?;
-        let h = config.tick / config.substeps as f64 / model.scales.time.to_f64();
         Ok(Twin {
-            coefficients: model.coefficients(&fluid)?,
-            stepper: Stepper::new(config.scheme, h),
+            coefficients: model.coefficients(&eq.fluid)?,
+            stepper: Stepper::new(config.scheme, config.step(model.scales.time.to_f64())),
             substeps: config.substeps,
             state: model.equilibrium_state(&eq),
             model,
@@ -112,10 +121,7 @@ impl<F: Float, T: Real> Twin<F, T> {
 
     /// As [`Twin::set_temperature`] from an already evaluated fluid state.
     pub fn set_fluid(&mut self, fluid: &FluidState<F>) -> Result<(), ModelError> {
-        let (q_t, g_l) = self.model.hydraulic(fluid)?;
-        self.coefficients.q_t = represent(q_t, "q_t")?;
-        self.coefficients.g_l = represent(g_l, "g_l")?;
-        Ok(())
+        self.coefficients.set_hydraulic(&self.model, fluid)
     }
 
     /// Advances one tick. On a failed step the state is left at the last

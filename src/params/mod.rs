@@ -87,10 +87,11 @@ pub struct Params<T> {
 }
 
 /// Converts a validated `f64` to `T`, rejecting values that overflow or
-/// (for positive quantities) underflow to zero there.
-fn conv<T: Float>(field: &'static str, v: f64, positive: bool) -> Result<T, ParamError> {
+/// underflow to zero there (a positive value must stay positive; a zero the
+/// schema allows stays zero).
+fn conv<T: Float>(field: &'static str, v: f64) -> Result<T, ParamError> {
     let t = T::from_f64(v);
-    let lost = !t.is_finite() || (positive && !(t > T::ZERO));
+    let lost = !t.is_finite() || (v > 0.0 && !(t > T::ZERO));
     if lost {
         Err(ParamError {
             field,
@@ -107,8 +108,10 @@ impl<T: Float> Params<T> {
     ///
     /// Errors name the offending field (`section.key`).
     pub fn new(raw: &RawParams) -> Result<Self, ParamError> {
-        raw.validate()?;
-        Self::from_core(&raw.core, raw.machine.as_ref())
+        // `from_core` validates the core and machine sections.
+        let params = Self::from_core(&raw.core, raw.machine.as_ref())?;
+        raw.estimator.validate()?;
+        Ok(params)
     }
 
     /// As [`Params::new`], from the sections separately.
@@ -116,9 +119,7 @@ impl<T: Float> Params<T> {
         core.validate()?;
         let f = &CORE_FIELDS;
         let v = core.to_array();
-        // Zero is allowed for damping (index 11), preload (13) and the outlet
-        // pressure (20); everything else is strictly positive.
-        let c = |i: usize| conv::<T>(f[i].path, v[i], !matches!(i, 3 | 11 | 13 | 20));
+        let c = |i: usize| conv::<T>(f[i].path, v[i]);
         let params = Params {
             oil: {
                 for i in 0..5 {
@@ -156,9 +157,9 @@ impl<T: Float> Params<T> {
                     m.validate()?;
                     let mf = &MACHINE_FIELDS;
                     Some(Machine {
-                        working_flow: conv(mf[0].path, m.working_flow, false)?,
-                        leakage_reference: conv(mf[1].path, m.leakage_reference, false)?,
-                        leakage_temperature: conv(mf[2].path, m.leakage_temperature, false)?,
+                        working_flow: conv(mf[0].path, m.working_flow)?,
+                        leakage_reference: conv(mf[1].path, m.leakage_reference)?,
+                        leakage_temperature: conv(mf[2].path, m.leakage_temperature)?,
                     })
                 }
             },

@@ -57,7 +57,7 @@ pub fn capture(cmd: &mut Command, timeout: Duration) -> Output {
             Ok(Some(st)) => break Some(st),
             Ok(None) if Instant::now() >= deadline => {
                 timed_out = true;
-                let _ = child.kill();
+                kill_tree(&mut child);
                 break child.wait().ok();
             }
             Ok(None) => std::thread::sleep(Duration::from_millis(20)),
@@ -85,7 +85,7 @@ pub fn run(cmd: &mut Command, timeout: Duration) -> Option<i32> {
                     "xtask: {:?} did not finish within {timeout:?}; killed",
                     cmd.get_program()
                 );
-                let _ = child.kill();
+                kill_tree(&mut child);
                 let _ = child.wait();
                 return None;
             }
@@ -95,10 +95,66 @@ pub fn run(cmd: &mut Command, timeout: Duration) -> Option<i32> {
     }
 }
 
+/// Kills `child` and every process descended from it (cargo's rustc,
+/// apt-get's dpkg...), so that a deadline leaves nothing running and no
+/// pipe held open. The descendants come from `/proc` (Linux); elsewhere
+/// only the child is killed. They stay in xtask's process group, so a
+/// Ctrl-C at the terminal still reaches all of them.
+pub fn kill_tree(child: &mut std::process::Child) {
+    let mut tree = vec![child.id()];
+    let parents = parent_ids();
+    let mut i = 0;
+    while i < tree.len() {
+        let p = tree[i];
+        tree.extend(parents.iter().filter(|(_, pp)| *pp == p).map(|(pid, _)| *pid));
+        i += 1;
+    }
+    if tree.len() > 1 {
+        let mut kill = Command::new("kill");
+        kill.arg("-KILL").args(tree[1..].iter().map(u32::to_string));
+        let _ = kill.stdout(Stdio::null()).stderr(Stdio::null()).status();
+    }
+    let _ = child.kill();
+}
+
+/// `(pid, parent pid)` of every process in `/proc` (empty elsewhere).
+fn parent_ids() -> Vec<(u32, u32)> {
+    let Ok(dir) = std::fs::read_dir("/proc") else {
+        return Vec::new();
+    };
+    dir.filter_map(|e| {
+        let pid: u32 = e.ok()?.file_name().to_str()?.parse().ok()?;
+        let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+        // "pid (comm) state ppid ...": comm may hold spaces and parentheses.
+        let after = &stat[stat.rfind(')')? + 1..];
+        let ppid = after.split_whitespace().nth(1)?.parse().ok()?;
+        Some((pid, ppid))
+    })
+    .collect()
+}
+
 /// `true` when running as root (may install packages).
 pub fn is_root() -> bool {
     capture(Command::new("id").arg("-u"), Duration::from_secs(5))
         .stdout
         .trim()
         == "0"
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_deadline_kills_the_grandchildren_too() {
+        // The shell's background child holds the output pipe: without the
+        // tree kill, reading the output would wait out its 60 s.
+        let t0 = Instant::now();
+        let out = capture(
+            Command::new("sh").args(["-c", "sleep 60 & sleep 60"]),
+            Duration::from_millis(300),
+        );
+        assert!(out.timed_out && out.code.is_none());
+        assert!(t0.elapsed() < Duration::from_secs(20), "{:?}", t0.elapsed());
+    }
 }

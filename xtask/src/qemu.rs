@@ -189,7 +189,7 @@ pub fn run(elf: &Path, machine: Machine, icount: bool, timeout: Duration, show: 
         }
     }
     if timed_out {
-        let _ = child.kill();
+        crate::process::kill_tree(&mut child);
         let _ = child.wait();
         eprintln!("xtask: {} did not finish within {timeout:?}; killed", elf.display());
         return Ok(Run { code: 124, lines });
