@@ -65,7 +65,8 @@ pub fn capture(cmd: &mut Command, timeout: Duration) -> Output {
         }
     };
     Output {
-        code: status.and_then(|s| s.code()),
+        // A command killed at the deadline has no exit code of its own.
+        code: if timed_out { None } else { status.and_then(|s| s.code()) },
         stdout: t_out.join().unwrap_or_default(),
         stderr: t_err.join().unwrap_or_default(),
         timed_out,
@@ -109,12 +110,13 @@ pub fn kill_tree(child: &mut std::process::Child) {
         tree.extend(parents.iter().filter(|(_, pp)| *pp == p).map(|(pid, _)| *pid));
         i += 1;
     }
+    // The child first, so that it cannot react to its children's deaths.
+    let _ = child.kill();
     if tree.len() > 1 {
         let mut kill = Command::new("kill");
         kill.arg("-KILL").args(tree[1..].iter().map(u32::to_string));
         let _ = kill.stdout(Stdio::null()).stderr(Stdio::null()).status();
     }
-    let _ = child.kill();
 }
 
 /// `(pid, parent pid)` of every process in `/proc` (empty elsewhere).
@@ -154,7 +156,13 @@ mod tests {
             Command::new("sh").args(["-c", "sleep 60 & sleep 60"]),
             Duration::from_millis(300),
         );
-        assert!(out.timed_out && out.code.is_none());
+        assert!(
+            out.timed_out && out.code.is_none(),
+            "code {:?}, timed out {}, stderr {:?}",
+            out.code,
+            out.timed_out,
+            out.stderr
+        );
         assert!(t0.elapsed() < Duration::from_secs(20), "{:?}", t0.elapsed());
     }
 }
