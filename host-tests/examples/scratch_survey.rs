@@ -5,7 +5,8 @@ use host_tests::survey::{Solved, designs, steps};
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();
-    let scheme = Scheme::from_name(&a[1]).unwrap();
+    let auto = a[1] == "auto";
+    let scheme = Scheme::from_name(if auto { "sdirk3" } else { &a[1] }).unwrap();
     let substeps: u8 = a[2].parse().unwrap();
     let n: usize = a[3].parse().unwrap();
     let verbose = a.get(4).is_some();
@@ -20,7 +21,29 @@ fn main() {
     let (mut end_fail, mut traj_fail, mut cases, mut ref_fail) = ([0; 3], [0; 3], 0, 0);
     let mut worst_end = [0.0f64; 3];
     let mut worst_traj = [0.0f64; 3];
+    let mut hist = std::collections::BTreeMap::new();
+    let t0 = std::time::Instant::now();
     for (i, raw) in designs(n, 0xD5).iter().enumerate() {
+        let cfg = if auto {
+            let p = compensator::Params::<f64>::new(raw).unwrap();
+            let ch = compensator::dynamics::config::choose(
+                &p,
+                1e-3,
+                (raw.estimator.valid_min, raw.estimator.valid_max),
+                raw.estimator.oil_min,
+            )
+            .unwrap();
+            *hist.entry(ch.config.substeps).or_insert(0) += 1;
+            if !ch.goal_met || verbose {
+                println!(
+                    "design {i}: chose {} est {:.4} met {}",
+                    ch.config.substeps, ch.estimated_error_pct, ch.goal_met
+                );
+            }
+            ch.config
+        } else {
+            cfg
+        };
         for st in steps(raw, &mut rng) {
             let s = match Solved::new(raw, st) {
                 Ok(s) => s,
@@ -58,6 +81,7 @@ fn main() {
             }
         }
     }
+    println!("chosen {hist:?} in {:?}", t0.elapsed());
     println!(
         "cases {cases} (reference failures {ref_fail}); end failures {end_fail:?} worst {worst_end:?}; trajectory failures {traj_fail:?} worst {worst_traj:.3?}"
     );

@@ -211,24 +211,43 @@ pub struct Solved {
     pub x_ref: Vec<f64>,
 }
 
+/// Longest simulated step [s].
+pub const MAX_SETTLE: f64 = 20.0;
+
 /// Tick of the survey [s] (the firmware's default).
 pub const TICK: f64 = 1e-3;
 
 impl Solved {
-    /// Solves the reference (Radau5, rtol 1e-10) for `step`.
+    /// Solves the reference (Radau5, rtol 1e-10) for `step`, long enough
+    /// for the reference to settle on the closed form (within 1e-5 of the
+    /// stroke and 1e-4 of `dp`): [`settle_time`] first, doubled up to
+    /// [`MAX_SETTLE`]. A reference that has not settled by then is an error.
     pub fn new(raw: &RawParams, step: Step) -> Result<Solved, String> {
-        let ticks = (settle_time(raw, &step) / TICK).round() as usize;
         let prof = Profile::Step {
             from: step.from,
             to: step.to,
         };
-        let tr = reference::simulate(&raw.core, prof, ticks as f64 * TICK, TICK, Method::Radau5, 1e-10)?;
-        Ok(Solved {
-            raw: *raw,
-            step,
-            ticks,
-            x_ref: tr.state.iter().map(|s| s[0]).collect(),
-        })
+        let eq = crate::reference::equilibrium(&raw.core, step.to);
+        let mut time = settle_time(raw, &step);
+        loop {
+            let ticks = (time / TICK).round() as usize;
+            let tr = reference::simulate(&raw.core, prof, ticks as f64 * TICK, TICK, Method::Radau5, 1e-10)?;
+            let end = tr.state[ticks];
+            let settled = (end[0] - eq.x).abs() <= 1e-5 * raw.core.stroke
+                && (end[2] - eq.p_a).abs().max((end[3] - eq.p_b).abs()) <= 1e-4 * raw.core.pressure_drop;
+            if settled {
+                return Ok(Solved {
+                    raw: *raw,
+                    step,
+                    ticks,
+                    x_ref: tr.state.iter().map(|s| s[0]).collect(),
+                });
+            }
+            if time >= MAX_SETTLE {
+                return Err(format!("the reference has not settled after {time} s"));
+            }
+            time = (2.0 * time).min(MAX_SETTLE);
+        }
     }
 
     /// The twin in `precision` with `config`, against the closed form at

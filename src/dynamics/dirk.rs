@@ -58,6 +58,9 @@
 //! O.D.E.'s", SIAM J. Numer. Anal. 14 (1977) 1006-1021; also Hairer &
 //! Wanner, *Solving ODEs II*, IV.6.
 
+// Tableau code indexes stages explicitly, as the methods are written.
+#![allow(clippy::needless_range_loop)]
+
 use super::fsi::{Coefficients, Contact};
 use crate::scalar::Real;
 

@@ -89,7 +89,72 @@ pub const RELEASE_ITERATIONS: u8 = 4;
 pub const IMPACT_ITERATIONS: u8 = 6;
 
 /// Steps per held substep.
-pub const HELD_STEPS: u8 = 4;
+pub const HELD_STEPS: u8 = 1;
+
+/// Pieces of a graded substep (see [`Twin::tick`]): the first is
+/// `2^-(GRADED_PIECES - 1)` of the substep.
+pub const GRADED_PIECES: u8 = 9;
+
+/// Relative change of the capillary conductance `g_l` between ticks above
+/// which the next tick is graded: about 0.3 C of a mineral oil's viscosity
+/// (a 1 C/s ramp changes it by 0.003 % per 1 ms tick; a step accepted by the
+/// estimator's spike filter by far more).
+pub const ABRUPT_CHANGE: f64 = 0.01;
+
+/// Stop events (releases, impacts) located inside one substep; a further
+/// one waits for the next substep (an impact then ends on the stop at the
+/// substep's end, a release at its start).
+pub const EVENTS_PER_SUBSTEP: u8 = 2;
+
+/// The static force on a plunger held at `held`'s stop, positive when it
+/// pulls the plunger off the stop.
+#[inline]
+fn away_from<T: Real>(c: &Coefficients<T>, held: Contact, y: &[T; 4]) -> T {
+    match held {
+        Contact::Open => -c.static_force(y),
+        _ => c.static_force(y),
+    }
+}
+
+/// Illinois regula falsi on `[0, 1]` for a function that is `f0 <= 0` at 0
+/// and `f1 > 0` at 1: `iterations` evaluations, returning the final
+/// bracket `(lo, hi)` (`f(lo) <= 0 < f(hi)`). Fixed cost; the bracket
+/// shrinks superlinearly on smooth functions.
+fn illinois<T: Real>(
+    f0: T,
+    f1: T,
+    iterations: u8,
+    mut f: impl FnMut(T) -> Result<T, StepError>,
+) -> Result<(T, T), StepError> {
+    let (mut lo, mut f_lo, mut hi, mut f_hi) = (T::ZERO, f0, T::ONE, f1);
+    let mut side = 0i8;
+    for _ in 0..iterations {
+        let span = f_hi - f_lo;
+        let mut t = if span > T::ZERO {
+            lo - f_lo * (hi - lo) / span
+        } else {
+            (lo + hi) * T::HALF
+        };
+        if !(t > lo && t < hi) {
+            t = (lo + hi) * T::HALF;
+        }
+        let v = f(t)?;
+        if v > T::ZERO {
+            (hi, f_hi) = (t, v);
+            if side == -1 {
+                f_lo *= T::HALF;
+            }
+            side = -1;
+        } else {
+            (lo, f_lo) = (t, v);
+            if side == 1 {
+                f_hi *= T::HALF;
+            }
+            side = 1;
+        }
+    }
+    Ok((lo, hi))
+}
 
 /// The integrator behind a twin.
 #[derive(Clone, Copy, Debug)]
@@ -109,6 +174,8 @@ pub struct Twin<F, T> {
     substeps: u8,
     /// The substep length times `a_x` (model units): `xi' = a_x w`.
     h_a_x: T,
+    /// [`ABRUPT_CHANGE`] in `T`.
+    abrupt_threshold: T,
     /// `1 / HELD_STEPS`: the length of a held step, in substeps.
     held_part: T,
     /// Pressure bounds `[-PRESSURE_MARGIN, 1 + PRESSURE_MARGIN]`.
@@ -116,6 +183,8 @@ pub struct Twin<F, T> {
     state: [T; 4],
     /// What rounding has left out of `xi` so far ([`Real::mul_add_compensated`]).
     xi_carry: T,
+    /// The coefficients changed abruptly since the last tick.
+    abrupt: bool,
     config: TwinConfig,
 }
 
@@ -134,12 +203,14 @@ impl<F: Float, T: Real> Twin<F, T> {
         Ok(Twin {
             h_a_x: T::from_f64(h) * coefficients.a_x,
             held_part: T::from_f64(1.0 / HELD_STEPS as f64),
+            abrupt_threshold: T::from_f64(ABRUPT_CHANGE),
             coefficients,
             engine,
             substeps: config.substeps,
             pressure_bounds: (T::from_f64(-PRESSURE_MARGIN), T::from_f64(1.0 + PRESSURE_MARGIN)),
             state: model.equilibrium_state(&eq),
             xi_carry: T::ZERO,
+            abrupt: false,
             model,
             config,
         })
@@ -168,8 +239,14 @@ impl<F: Float, T: Real> Twin<F, T> {
     }
 
     /// As [`Twin::set_temperature`] from an already evaluated fluid state.
+    /// A change of the capillary conductance by more than
+    /// [`ABRUPT_CHANGE`] (relative) makes the next tick start graded.
     pub fn set_fluid(&mut self, fluid: &FluidState<F>) -> Result<(), ModelError> {
-        self.coefficients.set_hydraulic(&self.model, fluid)
+        let before = self.coefficients.g_l;
+        self.coefficients.set_hydraulic(&self.model, fluid)?;
+        let change = (self.coefficients.g_l - before).abs();
+        self.abrupt |= change > self.abrupt_threshold * before;
+        Ok(())
     }
 
     /// Advances one tick of `substeps` substeps. On a failed substep the
@@ -197,9 +274,12 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// at most two free and `RELEASE_ITERATIONS + 2` held steps.
     pub fn tick(&mut self) -> Result<TickReport, StepError> {
         let mut impact = false;
+        let mut graded = self.abrupt;
+        self.abrupt = false;
         for _ in 0..self.substeps {
             let mut carry = self.xi_carry;
-            let (next, hit) = self.substep(&self.state, &mut carry)?;
+            let (next, hit) = self.substep(&self.state, &mut carry, graded)?;
+            graded = false;
             self.check(&next)?;
             impact |= hit;
             self.state = next;
@@ -245,35 +325,137 @@ impl<F: Float, T: Real> Twin<F, T> {
         }
     }
 
-    /// One substep from `y`; `carry` is `xi`'s compensated-summation carry.
-    fn substep(&self, y: &[T; 4], carry: &mut T) -> Result<([T; 4], bool), StepError> {
-        let c = &self.coefficients;
-        let held = c.contact(y);
-        if held == Contact::Free {
-            return self.free_part(y, T::ONE, carry);
+    /// `frac` of a substep from `y`; `carry` is `xi`'s compensated-summation carry.
+    fn piece(&self, y: &[T; 4], frac: T, carry: &mut T) -> Result<([T; 4], bool), StepError> {
+        match self.coefficients.contact(y) {
+            Contact::Free => self.free_piece(y, frac, carry, EVENTS_PER_SUBSTEP),
+            held => self.held_piece(y, frac, held, carry, EVENTS_PER_SUBSTEP),
         }
-        // On the stop exactly: nothing left to carry.
-        *carry = T::ZERO;
-        // Held: the plunger on the stop at rest; the pressures evolve, in
-        // HELD_STEPS equal steps (a pressure transient after a change of
-        // temperature decides when the plunger lifts off: it is followed,
-        // not stepped over).
-        // Positive: the force pulls away from the stop (a release).
-        let away = |s: &[T; 4]| match held {
-            Contact::Open => -c.static_force(s),
-            _ => c.static_force(s),
+    }
+
+    /// One substep from `y`; after an abrupt change of the coefficients the
+    /// substep is taken in [`GRADED_PIECES`] pieces growing geometrically
+    /// from `2^-(GRADED_PIECES - 1)` of it, so that the transient the
+    /// change starts (the pressures re-equilibrating, the plunger
+    /// accelerating into its new motion) is followed rather than stepped
+    /// over.
+    fn substep(&self, y: &[T; 4], carry: &mut T, graded: bool) -> Result<([T; 4], bool), StepError> {
+        if !graded {
+            return self.piece(y, T::ONE, carry);
+        }
+        let mut frac = T::ONE;
+        for _ in 1..GRADED_PIECES {
+            frac *= T::HALF;
+        }
+        let (mut state, mut impact) = self.piece(y, frac, carry)?;
+        for _ in 1..GRADED_PIECES {
+            let (next, hit) = self.piece(&state, frac, carry)?;
+            state = next;
+            impact |= hit;
+            frac = frac + frac;
+        }
+        Ok((state, impact))
+    }
+
+    /// Free motion from `y` over `frac` of a substep. A step that ends
+    /// beyond a stop is redone up to the impact (on its cubic Hermite
+    /// interpolant), the plunger stops there (inelastic: `w = 0`) and the
+    /// rest of the piece is held. With no `events` left the impact is not
+    /// located: the plunger is put on the stop and the whole piece held from
+    /// `y`'s pressures (never with the pressures of a motion the stop
+    /// forbids). Returns the state and whether an impact happened.
+    fn free_piece(&self, y: &[T; 4], frac: T, carry: &mut T, events: u8) -> Result<([T; 4], bool), StepError> {
+        let mut tried = *carry;
+        let next = self.step(y, frac, Contact::Free, &mut tried)?;
+        let (stop, contact) = if next[0] < T::ZERO {
+            (T::ZERO, Contact::Closed)
+        } else if next[0] > T::ONE {
+            (T::ONE, Contact::Open)
+        } else {
+            *carry = tried;
+            return Ok((next, false));
         };
-        let part = self.held_part;
+        *carry = T::ZERO;
+        if events == 0 {
+            let at = [stop, T::ZERO, y[2], y[3]];
+            let (end, _) = self.held_piece(&at, frac, contact, carry, 0)?;
+            return Ok((end, true));
+        }
+        let theta = self.impact_fraction(y, &next, frac, stop);
+        let mut at = if theta > T::ZERO {
+            let mut c = T::ZERO;
+            self.step(y, frac * theta, Contact::Free, &mut c)?
+        } else {
+            *y
+        };
+        at[0] = stop;
+        at[1] = T::ZERO;
+        let rest = frac * (T::ONE - theta);
+        if !(rest > T::ZERO) {
+            return Ok((at, true));
+        }
+        // Held for the rest, unless the plunger travelled before the impact
+        // and the force there pulls it off the stop again (a touch).
+        let (end, _) = if theta > T::ZERO && away_from(&self.coefficients, contact, &at) > T::ZERO {
+            self.free_piece(&at, rest, carry, events - 1)?
+        } else {
+            self.held_piece(&at, rest, contact, carry, events - 1)?
+        };
+        Ok((end, true))
+    }
+
+    /// Held on a stop from `y` over `frac` of a substep: the plunger at
+    /// rest, the pressures in `HELD_STEPS` equal steps (the pressure
+    /// transient after a change of temperature decides when the plunger
+    /// lifts off: it is followed, not stepped over). When the held force
+    /// pulls away at a step's end and `events` remain, the release is
+    /// located (Illinois on the held force) and the piece goes on free from
+    /// there.
+    fn held_piece(
+        &self,
+        y: &[T; 4],
+        frac: T,
+        held: Contact,
+        carry: &mut T,
+        events: u8,
+    ) -> Result<([T; 4], bool), StepError> {
+        let c = &self.coefficients;
+        // On the stop exactly: nothing is left to carry.
+        *carry = T::ZERO;
+        let away = |s: &[T; 4]| away_from(c, held, s);
+        let part = if frac == T::ONE {
+            self.held_part
+        } else {
+            frac * self.held_part
+        };
         let mut start = [y[0], T::ZERO, y[2], y[3]];
         let mut t0 = T::ZERO;
         for _ in 0..HELD_STEPS {
             let end = self.step(&start, part, held, carry)?;
             let f1 = away(&end);
-            if f1 > T::ZERO {
-                // Release inside this step: Illinois on the held force over
-                // its fraction, bracket [0 (into the stop), 1 (away)].
-                let (lo_f, at) = self.release(&start, end, f1, held, &away)?;
-                return self.free_part(&at, T::ONE - (t0 + part * lo_f), carry);
+            if f1 > T::ZERO && events > 0 {
+                let f0 = away(&start);
+                if f0 > T::ZERO {
+                    // Held although pulled away at the start (the piece
+                    // after an impact at its start): released there.
+                    return self.free_piece(&start, frac - t0, carry, events - 1);
+                }
+                // The first bracketed time at which the held force pulls away.
+                let mut at = end;
+                let (_, theta) = illinois(f0, f1, RELEASE_ITERATIONS, |t| {
+                    let mut no_carry = T::ZERO;
+                    let s = self.step(&start, part * t, held, &mut no_carry)?;
+                    let f = away(&s);
+                    if f > T::ZERO {
+                        at = s;
+                    }
+                    Ok(f)
+                })?;
+                let rest = frac - (t0 + part * theta);
+                if !(rest > T::ZERO) {
+                    return Ok((at, false));
+                }
+                return self.free_piece(&at, rest, carry, events - 1);
             }
             start = end;
             t0 += part;
@@ -281,130 +463,27 @@ impl<F: Float, T: Real> Twin<F, T> {
         Ok((start, false))
     }
 
-    /// Locates the release inside a held step of `held_part` from `start`
-    /// whose end `end` pulls away with force `f1`: the first bracketed
-    /// fraction of the step at which the force pulls away, and the state
-    /// there.
-    fn release(
-        &self,
-        start: &[T; 4],
-        end: [T; 4],
-        f1: T,
-        held: Contact,
-        away: &impl Fn(&[T; 4]) -> T,
-    ) -> Result<(T, [T; 4]), StepError> {
-        let (mut lo, mut f_lo) = (T::ZERO, away(start));
-        let (mut hi, mut f_hi) = (T::ONE, f1);
-        let mut at_hi = end;
-        let mut side = 0i8;
-        for _ in 0..RELEASE_ITERATIONS {
-            let span = f_hi - f_lo;
-            let mut t = if span > T::ZERO {
-                lo - f_lo * (hi - lo) / span
-            } else {
-                (lo + hi) * T::HALF
-            };
-            if !(t > lo && t < hi) {
-                t = (lo + hi) * T::HALF;
-            }
-            let mut no_carry = T::ZERO;
-            let s = self.step(start, t * self.held_part, held, &mut no_carry)?;
-            let f = away(&s);
-            if f > T::ZERO {
-                (hi, f_hi, at_hi) = (t, f, s);
-                if side == -1 {
-                    f_lo = f_lo * T::HALF;
-                }
-                side = -1;
-            } else {
-                (lo, f_lo) = (t, f);
-                if side == 1 {
-                    f_hi = f_hi * T::HALF;
-                }
-                side = 1;
-            }
-        }
-        Ok((hi, at_hi))
-    }
-
-    /// Free motion over `frac` of a substep from `y`; an impact on a stop
-    /// inside it ends the motion there and holds the plunger for the rest.
-    fn free_part(&self, y: &[T; 4], frac: T, carry: &mut T) -> Result<([T; 4], bool), StepError> {
-        if !(frac > T::ZERO) {
-            return Ok((*y, false));
-        }
-        let mut tried = *carry;
-        let next = self.step(y, frac, Contact::Free, &mut tried)?;
-        let (x0, x1) = (y[0], next[0]);
-        let (stop, contact) = if x1 < T::ZERO {
-            (T::ZERO, Contact::Closed)
-        } else if x1 > T::ONE {
-            (T::ONE, Contact::Open)
-        } else {
-            *carry = tried;
-            return Ok((next, false));
-        };
-        // Impact time on the cubic Hermite interpolant of xi over the step
-        // (theta in [0, 1]), first crossing of the stop: Illinois.
+    /// The fraction of a free step `y -> next` of `frac` substeps at which
+    /// `xi` first reaches `stop`, on the step's cubic Hermite interpolant
+    /// (no model evaluation; the last bracketed point not beyond the stop).
+    fn impact_fraction(&self, y: &[T; 4], next: &[T; 4], frac: T, stop: T) -> T {
         let hx = self.h_a_x * frac;
-        let (d0, d1) = (hx * y[1], hx * next[1]);
-        let p = |t: T| {
-            // Hermite basis on [0, 1].
+        let (x0, x1, d0, d1) = (y[0], next[0], hx * y[1], hx * next[1]);
+        // Positive: beyond the stop.
+        let sign = if stop == T::ZERO { -T::ONE } else { T::ONE };
+        let beyond = |t: T| {
             let t2 = t * t;
             let t3 = t2 * t;
             let h00 = T::TWO * t3 - (t2 + t2 + t2) + T::ONE;
             let h10 = t3 - T::TWO * t2 + t;
             let h01 = (t2 + t2 + t2) - T::TWO * t3;
             let h11 = t3 - t2;
-            h00 * x0 + h10 * d0 + h01 * x1 + h11 * d1 - stop
+            sign * (h00 * x0 + h10 * d0 + h01 * x1 + h11 * d1 - stop)
         };
-        let sign = if contact == Contact::Closed { -T::ONE } else { T::ONE };
-        // Positive: beyond the stop.
-        let (mut lo, mut f_lo) = (T::ZERO, sign * (x0 - stop));
-        let (mut hi, mut f_hi) = (T::ONE, sign * (x1 - stop));
-        let mut side = 0i8;
-        for _ in 0..IMPACT_ITERATIONS {
-            let span = f_hi - f_lo;
-            let mut t = if span > T::ZERO {
-                lo - f_lo * (hi - lo) / span
-            } else {
-                (lo + hi) * T::HALF
-            };
-            if !(t > lo && t < hi) {
-                t = (lo + hi) * T::HALF;
-            }
-            let f = sign * p(t);
-            if f > T::ZERO {
-                (hi, f_hi) = (t, f);
-                if side == -1 {
-                    f_lo = f_lo * T::HALF;
-                }
-                side = -1;
-            } else {
-                (lo, f_lo) = (t, f);
-                if side == 1 {
-                    f_hi = f_hi * T::HALF;
-                }
-                side = 1;
-            }
-        }
-        let theta = lo;
-        let mut at = if theta > T::ZERO {
-            self.step(y, frac * theta, Contact::Free, carry)?
-        } else {
-            *y
-        };
-        // Inelastic impact: on the stop, at rest.
-        at[0] = stop;
-        at[1] = T::ZERO;
-        *carry = T::ZERO;
-        let rest = frac * (T::ONE - theta);
-        let end = if rest > T::ZERO {
-            self.step(&at, rest, contact, carry)?
-        } else {
-            at
-        };
-        Ok((end, true))
+        let r: Result<_, StepError> = illinois(sign * (x0 - stop), sign * (x1 - stop), IMPACT_ITERATIONS, |t| {
+            Ok(beyond(t))
+        });
+        r.map(|(lo, _)| lo).unwrap_or(T::ZERO)
     }
 
     /// The state in SI units.
@@ -417,8 +496,10 @@ impl<F: Float, T: Real> Twin<F, T> {
         self.state
     }
 
-    /// Replaces the state (SI units).
+    /// Replaces the state (SI units); the compensated carry of `xi` starts
+    /// afresh.
     pub fn set_state(&mut self, s: &DynamicState<F>) {
         self.state = self.model.scales.from_si(s);
+        self.xi_carry = T::ZERO;
     }
 }
