@@ -275,6 +275,7 @@ pub fn budget(fw: &Firmware) -> Result<(String, Vec<String>), String> {
 
 /// The full report: budget, pieces, the scheme cost table and the
 /// accuracy-against-cost table (host simulations).
+#[cfg(feature = "host")]
 pub fn report(fw: &Firmware) -> Result<(String, Vec<String>), String> {
     let (m4, m3) = (&fw.m4, &fw.m3);
     let (budget_table, over) = budget(fw)?;
@@ -389,6 +390,7 @@ pub fn report(fw: &Firmware) -> Result<(String, Vec<String>), String> {
 
 /// Worst error (% of the step) over the paper cases of one configuration;
 /// infinite where the scheme is unstable at that step.
+#[cfg(feature = "host")]
 struct Accuracy {
     scheme: String,
     substeps: u32,
@@ -397,6 +399,7 @@ struct Accuracy {
     fixed: f64,
 }
 
+#[cfg(feature = "host")]
 fn accuracy_points(configs: &[(String, u32)]) -> Result<Vec<Accuracy>, String> {
     use compensator::dynamics::Scheme;
     use compensator_cli::dynamics::Precision;
@@ -437,7 +440,9 @@ fn accuracy_points(configs: &[(String, u32)]) -> Result<Vec<Accuracy>, String> {
     Ok(out)
 }
 
-/// `cargo xtask bench [--write]`.
+/// `cargo xtask bench [--write]` (the accuracy table needs the `host`
+/// feature; `main` re-runs xtask with it).
+#[cfg(feature = "host")]
 pub fn cmd(root: &Path, args: &[String]) -> Result<i32, String> {
     let tc = crate::toolchain::get(root, &firmware::TARGETS)?;
     eprintln!("xtask: toolchain: {}", tc.description);
