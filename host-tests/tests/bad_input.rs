@@ -167,12 +167,12 @@ fn sensor_settings_are_checked_alone_and_against_the_oil_range() {
         // A PT1000 on a board fitted for a PT100: R(150 C) = 1573.251 ohm
         // (IEC 60751, by hand: 1000 (1 + 0.58625 - 0.01299)) and two codes
         // of margin, 1573.251 * 32768 / 32766 = 1573.347 ohm.
-        (
-            "rtd_r0 = 1000",
-            "estimator.rtd_reference = 430: must exceed 1573.3472",
-        ),
+        ("rtd_r0 = 1000", "estimator.rtd_reference = 430: must exceed 1573.3472"),
         // The default PT100 at a hotter oil_max: R(300 C) = 212.0515 ohm.
-        ("oil_max = 300\nrtd_reference = 212", "estimator.rtd_reference = 212: must exceed 212.06"),
+        (
+            "oil_max = 300\nrtd_reference = 212",
+            "estimator.rtd_reference = 212: must exceed 212.06",
+        ),
     ];
     for (lines, message) in cases {
         let text = format!("{}\n[estimator]\n{lines}\n", preset_text());

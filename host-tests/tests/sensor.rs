@@ -423,14 +423,20 @@ fn the_simulated_converter_shows_wiring_faults_only_to_the_detection_cycle() {
     drv.configure().unwrap();
     assert_eq!(drv.read(), Err(SensorFault::Wiring), "the start-up cycle");
     let readings: Vec<_> = (0..40).map(|_| drv.read()).collect();
-    assert!(readings.iter().all(|r| matches!(r, Ok(None) | Err(SensorFault::Wiring))));
+    assert!(
+        readings
+            .iter()
+            .all(|r| matches!(r, Ok(None) | Err(SensorFault::Wiring)))
+    );
     assert!(readings.iter().any(|r| r == &Err(SensorFault::Wiring)));
     assert!(drv.device_mut().detection_cycles > 3, "rechecked while faulted");
     // Repaired: the next cycle passes and readings come back.
     drv.device_mut().fault = 0;
     let after: Vec<_> = (0..20).map(|_| drv.read()).collect();
     assert!(
-        after.iter().any(|r| matches!(r, Ok(Some(t)) if (t - 30.0).abs() < 0.02)),
+        after
+            .iter()
+            .any(|r| matches!(r, Ok(Some(t)) if (t - 30.0).abs() < 0.02)),
         "{after:?}"
     );
 }

@@ -413,7 +413,9 @@ impl RawEstimator {
                 return Err(err(
                     p(14),
                     self.rtd_b,
-                    Problem::Inconsistent("the RTD's resistance must rise with temperature over estimator.oil_min..oil_max"),
+                    Problem::Inconsistent(
+                        "the RTD's resistance must rise with temperature over estimator.oil_min..oil_max",
+                    ),
                 ));
             }
             t = self.oil_min + (self.oil_max - self.oil_min) * f64::from(i + 1) / 64.0;

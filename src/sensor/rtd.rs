@@ -120,7 +120,11 @@ mod tests {
     fn a_calibrated_curve_round_trips_and_differs_from_the_standard_one() {
         // A probe 0.1 % steeper than the standard: alpha 0.003854 instead of
         // 0.003850 (the coefficients scaled by hand).
-        let cal = Cvd { a: 3.9122e-3, b: -5.781e-7, c: -4.187e-12 };
+        let cal = Cvd {
+            a: 3.9122e-3,
+            b: -5.781e-7,
+            c: -4.187e-12,
+        };
         for t in [-150.0f32, -20.0, 0.0, 40.0, 80.0, 300.0] {
             let r = cal.resistance(100.0, t);
             let back = cal.temperature(100.0, r).unwrap();
@@ -135,6 +139,10 @@ mod tests {
         // The slope is dR/dt: a finite difference of the curve.
         let (t, h) = (60.0f32, 0.5f32);
         let fd = (cal.resistance(100.0, t + h) - cal.resistance(100.0, t - h)) / (2.0 * h);
-        assert!((cal.slope(100.0, t) - fd).abs() < 1e-4, "{} vs {fd}", cal.slope(100.0, t));
+        assert!(
+            (cal.slope(100.0, t) - fd).abs() < 1e-4,
+            "{} vs {fd}",
+            cal.slope(100.0, t)
+        );
     }
 }

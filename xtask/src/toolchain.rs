@@ -429,7 +429,10 @@ mod tests {
 
     /// Debian 12's web toolchain at `upstream` (e.g. "1.85.0", "1.96.0").
     fn bookworm(upstream: &str) -> HashMap<&'static str, String> {
-        let mm: String = upstream.rsplit_once('.').map(|(a, _)| a.to_string()).unwrap_or_default();
+        let mm: String = upstream
+            .rsplit_once('.')
+            .map(|(a, _)| a.to_string())
+            .unwrap_or_default();
         let v = format!("{upstream}+dfsg1-1~deb12u1");
         let mut m = HashMap::new();
         m.insert(
@@ -476,7 +479,10 @@ mod tests {
     fn versions_parse_from_debian_rustc_and_cargo_forms() {
         assert_eq!(Version::parse("1.85.0+dfsg1-1~deb12u2"), Some(Version(1, 85, 0)));
         assert_eq!(Version::parse("1:19.1.7-3"), Some(Version(19, 1, 7)));
-        assert_eq!(Version::parse("rustc 1.96.0 (abc 2026-05-01) (built from a source tarball)"), Some(Version(1, 96, 0)));
+        assert_eq!(
+            Version::parse("rustc 1.96.0 (abc 2026-05-01) (built from a source tarball)"),
+            Some(Version(1, 96, 0))
+        );
         assert_eq!(Version::parse("1.93"), Some(Version(1, 93, 0)));
         assert_eq!(Version::parse("stable"), None);
         assert!(Version(1, 85, 0) < Version(1, 93, 0) && Version(1, 93, 0) < Version(1, 96, 0));
@@ -522,7 +528,10 @@ mod tests {
         };
         let e = choose_debian(&mut apt, min()).unwrap_err();
         assert_eq!(apt.updates, 1);
-        assert!(e.contains("1.85.0") && e.contains("1.93.0") && e.contains("rustup toolchain install"), "{e}");
+        assert!(
+            e.contains("1.85.0") && e.contains("1.93.0") && e.contains("rustup toolchain install"),
+            "{e}"
+        );
         // Not root: no update, the command to run instead.
         let mut apt = FakeApt {
             lists: bookworm("1.85.0"),
@@ -546,8 +555,14 @@ mod tests {
 
     #[test]
     fn a_cached_toolchain_older_than_the_minimum_is_replaced() {
-        assert!(!cached_is_usable("rustc 1.85.0 (4d215e2de 2025-02-17) (built from a source tarball)", min()));
-        assert!(cached_is_usable("rustc 1.96.0 (0b1d3e6c1 2026-05-25) (built from a source tarball)", min()));
+        assert!(!cached_is_usable(
+            "rustc 1.85.0 (4d215e2de 2025-02-17) (built from a source tarball)",
+            min()
+        ));
+        assert!(cached_is_usable(
+            "rustc 1.96.0 (0b1d3e6c1 2026-05-25) (built from a source tarball)",
+            min()
+        ));
         assert!(!cached_is_usable("garbage", min()));
     }
 }
