@@ -18,7 +18,7 @@ impl TickClock {
     /// core running at `core_hz` [Hz]; `None` unless the core clock is a
     /// whole, non-zero number of MHz and the tick at least one cycle.
     pub const fn new(cycles_per_tick: u32, core_hz: u32) -> Option<TickClock> {
-        if core_hz == 0 || core_hz % 1_000_000 != 0 || cycles_per_tick == 0 {
+        if core_hz == 0 || !core_hz.is_multiple_of(1_000_000) || cycles_per_tick == 0 {
             return None;
         }
         Some(TickClock {

@@ -440,3 +440,59 @@ fn the_simulated_converter_shows_wiring_faults_only_to_the_detection_cycle() {
         "{after:?}"
     );
 }
+
+/// The simulated converter, counting the bytes clocked over SPI.
+struct Counting {
+    sim: SimulatedMax31865,
+    bytes: usize,
+}
+impl ErrorType for Counting {
+    type Error = <SimulatedMax31865 as ErrorType>::Error;
+}
+impl SpiDevice for Counting {
+    fn transaction(&mut self, operations: &mut [Operation<'_, u8>]) -> Result<(), Self::Error> {
+        for op in operations.iter() {
+            self.bytes += match op {
+                Operation::Write(b) => b.len(),
+                Operation::Read(b) => b.len(),
+                Operation::Transfer(r, _) => r.len(),
+                Operation::TransferInPlace(b) => b.len(),
+                Operation::DelayNs(_) => 0,
+            };
+        }
+        self.sim.transaction(operations)
+    }
+}
+
+#[test]
+fn no_reading_call_clocks_more_than_nine_bytes() {
+    // The tick budget: every read() is a few short transactions, whatever
+    // the diagnosis is doing. Over a minute of readings with a wiring
+    // fault, an open RTD and a repair, the worst call moves 9 bytes (an
+    // RTD read with its fault path and a cycle start), 72 us at the
+    // board's 1 MHz SPI clock, of a 1 ms tick.
+    let settings = Settings {
+        diagnosis_every: 50,
+        ..SETTINGS
+    };
+    let dev = Counting {
+        sim: SimulatedMax31865::new(settings, 40.0),
+        bytes: 0,
+    };
+    let mut drv = Max31865::new(dev, settings);
+    drv.configure().unwrap();
+    let mut worst = 0;
+    for k in 0..3000 {
+        let sim = &mut drv.device_mut().sim;
+        sim.fault = match k {
+            500..800 => fault::RTDIN_LOW,
+            1200..1300 => fault::RTD_HIGH,
+            1500..1520 => fault::RTD_HIGH | fault::REFIN_HIGH,
+            _ => 0,
+        };
+        drv.device_mut().bytes = 0;
+        let _ = drv.read();
+        worst = worst.max(drv.device_mut().bytes);
+    }
+    assert_eq!(worst, 9);
+}

@@ -7,15 +7,15 @@
 //! reads and writes, write address = read | 0x80), converts the oil
 //! temperature to the RTD code by Callendar-Van Dusen (the settings'
 //! coefficients), and injects faults: a persistent fault cause (status
-//! bits: RTD high/low and over/under-voltage are latched by every
+//! bits; RTD high/low and over/under-voltage are latched by every
 //! conversion read, the REFIN-/RTDIN- wiring bits only by a fault-detection
 //! cycle; the latch sets the RTD word's fault bit until cleared, and
 //! clearing only clears the latch), a forced code, a failing bus, or a
 //! MISO line stuck high (every byte reads 0xFF).
 //!
-//! Timing is not modelled: a fault-detection cycle (configuration D3:D2 =
-//! 01) completes at once (D3:D2 read back 00), and the RTD registers hold
-//! their last value while automatic conversion is off.
+//! Timing is not modelled: a fault-detection cycle (configuration bits
+//! D3:D2 set to 01) completes at once (D3:D2 read back 00), and the RTD
+//! registers hold their last value while automatic conversion is off.
 
 use super::max31865::{REG_CONFIG, REG_FAULT_STATUS, REG_RTD_MSB, Settings, code_of, config, fault};
 use embedded_hal::spi::{ErrorKind, ErrorType, Operation, SpiDevice};

@@ -164,10 +164,11 @@ pub fn run(elf: &Path, machine: Machine, icount: bool, timeout: Duration, show: 
                                 let mut o = stdout.lock();
                                 // Telemetry rounded for reading (`lines` keeps every digit).
                                 let _ = write!(o, "{}", crate::telemetry::humanize(&line));
-                                if let Some(loc) = locations.as_ref().and_then(|l| l.get(&frame.index())) {
-                                    if level != "INFO" && level != "PRINT" {
-                                        let _ = write!(o, "  ({}:{})", loc.file.display(), loc.line);
-                                    }
+                                if let Some(loc) = locations.as_ref().and_then(|l| l.get(&frame.index()))
+                                    && level != "INFO"
+                                    && level != "PRINT"
+                                {
+                                    let _ = write!(o, "  ({}:{})", loc.file.display(), loc.line);
                                 }
                                 let _ = writeln!(o);
                             }
