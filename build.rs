@@ -8,10 +8,12 @@
 //!    that an overflow faults instead of corrupting `.bss`). No `memory.x`
 //!    may sit in the workspace root: the linker runs there and would find
 //!    it before the search path.
-//! 2. Turns the parameter file into constants (`$OUT_DIR/params.rs`): the
-//!    file named by `COMPENSATOR_PARAMS` (default `presets/paper.toml`; a
-//!    relative path is taken from the directory the command was run in,
-//!    `$PWD`, as the CLI takes `--params`), read and validated by the same
+//! 2. For the firmware images (features `qemu`, `board`; host builds
+//!    include no parameter file), turns the parameter file into constants
+//!    (`$OUT_DIR/params.rs`): the file named by `COMPENSATOR_PARAMS`
+//!    (default `presets/paper.toml`; a relative path is taken from the
+//!    directory the command was run in, `$PWD`, as the CLI takes
+//!    `--params`), read and validated by the same
 //!    reader as the host tools, so that a device is only ever flashed with
 //!    a valid parameter set. A refused file fails the build with one line
 //!    naming the field (`cargo::error`, no backtrace).
@@ -37,6 +39,7 @@ fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
     let target = env::var("TARGET").unwrap_or_default();
     let board = env::var_os("CARGO_FEATURE_BOARD").is_some();
+    let firmware = board || env::var_os("CARGO_FEATURE_QEMU").is_some();
 
     if target.starts_with("thumb") {
         let layout = if board {
@@ -49,6 +52,12 @@ fn main() {
         println!("cargo:rerun-if-changed={layout}");
     }
 
+    if !firmware {
+        // Host builds (CLI, host tests, xtask) include no parameter file:
+        // COMPENSATOR_PARAMS neither rebuilds nor breaks them.
+        println!("cargo:rerun-if-changed=build.rs");
+        return;
+    }
     println!("cargo:rerun-if-env-changed=COMPENSATOR_PARAMS");
     let params = match env::var_os("COMPENSATOR_PARAMS") {
         Some(p) => {
@@ -67,6 +76,9 @@ fn main() {
         }
         None => manifest.join("presets/paper.toml"),
     };
+    // `dir/../file` as `file`, in messages and for cargo (a missing file is
+    // reported by the reader below).
+    let params = fs::canonicalize(&params).unwrap_or(params);
     println!("cargo:rerun-if-changed={}", params.display());
     let raw = match compensator_params::file::load(&params) {
         Ok(raw) => raw,

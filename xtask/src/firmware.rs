@@ -190,6 +190,51 @@ pub fn build_all(root: &Path, params: Option<&Path>) -> Result<(), String> {
     Ok(())
 }
 
+/// A parameter file the CLI refuses (a PT1000 on the 430 ohm board) fails a
+/// plain `cargo build` of the board image, run from `presets/` with the
+/// file's path relative to there, with one line naming the field and no
+/// panic: the build script's contract, for users who build without xtask.
+pub fn check_refused_file(tc: &Toolchain, root: &Path) -> Result<(), String> {
+    let text = std::fs::read_to_string(root.join("presets/paper.toml")).map_err(|e| e.to_string())?;
+    let file = root.join("target/xtask/pt1000-on-430-ohm.toml");
+    std::fs::create_dir_all(file.parent().expect("has a parent")).map_err(|e| e.to_string())?;
+    std::fs::write(&file, format!("{text}\n[estimator]\nrtd_r0 = 1000\n")).map_err(|e| e.to_string())?;
+    let presets = root.join("presets");
+    let mut cmd = tc.cargo();
+    cmd.current_dir(&presets)
+        // What a shell sets: the directory the user typed the command in.
+        .env("PWD", &presets)
+        .env("COMPENSATOR_PARAMS", "../target/xtask/pt1000-on-430-ohm.toml")
+        .args([
+            "build",
+            "--quiet",
+            "--release",
+            "--package",
+            "compensator",
+            "--bin",
+            "board",
+        ])
+        .args(["--target", M4, "--no-default-features", "--features", "board"])
+        .arg("--target-dir")
+        .arg(target_dir(root))
+        .args(tc.build_args());
+    let out = process::capture(&mut cmd, Duration::from_secs(600));
+    let naming: Vec<&str> = out
+        .stderr
+        .lines()
+        .filter(|l| l.contains("estimator.rtd_reference"))
+        .collect();
+    let expected = format!("{}: estimator.rtd_reference = 430: must exceed", file.display());
+    if out.code == Some(0) || naming.len() != 1 || !naming[0].contains(&expected) || out.stderr.contains("panicked") {
+        return Err(format!(
+            "a refused parameter file should fail the build with one line naming estimator.rtd_reference; cargo said (exit {:?}):\n{}",
+            out.code, out.stderr
+        ));
+    }
+    eprintln!("xtask: {}", naming[0].trim());
+    Ok(())
+}
+
 /// Compares decoded QEMU output, without its `[measure]` lines, with
 /// `tests/snapshots/<name>.log` (`--bless` rewrites it).
 pub fn check_snapshot(root: &Path, name: &str, lines: &[String], bless: bool) -> Result<(), String> {

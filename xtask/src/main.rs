@@ -328,6 +328,8 @@ fn cmd_test(args: &[String]) -> Outcome {
             .find(|l| l.contains("checks:"))
             .map_or("", String::as_str)
     );
+    step("a parameter file the CLI refuses fails the firmware build in one line naming the field");
+    firmware::check_refused_file(&tc, &root)?;
     step("firmware images");
     let elfs = firmware::build_all_with(&tc, &root)?;
     let twin = firmware::build_with(&tc, &root, &firmware::Image::TWIN, firmware::Options::default())?;
