@@ -369,7 +369,15 @@ pub fn get(workspace: &Path, targets: &[&str]) -> Result<Toolchain, String> {
             if add.timed_out {
                 "deadline passed".to_string()
             } else {
-                add.stderr.lines().last().unwrap_or("failed").trim().to_string()
+                // rustup's first error line says what failed (the last one
+                // is often a bare curl code).
+                add.stderr
+                    .lines()
+                    .find(|l| l.trim_start().starts_with("error"))
+                    .or_else(|| add.stderr.lines().last())
+                    .unwrap_or("failed")
+                    .trim()
+                    .to_string()
             }
         );
     }
@@ -427,35 +435,45 @@ mod tests {
         format!("Package: {pkg}\nVersion: {version}\nArchitecture: amd64\nDepends: {depends}\nDescription: x\n")
     }
 
-    /// Debian 12's web toolchain at `upstream` (e.g. "1.85.0", "1.96.0").
+    /// Debian 12's web toolchain at `upstream` (e.g. "1.85.0", "1.96.0"),
+    /// with the dependency chain of bookworm's 1.96 records: rustc-web ->
+    /// libstd-rust-web-dev -> libstd-rust-web-1.96 -> libllvm22.
     fn bookworm(upstream: &str) -> HashMap<&'static str, String> {
         let mm: String = upstream
             .rsplit_once('.')
             .map(|(a, _)| a.to_string())
             .unwrap_or_default();
-        let v = format!("{upstream}+dfsg1-1~deb12u1");
+        let v = format!("{upstream}+dfsg1-1~deb12u2");
         let mut m = HashMap::new();
         m.insert(
             "rustc-web",
             record(
                 "rustc-web",
                 &v,
-                &format!("libc6 (>= 2.34), libstd-rust-web-{mm} (= {v}), gcc, libc-dev, binutils (>= 2.26)"),
+                &format!("libc6 (>= 2.34), libgcc-s1 (>= 3.0), libstd-rust-web-dev (= {v}), gcc, libc-dev, binutils (>= 2.26)"),
             ),
         );
         m.insert("rust-web-src", record("rust-web-src", &v, ""));
         m.insert(
-            "libstd-rust-web-",
-            record("libstd-rust-web", &v, "libc6 (>= 2.34), libllvm19, libgcc-s1"),
+            "libstd-rust-web-dev",
+            record("libstd-rust-web-dev", &v, &format!("libstd-rust-web-{mm} (= {v})")),
         );
-        m.insert("libllvm19", record("libllvm19", "1:19.1.7-3", "libc6, libffi8"));
+        m.insert(
+            "libstd-rust-web-1.",
+            record(
+                "libstd-rust-web",
+                &v,
+                "libc6 (>= 2.34), libgcc-s1 (>= 4.2), libllvm22, libstdc++6 (>= 11)",
+            ),
+        );
+        m.insert("libllvm22", record("libllvm22", "1:22.1.0-1", "libc6, libffi8"));
         m
     }
 
     impl Apt for FakeApt {
         fn show(&mut self, pkg: &str) -> Option<String> {
-            let key = if pkg.starts_with("libstd-rust-web-") {
-                "libstd-rust-web-"
+            let key = if pkg.starts_with("libstd-rust-web-1.") {
+                "libstd-rust-web-1."
             } else {
                 self.lists.keys().find(|k| **k == pkg).copied()?
             };
@@ -502,7 +520,16 @@ mod tests {
         let (pkgs, v) = choose_debian(&mut apt, min()).unwrap();
         assert_eq!(v, Version(1, 96, 0));
         assert_eq!(apt.updates, 1);
-        assert_eq!(pkgs, ["rustc-web", "rust-web-src", "libstd-rust-web-1.96", "libllvm19"]);
+        assert_eq!(
+            pkgs,
+            [
+                "rustc-web",
+                "rust-web-src",
+                "libstd-rust-web-dev",
+                "libstd-rust-web-1.96",
+                "libllvm22"
+            ]
+        );
     }
 
     #[test]
@@ -551,6 +578,17 @@ mod tests {
         };
         let e = choose_debian(&mut apt, min()).unwrap_err();
         assert!(e.contains("no rustc-web"), "{e}");
+    }
+
+    #[test]
+    fn rust_toolchain_toml_names_every_firmware_target() {
+        // rustup installs what the file names: the targets xtask builds for.
+        let text = std::fs::read_to_string(crate::root().join("rust-toolchain.toml")).unwrap();
+        let targets = text.lines().find(|l| l.starts_with("targets")).unwrap();
+        for t in crate::firmware::TARGETS {
+            assert!(targets.contains(&format!("\"{t}\"")), "{t} missing from {targets}");
+        }
+        assert!(text.contains("channel = \"stable\""));
     }
 
     #[test]
