@@ -1,19 +1,35 @@
 //! Build script of the firmware package.
 //!
-//! 1. Puts `memory.x` (STM32F405: 1 MiB flash, 128 KiB RAM) on the linker's
-//!    search path. The Cortex-M3 benchmark runs on QEMU's `netduino2`
-//!    (STM32F205), which has the same memory map, so one layout serves both.
-//! 2. Turns the parameter file into constants (`$OUT_DIR/params.rs`): the
-//!    file named by `COMPENSATOR_PARAMS` (default `presets/paper.toml`),
-//!    read and validated by the same reader as the host tools, so that a
-//!    device is only ever flashed with a valid parameter set. A bad file
-//!    fails the build with the field's name.
-//! 3. Writes the QEMU twin's replay schedule and the bounds it checks
-//!    itself against (`$OUT_DIR/replay.rs`), and the expectations of the
-//!    on-target tests (`$OUT_DIR/expectations.rs`). Both are computed here,
-//!    on the host, in `f64` by the independent reference
-//!    (`compensator-reference`: bisection on each chamber's flow balance,
-//!    Walther and density written from MODEL.md), never by the core.
+//! 1. Puts the memory layout on the linker's search path as `memory.x`:
+//!    `link/memory-qemu.x` (STM32F405: 1 MiB flash, 128 KiB RAM) for the
+//!    QEMU images (the Cortex-M3 benchmark runs on QEMU's `netduino2`, an
+//!    STM32F205 with the same map), `link/memory-board.x` for the board
+//!    image (feature `board`: the stack alone in the core-coupled RAM, so
+//!    that an overflow faults instead of corrupting `.bss`). No `memory.x`
+//!    may sit in the workspace root: the linker runs there and would find
+//!    it before the search path.
+//! 2. For the firmware images (features `qemu`, `board`; host builds
+//!    include no parameter file), turns the parameter file into constants
+//!    (`$OUT_DIR/params.rs`): the file named by `COMPENSATOR_PARAMS`
+//!    (default `presets/paper.toml`; a relative path is taken from the
+//!    directory the command was run in, `$PWD`, as the CLI takes
+//!    `--params`), read and validated by the same
+//!    reader as the host tools, so that a device is only ever flashed with
+//!    a valid parameter set. A refused file fails the build with one line
+//!    naming the field (`cargo::error`, no backtrace).
+//! 3. For the QEMU images only (feature `qemu`): the QEMU twin's replay
+//!    schedule, adapted to the device's validated and oil ranges, and the
+//!    bounds it checks itself against (`$OUT_DIR/replay.rs`, and the same
+//!    schedule as text in `$OUT_DIR/replay.txt` for the host-side replica
+//!    of `cargo xtask test`), and the expectations of the on-target tests
+//!    (`$OUT_DIR/expectations.rs`). Both are computed here, on the host, in
+//!    `f64` by the independent reference (`compensator-reference`:
+//!    bisection on each chamber's flow balance, Walther and density written
+//!    from MODEL.md), never by the core. The board image needs none of it,
+//!    and does not build the reference.
+
+// The replay's template is only used for the QEMU images (feature `qemu`).
+#![cfg_attr(not(feature = "qemu"), allow(dead_code))]
 
 use std::path::PathBuf;
 use std::{env, fs};
@@ -22,27 +38,54 @@ fn main() {
     let manifest = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").unwrap());
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
     let target = env::var("TARGET").unwrap_or_default();
+    let board = env::var_os("CARGO_FEATURE_BOARD").is_some();
+    let firmware = board || env::var_os("CARGO_FEATURE_QEMU").is_some();
 
     if target.starts_with("thumb") {
-        fs::copy(manifest.join("memory.x"), out.join("memory.x")).expect("copy memory.x");
+        let layout = if board {
+            "link/memory-board.x"
+        } else {
+            "link/memory-qemu.x"
+        };
+        fs::copy(manifest.join(layout), out.join("memory.x")).expect("copy the memory layout");
         println!("cargo:rustc-link-search={}", out.display());
-        println!("cargo:rerun-if-changed=memory.x");
+        println!("cargo:rerun-if-changed={layout}");
     }
 
+    if !firmware {
+        // Host builds (CLI, host tests, xtask) include no parameter file:
+        // COMPENSATOR_PARAMS neither rebuilds nor breaks them.
+        println!("cargo:rerun-if-changed=build.rs");
+        return;
+    }
     println!("cargo:rerun-if-env-changed=COMPENSATOR_PARAMS");
     let params = match env::var_os("COMPENSATOR_PARAMS") {
         Some(p) => {
             let p = PathBuf::from(p);
-            if p.is_absolute() { p } else { manifest.join(p) }
+            if p.is_absolute() {
+                p
+            } else {
+                // Where the user ran cargo (cargo itself runs this script in
+                // the package's directory).
+                println!("cargo:rerun-if-env-changed=PWD");
+                match env::var_os("PWD").map(PathBuf::from) {
+                    Some(cwd) if cwd.is_absolute() => cwd.join(p),
+                    _ => manifest.join(p),
+                }
+            }
         }
         None => manifest.join("presets/paper.toml"),
     };
+    // `dir/../file` as `file`, in messages and for cargo (a missing file is
+    // reported by the reader below).
+    let params = fs::canonicalize(&params).unwrap_or(params);
     println!("cargo:rerun-if-changed={}", params.display());
     let raw = match compensator_params::file::load(&params) {
         Ok(raw) => raw,
         Err(e) => {
-            eprintln!("error: parameter file {}: {e}", params.display());
-            std::process::exit(1);
+            // One line naming the field; cargo fails the build after it.
+            println!("cargo::error=parameter file {}: {e}", params.display());
+            return;
         }
     };
     let array = |v: &[f64]| v.iter().map(|x| format!("{x:?}")).collect::<Vec<_>>().join(", ");
@@ -71,10 +114,16 @@ fn main() {
             .unwrap_or_default(),
     );
     fs::write(out.join("params.rs"), code).expect("write params.rs");
-    let rtd = (raw.estimator.rtd_r0, raw.estimator.rtd_reference);
-    let valid = (raw.estimator.valid_min, raw.estimator.valid_max);
-    fs::write(out.join("replay.rs"), replay(&raw.core, rtd, valid)).expect("write replay.rs");
-    fs::write(out.join("expectations.rs"), expectations(&raw.core)).expect("write expectations.rs");
+    #[cfg(feature = "qemu")]
+    {
+        let replay = adapt(&raw.estimator);
+        for note in &replay.notes {
+            println!("cargo::warning={note}");
+        }
+        fs::write(out.join("replay.rs"), replay_rs(&raw.core, &raw.estimator, &replay)).expect("write replay.rs");
+        fs::write(out.join("replay.txt"), replay.schedule()).expect("write replay.txt");
+        fs::write(out.join("expectations.rs"), expectations(&raw.core)).expect("write expectations.rs");
+    }
 }
 
 /// Temperature pieces of the replay: (start [s], end [s], from [C], to [C]).
@@ -104,42 +153,190 @@ const FAULTS: [(f64, f64, &str, &str); 5] = [
 /// ample for the 60 -> 90 C step).
 const OUT_OF_RANGE_DELAY: f64 = 0.5;
 
-/// The replay and its checkpoints: at the end of each hold the estimate
-/// must sit at the reference equilibrium.
-fn replay(core: &compensator_params::RawCore, rtd: (f64, f64), valid: (f64, f64)) -> String {
+/// Margin kept inside the oil range by the replay's temperatures [C]: a
+/// sample outside `estimator.oil_min..oil_max` is a sensor fault, not a
+/// temperature.
+const OIL_MARGIN: f64 = 1.0;
+
+/// Room the out-of-range hold needs beyond the validated range [C].
+const OUT_OF_RANGE_ROOM: f64 = 2.0;
+
+/// How far the template's out-of-range hold lies beyond the validated
+/// range (90 C against 78 C) [C].
+const OUT_OF_RANGE_DEPTH: f64 = 12.0;
+
+/// The replay as run for this device.
+#[cfg(feature = "qemu")]
+struct Replay {
+    /// (start s, end s, from C, to C).
+    pieces: Vec<(f64, f64, f64, f64)>,
+    /// (start s, end s, `Injected` variant, `Flags` constant).
+    faults: Vec<(f64, f64, &'static str, &'static str)>,
+    /// When OUT_OF_RANGE must be raised (from s, to s); `None` when the
+    /// oil range leaves no room outside the validated one.
+    out_of_range: Option<(f64, f64)>,
+    /// What the injected spike adds to the temperature [C].
+    spike: f64,
+    /// What could not be adapted (shown as build warnings).
+    notes: Vec<String>,
+}
+
+#[cfg(feature = "qemu")]
+impl Replay {
+    /// Temperature of the replay at `t` [s].
+    fn temperature_at(&self, t: f64) -> f64 {
+        for &(t0, t1, a, b) in &self.pieces {
+            if t >= t0 && t < t1 {
+                return a + (b - a) * (t - t0) / (t1 - t0);
+            }
+        }
+        self.pieces.last().map_or(0.0, |p| p.3)
+    }
+
+    /// The schedule as text, one item a line (read by `cargo xtask`).
+    fn schedule(&self) -> String {
+        let mut s =
+            String::from("# The QEMU twin's replay, generated by build.rs (read by cargo xtask's host-side replica)\n");
+        for (a, b, c, d) in &self.pieces {
+            s += &format!("piece {a:?} {b:?} {c:?} {d:?}\n");
+        }
+        for (a, b, k, _) in &self.faults {
+            s += &format!("fault {a:?} {b:?} {k}\n");
+        }
+        s += &format!("spike_delta {:?}\n", self.spike);
+        s
+    }
+}
+
+/// The template replay (`PIECES`, `FAULTS`, written for the paper's 26-78 C
+/// and -20..150 C) adapted to a device's ranges, so that any parameter file
+/// the CLI accepts builds the QEMU twin: every temperature inside the oil
+/// range; an out-of-range hold outside the validated range (the template's
+/// if it is, else the hottest hold moved above it, or the coldest below,
+/// where the oil range leaves room); a spike larger than the spike
+/// threshold that stays inside the oil range.
+#[cfg(feature = "qemu")]
+fn adapt(est: &compensator_params::RawEstimator) -> Replay {
+    let (oil_lo, oil_hi) = (est.oil_min + OIL_MARGIN, est.oil_max - OIL_MARGIN);
+    let (valid_lo, valid_hi) = (est.valid_min, est.valid_max);
+    let clamp = |t: f64| {
+        if oil_lo < oil_hi {
+            t.clamp(oil_lo, oil_hi)
+        } else {
+            (est.oil_min + est.oil_max) / 2.0
+        }
+    };
+    let mut notes = Vec::new();
+    let mut pieces: Vec<(f64, f64, f64, f64)> = PIECES.iter().map(|&(a, b, c, d)| (a, b, clamp(c), clamp(d))).collect();
+    let outside = |t: f64| !(valid_lo..=valid_hi).contains(&t);
+    let is_hold = |p: &(f64, f64, f64, f64)| p.2 == p.3;
+    if !pieces.iter().any(|p| is_hold(p) && outside(p.3)) {
+        let above = oil_hi - valid_hi;
+        let below = valid_lo - oil_lo;
+        let hottest = (0..pieces.len())
+            .filter(|&i| is_hold(&pieces[i]))
+            .max_by(|&i, &j| pieces[i].3.total_cmp(&pieces[j].3));
+        let coldest = (0..pieces.len())
+            .filter(|&i| is_hold(&pieces[i]))
+            .min_by(|&i, &j| pieces[i].3.total_cmp(&pieces[j].3));
+        if let (Some(i), true) = (hottest, above >= OUT_OF_RANGE_ROOM) {
+            let t = valid_hi + OUT_OF_RANGE_DEPTH.min(above);
+            pieces[i].2 = t;
+            pieces[i].3 = t;
+        } else if let (Some(i), true) = (coldest, below >= OUT_OF_RANGE_ROOM) {
+            let t = valid_lo - OUT_OF_RANGE_DEPTH.min(below);
+            pieces[i].2 = t;
+            pieces[i].3 = t;
+        } else {
+            notes.push(format!(
+                "the validated range {valid_lo}..{valid_hi} C leaves no room inside the oil range {}..{} C: the QEMU twin does not check OUT_OF_RANGE",
+                est.oil_min, est.oil_max
+            ));
+        }
+    }
+    let out_of_range = pieces
+        .iter()
+        .find(|p| is_hold(p) && outside(p.3))
+        .map(|p| (p.0 + OUT_OF_RANGE_DELAY, p.1));
+    let mut replay = Replay {
+        pieces,
+        faults: FAULTS.to_vec(),
+        out_of_range,
+        spike: 0.0,
+        notes,
+    };
+    // The spike: out of the filter's band (more than spike_threshold away),
+    // inside the oil range (else it is a sensor fault, not a spike).
+    let at = FAULTS.iter().find(|f| f.2 == "Spike").map_or(0.0, |f| f.0);
+    let t = replay.temperature_at(at);
+    let want = (2.0 * est.spike_threshold).max(40.0);
+    let (up, down) = (oil_hi - t, t - oil_lo);
+    replay.spike = if up >= want {
+        want
+    } else if down >= want {
+        -want
+    } else if up >= down {
+        up
+    } else {
+        -down
+    };
+    if replay.spike.abs() <= est.spike_threshold {
+        replay.notes.push(format!(
+            "the oil range leaves no room for a spike beyond estimator.spike_threshold = {}: the QEMU twin's spike check will fail",
+            est.spike_threshold
+        ));
+    }
+    replay
+}
+
+/// The replay's Rust constants and its checkpoints: at the end of each hold
+/// inside the validated range the estimate must sit at the reference
+/// equilibrium.
+#[cfg(feature = "qemu")]
+fn replay_rs(core: &compensator_params::RawCore, est: &compensator_params::RawEstimator, replay: &Replay) -> String {
     let mut s = String::from("// Generated by build.rs.\n");
     s += "/// Temperature pieces: (start s, end s, from C, to C).\n";
-    s += "const REPLAY_PIECES: [(f32, f32, f32, f32); 7] = [\n";
-    for (a, b, c, d) in PIECES {
+    s += &format!(
+        "const REPLAY_PIECES: [(f32, f32, f32, f32); {}] = [\n",
+        replay.pieces.len()
+    );
+    for (a, b, c, d) in &replay.pieces {
         s += &format!("    ({a:?}, {b:?}, {c:?}, {d:?}),\n");
     }
     s += "];\n/// Injected faults: (start s, end s, what, flag expected).\n";
-    s += "const REPLAY_FAULTS: [(f32, f32, Injected, Flags); 5] = [\n";
-    for (a, b, k, f) in FAULTS {
+    s += &format!(
+        "const REPLAY_FAULTS: [(f32, f32, Injected, Flags); {}] = [\n",
+        replay.faults.len()
+    );
+    for (a, b, k, f) in &replay.faults {
         s += &format!("    ({a:?}, {b:?}, Injected::{k}, Flags::{f}),\n");
     }
     s += "];\n";
-    let outside = PIECES
-        .iter()
-        .find(|p| p.2 == p.3 && !(valid.0..=valid.1).contains(&p.3))
-        .expect("the replay leaves the validated range");
+    s += "/// What the injected spike adds to the temperature [C] (beyond the\n";
+    s += "/// spike threshold, inside the oil range).\n";
+    s += &format!("const SPIKE_DELTA: f32 = {:?};\n", replay.spike);
+    let (from, to) = replay.out_of_range.unwrap_or((0.0, 0.0));
     s += "/// When the estimate must be flagged OUT_OF_RANGE: (from s, to s).\n";
+    s += &format!("const OUT_OF_RANGE_HOLD: (f32, f32) = ({from:?}, {to:?});\n");
+    s += "/// Whether the replay leaves the validated range at all (the oil\n";
+    s += "/// range may leave no room beyond it).\n";
     s += &format!(
-        "const OUT_OF_RANGE_HOLD: (f32, f32) = ({:?}, {:?});\n",
-        outside.0 + OUT_OF_RANGE_DELAY,
-        outside.1
+        "const OUT_OF_RANGE_REACHABLE: bool = {};\n",
+        replay.out_of_range.is_some()
     );
     s += "/// Checkpoints from the f64 reference, over the sensor's quantization\n";
     s += "/// (half a code either side): (time s, temperature C, half code C,\n";
     s += "/// x min/max m, p_a min/max Pa, p_b min/max Pa).\n";
-    let holds: Vec<(f64, f64)> = PIECES
+    let (valid_lo, valid_hi) = (est.valid_min, est.valid_max);
+    let holds: Vec<(f64, f64)> = replay
+        .pieces
         .iter()
-        .filter(|p| p.2 == p.3 && (valid.0..=valid.1).contains(&p.3))
+        .filter(|p| p.2 == p.3 && (valid_lo..=valid_hi).contains(&p.3))
         .map(|p| (p.1 - 0.001, p.3))
         .collect();
     s += &format!("const CHECKPOINTS: [(f32, f32, f32, [f32; 6]); {}] = [\n", holds.len());
     for (t, temp) in holds {
-        let half = half_code(rtd, temp);
+        let half = half_code(est, temp);
         let lo = compensator_reference::statics::equilibrium(core, temp - half);
         let hi = compensator_reference::statics::equilibrium(core, temp + half);
         // x and p_b rise with temperature, p_a falls.
@@ -151,14 +348,15 @@ fn replay(core: &compensator_params::RawCore, rtd: (f64, f64), valid: (f64, f64)
 }
 
 /// Half a MAX31865 code in degrees at `t` [C]: `(R_ref / 2^16) / (dR/dt)`,
-/// with Callendar-Van Dusen's slope `R0 (A + 2 B t)` (t >= 0).
-fn half_code(rtd: (f64, f64), t: f64) -> f64 {
-    let (r0, reference) = rtd;
-    (reference / 65536.0) / (r0 * (3.9083e-3 - 2.0 * 5.775e-7 * t))
+/// with the device's Callendar-Van Dusen slope.
+#[cfg(feature = "qemu")]
+fn half_code(est: &compensator_params::RawEstimator, t: f64) -> f64 {
+    (est.rtd_reference / 65536.0) / est.rtd_slope(t)
 }
 
 /// Host-computed values the core's `f32` results on the target are
 /// checked against: (t C, nu m^2/s, rho kg/m^3, p_a Pa, p_b Pa, x m, Q0 m^3/s).
+#[cfg(feature = "qemu")]
 fn expectations(core: &compensator_params::RawCore) -> String {
     let mut s = String::from("// Generated by build.rs from the f64 reference.\n");
     let temps = [26.0, 30.0, 35.0, 40.0, 50.0, 60.0, 70.0, 78.0];

@@ -607,6 +607,6 @@ impl Estimator {
 
     /// `true` when this tick's estimate should be published.
     pub fn telemetry_due(&self) -> bool {
-        self.config.telemetry_every > 0 && self.tick % self.config.telemetry_every == 0
+        self.config.telemetry_every > 0 && self.tick.is_multiple_of(self.config.telemetry_every)
     }
 }

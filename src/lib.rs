@@ -28,6 +28,7 @@
 #![forbid(unsafe_op_in_unsafe_fn)]
 
 pub mod asymptotic;
+pub mod clock;
 pub mod compensation;
 pub mod dynamics;
 pub mod equilibrium;
@@ -41,6 +42,8 @@ pub mod scalar;
 pub mod sensor;
 pub mod throttle;
 
+#[cfg(all(feature = "qemu", target_os = "none"))]
+pub mod qemu;
 #[cfg(all(feature = "qemu", target_os = "none"))]
 mod qemu_log;
 

@@ -131,11 +131,11 @@ pub fn find_balance(raw: &RawParams, p: &Params<f64>) -> Result<f64, CliError> {
     for i in 0..=n {
         let t = (lo + i as f64).min(hi);
         if let Some(v) = g(t) {
-            if let Some((tp, vp)) = prev {
-                if (vp > 0.0) != (v > 0.0) {
-                    return balance_temperature(p, tp, t)
-                        .map_err(|e| CliError::Failed(format!("balance temperature: {e}")));
-                }
+            if let Some((tp, vp)) = prev
+                && (vp > 0.0) != (v > 0.0)
+            {
+                return balance_temperature(p, tp, t)
+                    .map_err(|e| CliError::Failed(format!("balance temperature: {e}")));
             }
             prev = Some((t, v));
         }

@@ -72,6 +72,13 @@ fn main() {
     // `cargo bench` passes `--bench`; a workload name selects one.
     let arg = std::env::args().skip(1).find(|a| !a.starts_with("--"));
     match arg {
+        // For `cargo xtask callgrind`: the operation count and the workloads.
+        Some(list) if list == "list" => {
+            println!("count {COUNT}");
+            for name in WORKLOADS {
+                println!("workload {name}");
+            }
+        }
         Some(name) => {
             if !run(&name) {
                 eprintln!("unknown workload {name}");

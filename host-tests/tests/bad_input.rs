@@ -153,6 +153,43 @@ fn estimator_settings_the_loop_cannot_honour_are_rejected() {
 }
 
 #[test]
+fn sensor_settings_are_checked_alone_and_against_the_oil_range() {
+    let cases: &[(&str, &str)] = &[
+        ("rtd_wires = 5", "estimator.rtd_wires = 5: must lie in [2, 4]"),
+        ("rtd_wires = 2.5", "estimator.rtd_wires = 2.5: must be a whole number"),
+        ("mains_hz = 55", "estimator.mains_hz = 55: must be 50 or 60"),
+        ("rtd_a = 0.039", "estimator.rtd_a = 0.039: must lie in [0.001, 0.01]"),
+        // R(t) falling above 195 C: A + 2 B t < 0 there, inside oil_max = 300.
+        (
+            "oil_max = 300\nrtd_reference = 4000\nrtd_b = -1.0e-5",
+            "estimator.rtd_b = -0.00001: the RTD's resistance must rise with temperature over estimator.oil_min..oil_max",
+        ),
+        // A PT1000 on a board fitted for a PT100: R(150 C) = 1573.251 ohm
+        // (IEC 60751, by hand: 1000 (1 + 0.58625 - 0.01299)) and two codes
+        // of margin, 1573.251 * 32768 / 32766 = 1573.347 ohm.
+        ("rtd_r0 = 1000", "estimator.rtd_reference = 430: must exceed 1573.3472"),
+        // The default PT100 at a hotter oil_max: R(300 C) = 212.0515 ohm.
+        (
+            "oil_max = 300\nrtd_reference = 212",
+            "estimator.rtd_reference = 212: must exceed 212.06",
+        ),
+    ];
+    for (lines, message) in cases {
+        let text = format!("{}\n[estimator]\n{lines}\n", preset_text());
+        let e = param_error(&text).to_string();
+        assert!(e.starts_with(message), "{lines}: {e}");
+    }
+    // The board's own settings are accepted: 4 wires, 60 Hz, a calibrated
+    // curve, a PT1000 with its 4300 ohm reference.
+    let text = format!(
+        "{}\n[estimator]\nrtd_wires = 4\nmains_hz = 60\nrtd_r0 = 1000\nrtd_reference = 4300\nrtd_a = 3.9122e-3\nrtd_b = -5.781e-7\n",
+        preset_text()
+    );
+    let raw = params_file::parse(&text).unwrap();
+    assert_eq!((raw.estimator.rtd_wires, raw.estimator.mains_hz), (4.0, 60.0));
+}
+
+#[test]
 fn unknown_keys_wrong_types_and_partial_sections_are_errors() {
     let typo = preset_text().replace("spring_rate", "spring_rat");
     assert!(matches!(params_file::parse(&typo), Err(LoadError::UnknownKey(k)) if k == "plunger.spring_rat"));
@@ -246,6 +283,12 @@ fn cli_bad_input_exits_2_with_one_line_naming_the_field() {
         &["equilibrium", "--params", "/nonexistent/p.toml"],
         "/nonexistent/p.toml",
     );
+    // A PT1000 on a 430 ohm board: every reading would saturate.
+    let pt1000 = write(
+        "pt1000.toml",
+        &format!("{}\n[estimator]\nrtd_r0 = 1000\n", preset_text()),
+    );
+    assert_bad_input(&["equilibrium", "--params", &pt1000], "estimator.rtd_reference");
     assert_bad_input(
         &[
             "asymptotic",

@@ -1,20 +1,33 @@
 //! The MAX31865 driver against the datasheet's register map (mock SPI
-//! transactions), fault decoding, bus errors, and the simulated converter
-//! the QEMU twin reads.
+//! transactions): configuration, conversion, the fault-detection cycle at
+//! start-up and on its schedule, fault decoding (a status no chip can
+//! answer is a bus fault), bus errors, and the simulated converter the QEMU
+//! twin reads.
 
-use compensator::sensor::max31865::{Mains, Max31865, Settings, Wires, classify, code_of, config, fault};
+use compensator::params::RawEstimator;
+use compensator::sensor::max31865::{
+    DIAGNOSIS_INTERVAL, Mains, Max31865, Phase, Settings, Wires, classify, code_of, config, fault, is_chip_answer,
+};
+use compensator::sensor::rtd::Cvd;
 use compensator::sensor::simulated::SimulatedMax31865;
 use compensator::sensor::{SensorFault, TemperatureSource, rtd};
 use embedded_hal::spi::{ErrorKind, ErrorType, Operation, SpiDevice};
 use embedded_hal_mock::eh1::spi::{Mock, Transaction as T};
 
-const SETTINGS: Settings = Settings {
-    r0: 100.0,
-    reference: 430.0,
-    wires: Wires::Three,
-    mains: Mains::Hz50,
-    fault_band: (-60.0, 250.0),
-};
+/// PT100, 430 ohm, 3 wires, 50 Hz, IEC 60751, fault band -60..250 C, a
+/// detection cycle every 500 readings.
+const SETTINGS: Settings = Settings::PT100_430;
+
+/// The datasheet's configuration bytes for these settings (3-wire, 50 Hz):
+/// bias on with the fault clear (D5, D3, D2 = 0), the automatic
+/// fault-detection cycle `100X010Xb`, continuous conversion, continuous
+/// conversion with the fault clear.
+const CLEAR_BIAS_ON: u8 = 0x80 | 0x10 | 0x02 | 0x01;
+const CYCLE_AUTO: u8 = 0x80 | 0x10 | 0x04 | 0x01;
+const CONTINUOUS: u8 = 0x80 | 0x40 | 0x10 | 0x01;
+const CONTINUOUS_CLEAR: u8 = CONTINUOUS | 0x02;
+/// The configuration read back after a cycle: D3:D2 self-cleared.
+const CYCLE_DONE: u8 = 0x80 | 0x10 | 0x01;
 
 /// The RTD word (code << 1 | fault bit) as the two bytes of registers 1-2.
 fn rtd_bytes(code: u16, fault: bool) -> Vec<u8> {
@@ -22,30 +35,250 @@ fn rtd_bytes(code: u16, fault: bool) -> Vec<u8> {
     vec![(w >> 8) as u8, w as u8]
 }
 
-#[test]
-fn configure_writes_thresholds_then_starts_continuous_conversion() {
-    // Thresholds, worked by hand from IEC 60751: R(250 C) = 194.0981 ohm,
-    // code round(194.0981 / 430 * 2^15) = 14791, word 14791 << 1 = 0x738E;
-    // R(-60 C) = 76.3278 ohm, code 5817, word 0x2D72.
-    // Datasheet: write address = read address | 0x80; thresholds at 0x03-0x06
-    // (high MSB, LSB, low MSB, LSB), auto-incrementing; configuration 0x00.
-    let expectations = [
+/// One register read: address, then the value.
+fn read_reg(addr: u8, value: u8) -> Vec<T<u8>> {
+    vec![
+        T::transaction_start(),
+        T::write_vec(vec![addr]),
+        T::read_vec(vec![value]),
+        T::transaction_end(),
+    ]
+}
+
+/// A configuration write.
+fn write_config(value: u8) -> Vec<T<u8>> {
+    vec![
+        T::transaction_start(),
+        T::write_vec(vec![0x80, value]),
+        T::transaction_end(),
+    ]
+}
+
+/// An RTD read returning `code` with the fault bit `fault`.
+fn read_rtd(code: u16, fault: bool) -> Vec<T<u8>> {
+    vec![
+        T::transaction_start(),
+        T::write_vec(vec![0x01]),
+        T::read_vec(rtd_bytes(code, fault)),
+        T::transaction_end(),
+    ]
+}
+
+/// What `configure()` sends. Thresholds worked by hand from IEC 60751:
+/// R(250 C) = 194.0981 ohm, code round(194.0981 / 430 * 2^15) = 14791,
+/// word 14791 << 1 = 0x738E; R(-60 C) = 76.3278 ohm, code 5817, word
+/// 0x2D72. Datasheet: write address = read address | 0x80; thresholds at
+/// 0x03-0x06 (high MSB, LSB, low MSB, LSB), auto-incrementing;
+/// configuration 0x00. The fault clear is written with D5, D3, D2 = 0, then
+/// the cycle: "write 100X010Xb to the Configuration register".
+fn configure_transactions() -> Vec<T<u8>> {
+    let mut v = vec![
         T::transaction_start(),
         T::write_vec(vec![0x83, 0x73, 0x8E, 0x2D, 0x72]),
         T::transaction_end(),
-        T::transaction_start(),
-        // V_BIAS | auto | 3-wire | fault clear | 50 Hz
-        T::write_vec(vec![0x80, 0x80 | 0x40 | 0x10 | 0x02 | 0x01]),
-        T::transaction_end(),
     ];
+    v.extend(write_config(CLEAR_BIAS_ON));
+    v.extend(write_config(CYCLE_AUTO));
+    v
+}
+
+/// The end of a cycle that found `status`: configuration read back, status
+/// read, continuous conversion written back with the fault clear.
+fn cycle_result(status: u8) -> Vec<T<u8>> {
+    let mut v = read_reg(0x00, CYCLE_DONE);
+    v.extend(read_reg(0x07, status));
+    v.extend(write_config(CONTINUOUS_CLEAR));
+    v
+}
+
+fn code_at(t: f32) -> u16 {
+    code_of(&SETTINGS, rtd::resistance(100.0, t))
+}
+
+#[test]
+fn configure_writes_thresholds_clears_and_starts_the_detection_cycle() {
+    let expectations = configure_transactions();
     let mut spi = Mock::new(&expectations);
     let mut drv = Max31865::new(spi.clone(), SETTINGS);
     drv.configure().unwrap();
+    assert_eq!(drv.phase(), Phase::Detecting { polls: 0 });
     spi.done();
     assert_eq!(
-        config::V_BIAS | config::AUTO | config::THREE_WIRE | config::FILTER_50HZ,
-        0xD1
+        (CONTINUOUS, CYCLE_AUTO),
+        (
+            config::V_BIAS | config::AUTO | config::THREE_WIRE | config::FILTER_50HZ,
+            0b1001_0101
+        )
     );
+}
+
+#[test]
+fn a_passing_cycle_resumes_conversion_and_waits_for_a_fresh_reading() {
+    // The RTD registers hold the pre-cycle reading until the first new
+    // conversion (66 ms at most): four calls 20 ms apart return nothing
+    // and touch no register, the fifth (100 ms) reads.
+    assert_eq!(SETTINGS.restart_readings(), 5);
+    let mut expectations = configure_transactions();
+    expectations.extend(cycle_result(0));
+    expectations.extend(read_rtd(code_at(45.0), false));
+    let mut spi = Mock::new(&expectations);
+    let mut drv = Max31865::new(spi.clone(), SETTINGS);
+    drv.configure().unwrap();
+    assert_eq!(drv.read(), Ok(None), "a clean cycle");
+    for _ in 0..4 {
+        assert_eq!(drv.read(), Ok(None));
+    }
+    let t = drv.read().unwrap().unwrap();
+    assert!((t - 45.0).abs() < 0.02, "{t}");
+    assert_eq!(drv.phase(), Phase::Converting { until_cycle: 500 });
+    spi.done();
+}
+
+#[test]
+fn the_cycle_runs_again_at_its_interval_after_a_reading() {
+    // Every `diagnosis_every` readings: the reading is returned, then the
+    // cycle is started (conversion stops), its result read at the next call.
+    let settings = Settings {
+        diagnosis_every: 3,
+        ..SETTINGS
+    };
+    let mut expectations = Vec::new();
+    for t in [40.0, 41.0] {
+        expectations.extend(read_rtd(code_at(t), false));
+    }
+    expectations.extend(read_rtd(code_at(42.0), false));
+    expectations.extend(write_config(CYCLE_AUTO));
+    expectations.extend(cycle_result(0));
+    let mut spi = Mock::new(&expectations);
+    let mut drv = Max31865::new(spi.clone(), settings);
+    for t in [40.0, 41.0, 42.0] {
+        let read = drv.read().unwrap().unwrap();
+        assert!((read - t).abs() < 0.02, "{read}");
+    }
+    assert_eq!(drv.phase(), Phase::Detecting { polls: 0 });
+    assert_eq!(drv.read(), Ok(None));
+    assert_eq!(drv.phase(), Phase::Restarting { stale: 5 });
+    spi.done();
+    // At the 10 s interval: 500 readings at 50 Hz, 600 at 60 Hz.
+    let mut raw = RawEstimator::DEFAULT;
+    assert_eq!(Settings::from_params(&raw).diagnosis_every, 500);
+    raw.mains_hz = 60.0;
+    let s60 = Settings::from_params(&raw);
+    assert_eq!((s60.diagnosis_every, s60.mains), (600, Mains::Hz60));
+    assert_eq!(DIAGNOSIS_INTERVAL, 10.0);
+    // 66 ms over 16.7 ms periods: four, plus one.
+    assert_eq!(s60.restart_readings(), 5);
+}
+
+#[test]
+fn a_still_running_cycle_is_polled_then_restarted() {
+    // D3:D2 still 01 when read: not done yet (nothing returned); after two
+    // more polls the cycle is started again and the reading is implausible.
+    let running = CYCLE_AUTO;
+    let mut expectations = configure_transactions();
+    for _ in 0..3 {
+        expectations.extend(read_reg(0x00, running));
+    }
+    expectations.extend(write_config(CYCLE_AUTO));
+    let mut spi = Mock::new(&expectations);
+    let mut drv = Max31865::new(spi.clone(), SETTINGS);
+    drv.configure().unwrap();
+    assert_eq!(drv.read(), Ok(None));
+    assert_eq!(drv.read(), Ok(None));
+    assert_eq!(drv.read(), Err(SensorFault::Implausible));
+    assert_eq!(drv.phase(), Phase::Detecting { polls: 0 });
+    spi.done();
+}
+
+#[test]
+fn a_wiring_fault_found_by_the_cycle_withholds_readings_until_a_cycle_passes() {
+    // REFIN- < 0.85 V_BIAS with FORCE- open (D4): readings "appear valid"
+    // (datasheet, Tables 10-12), so none is trusted: the fault is reported
+    // for each, and a cycle is run after each fresh reading until one
+    // passes.
+    let mut expectations = configure_transactions();
+    expectations.extend(cycle_result(fault::REFIN_LOW));
+    expectations.extend(read_rtd(code_at(50.0), false));
+    expectations.extend(write_config(CYCLE_AUTO));
+    expectations.extend(cycle_result(0));
+    expectations.extend(read_rtd(code_at(50.0), false));
+    let mut spi = Mock::new(&expectations);
+    let mut drv = Max31865::new(spi.clone(), SETTINGS);
+    drv.configure().unwrap();
+    assert_eq!(drv.read(), Err(SensorFault::Wiring));
+    for _ in 0..4 {
+        assert_eq!(drv.read(), Ok(None));
+    }
+    // A valid-looking code, withheld; the next cycle starts.
+    assert_eq!(drv.read(), Err(SensorFault::Wiring));
+    assert_eq!(drv.phase(), Phase::Detecting { polls: 0 });
+    // The fault is gone: the cycle passes, readings resume.
+    assert_eq!(drv.read(), Ok(None));
+    for _ in 0..4 {
+        assert_eq!(drv.read(), Ok(None));
+    }
+    assert!((drv.read().unwrap().unwrap() - 50.0).abs() < 0.02);
+    spi.done();
+}
+
+#[test]
+fn a_fault_bit_reads_the_status_clears_it_and_names_the_fault() {
+    let mut expectations = read_rtd(code_at(40.0), true);
+    expectations.extend(read_reg(0x07, fault::RTD_HIGH));
+    expectations.extend(write_config(CONTINUOUS_CLEAR));
+    let mut spi = Mock::new(&expectations);
+    let mut drv = Max31865::new(spi.clone(), SETTINGS);
+    assert_eq!(drv.read(), Err(SensorFault::RtdHigh));
+    spi.done();
+}
+
+#[test]
+fn status_bits_map_to_faults_and_impossible_bytes_to_the_bus() {
+    assert_eq!(classify(fault::RTD_HIGH), SensorFault::RtdHigh);
+    assert_eq!(classify(fault::RTD_LOW), SensorFault::RtdLow);
+    assert_eq!(classify(fault::REFIN_HIGH), SensorFault::Wiring);
+    assert_eq!(classify(fault::REFIN_LOW | fault::RTD_HIGH), SensorFault::Wiring);
+    assert_eq!(classify(fault::RTDIN_LOW), SensorFault::Wiring);
+    assert_eq!(classify(fault::VOLTAGE), SensorFault::Voltage);
+    assert_eq!(classify(0), SensorFault::Implausible);
+    // MISO stuck high: 0xFF sets the unused D1:D0 and RTD high and low at
+    // once; no chip answers that.
+    for status in [0xFF, 0x01, 0x02, fault::RTD_HIGH | fault::RTD_LOW] {
+        assert!(!is_chip_answer(status), "{status:#04x}");
+        assert_eq!(classify(status), SensorFault::Bus, "{status:#04x}");
+    }
+    assert!(is_chip_answer(fault::RTD_HIGH | fault::REFIN_HIGH | fault::VOLTAGE));
+}
+
+#[test]
+fn miso_stuck_high_is_a_bus_fault_on_every_path() {
+    // An RTD word 0xFFFF (its fault bit set) makes the driver read the
+    // status: 0xFF, a bus fault, not "wiring".
+    let mut expectations = vec![
+        T::transaction_start(),
+        T::write_vec(vec![0x01]),
+        T::read_vec(vec![0xFF, 0xFF]),
+        T::transaction_end(),
+    ];
+    expectations.extend(read_reg(0x07, 0xFF));
+    expectations.extend(write_config(CONTINUOUS_CLEAR));
+    let mut spi = Mock::new(&expectations);
+    let mut drv = Max31865::new(spi.clone(), SETTINGS);
+    assert_eq!(drv.read(), Err(SensorFault::Bus));
+    spi.done();
+    // The cycle's configuration read answers 0xFF: not what was written.
+    // The driver configures the chip again at the next call.
+    let mut expectations = configure_transactions();
+    expectations.extend(read_reg(0x00, 0xFF));
+    expectations.extend(configure_transactions());
+    let mut spi = Mock::new(&expectations);
+    let mut drv = Max31865::new(spi.clone(), SETTINGS);
+    drv.configure().unwrap();
+    assert_eq!(drv.read(), Err(SensorFault::Bus));
+    assert_eq!(drv.phase(), Phase::Idle);
+    assert_eq!(drv.read(), Ok(None));
+    assert_eq!(drv.phase(), Phase::Detecting { polls: 0 });
+    spi.done();
 }
 
 #[test]
@@ -64,12 +297,7 @@ fn reading_converts_the_code_by_callendar_van_dusen() {
     for (t, ohm, code) in table {
         // The driver's own code of the table resistance agrees.
         assert_eq!(code_of(&SETTINGS, ohm), code, "{ohm} ohm");
-        let expectations = [
-            T::transaction_start(),
-            T::write_vec(vec![0x01]),
-            T::read_vec(rtd_bytes(code, false)),
-            T::transaction_end(),
-        ];
+        let expectations = read_rtd(code, false);
         let mut spi = Mock::new(&expectations);
         let mut drv = Max31865::new(spi.clone(), SETTINGS);
         let read = drv.read().unwrap().unwrap();
@@ -81,47 +309,58 @@ fn reading_converts_the_code_by_callendar_van_dusen() {
 }
 
 #[test]
-fn a_fault_bit_reads_the_status_clears_it_and_names_the_fault() {
-    let code = code_of(&SETTINGS, rtd::resistance(100.0, 40.0));
-    let expectations = [
-        T::transaction_start(),
-        T::write_vec(vec![0x01]),
-        T::read_vec(rtd_bytes(code, true)),
-        T::transaction_end(),
-        T::transaction_start(),
-        T::write_vec(vec![0x07]),
-        T::read_vec(vec![fault::RTD_HIGH]),
-        T::transaction_end(),
-        T::transaction_start(),
-        T::write_vec(vec![0x80, 0x80 | 0x40 | 0x10 | 0x01 | 0x02]),
-        T::transaction_end(),
-    ];
+fn a_calibrated_probe_is_read_with_its_own_coefficients() {
+    // A calibrated PT100 whose certificate gives A = 3.9122e-3,
+    // B = -5.781e-7: at 100 C it reads 100 (1 + 0.39122 - 0.005781) =
+    // 138.5439 ohm, code round(138.5439 / 430 * 2^15) = 10558 (by hand).
+    let settings = Settings {
+        cvd: Cvd {
+            a: 3.9122e-3,
+            b: -5.781e-7,
+            c: -4.187e-12,
+        },
+        ..SETTINGS
+    };
+    assert_eq!(code_of(&settings, 138.5439), 10558);
+    let expectations = read_rtd(10558, false);
     let mut spi = Mock::new(&expectations);
-    let mut drv = Max31865::new(spi.clone(), SETTINGS);
-    assert_eq!(drv.read(), Err(SensorFault::RtdHigh));
+    let mut drv = Max31865::new(spi.clone(), settings);
+    let read = drv.read().unwrap().unwrap();
     spi.done();
+    assert!((read - 100.0).abs() < 0.02, "{read}");
+    // The standard curve would have read the same code 0.1 C high.
+    let standard = rtd::temperature(100.0, 10558.0 * 430.0 / 32768.0).unwrap();
+    assert!((standard - read - 0.1).abs() < 0.02, "{standard} vs {read}");
 }
 
 #[test]
-fn status_bits_map_to_faults() {
-    assert_eq!(classify(fault::RTD_HIGH), SensorFault::RtdHigh);
-    assert_eq!(classify(fault::RTD_LOW), SensorFault::RtdLow);
-    assert_eq!(classify(fault::REFIN_HIGH), SensorFault::Wiring);
-    assert_eq!(classify(fault::REFIN_LOW | fault::RTD_HIGH), SensorFault::Wiring);
-    assert_eq!(classify(fault::RTDIN_LOW), SensorFault::Wiring);
-    assert_eq!(classify(fault::VOLTAGE), SensorFault::Voltage);
-    assert_eq!(classify(0), SensorFault::Implausible);
+fn two_and_four_wire_and_60_hz_configure_their_bits() {
+    // D4 clear for 2- and 4-wire, D0 clear for the 60 Hz notch.
+    let mut raw = RawEstimator::DEFAULT;
+    raw.rtd_wires = 4.0;
+    raw.mains_hz = 60.0;
+    let settings = Settings::from_params(&raw);
+    assert_eq!((settings.wires, settings.mains), (Wires::TwoOrFour, Mains::Hz60));
+    let drv = Max31865::new(Broken, settings);
+    assert_eq!(drv.config_byte(), 0x80 | 0x40);
+    raw.rtd_wires = 2.0;
+    assert_eq!(Settings::from_params(&raw).wires, Wires::TwoOrFour);
+    // The defaults are the usual breakout, with the oil's range as the
+    // converter's fault band.
+    let defaults = Settings::from_params(&RawEstimator::DEFAULT);
+    assert_eq!(
+        defaults,
+        Settings {
+            fault_band: (-20.0, 150.0),
+            ..SETTINGS
+        }
+    );
 }
 
 #[test]
 fn saturated_codes_are_implausible_not_temperatures() {
     for code in [0u16, 0x7FFF] {
-        let expectations = [
-            T::transaction_start(),
-            T::write_vec(vec![0x01]),
-            T::read_vec(rtd_bytes(code, false)),
-            T::transaction_end(),
-        ];
+        let expectations = read_rtd(code, false);
         let mut spi = Mock::new(&expectations);
         let mut drv = Max31865::new(spi.clone(), SETTINGS);
         assert_eq!(drv.read(), Err(SensorFault::Implausible));
@@ -151,8 +390,11 @@ fn bus_errors_are_faults_not_panics() {
 fn the_simulated_converter_speaks_the_same_register_map() {
     let mut drv = Max31865::new(SimulatedMax31865::new(SETTINGS, 61.2), SETTINGS);
     drv.configure().unwrap();
+    assert_eq!(drv.device_mut().detection_cycles, 1);
+    assert_eq!(drv.read(), Ok(None), "the start-up cycle passes");
     assert_eq!(drv.device_mut().config(), 0xD1, "fault-clear bit self-clears");
-    assert!((drv.read().unwrap().unwrap() - 61.2).abs() < 0.02);
+    let first = (0..5).map(|_| drv.read()).find(|r| r != &Ok(None));
+    assert!((first.unwrap().unwrap().unwrap() - 61.2).abs() < 0.02);
     drv.device_mut().fault = fault::RTD_LOW;
     assert_eq!(drv.read(), Err(SensorFault::RtdLow));
     // The cause persists: clearing the latch does not hide it.
@@ -164,4 +406,93 @@ fn the_simulated_converter_speaks_the_same_register_map() {
     drv.device_mut().forced_code = None;
     drv.device_mut().bus_error = true;
     assert_eq!(drv.read(), Err(SensorFault::Bus));
+    drv.device_mut().bus_error = false;
+    drv.device_mut().miso_stuck_high = true;
+    assert_eq!(drv.read(), Err(SensorFault::Bus));
+}
+
+#[test]
+fn the_simulated_converter_shows_wiring_faults_only_to_the_detection_cycle() {
+    // FORCE- open: readings stay plausible; only the cycle sees it.
+    let settings = Settings {
+        diagnosis_every: 10,
+        ..SETTINGS
+    };
+    let mut drv = Max31865::new(SimulatedMax31865::new(settings, 30.0), settings);
+    drv.device_mut().fault = fault::RTDIN_LOW;
+    drv.configure().unwrap();
+    assert_eq!(drv.read(), Err(SensorFault::Wiring), "the start-up cycle");
+    let readings: Vec<_> = (0..40).map(|_| drv.read()).collect();
+    assert!(
+        readings
+            .iter()
+            .all(|r| matches!(r, Ok(None) | Err(SensorFault::Wiring)))
+    );
+    assert!(readings.iter().any(|r| r == &Err(SensorFault::Wiring)));
+    assert!(drv.device_mut().detection_cycles > 3, "rechecked while faulted");
+    // Repaired: the next cycle passes and readings come back.
+    drv.device_mut().fault = 0;
+    let after: Vec<_> = (0..20).map(|_| drv.read()).collect();
+    assert!(
+        after
+            .iter()
+            .any(|r| matches!(r, Ok(Some(t)) if (t - 30.0).abs() < 0.02)),
+        "{after:?}"
+    );
+}
+
+/// The simulated converter, counting the bytes clocked over SPI.
+struct Counting {
+    sim: SimulatedMax31865,
+    bytes: usize,
+}
+impl ErrorType for Counting {
+    type Error = <SimulatedMax31865 as ErrorType>::Error;
+}
+impl SpiDevice for Counting {
+    fn transaction(&mut self, operations: &mut [Operation<'_, u8>]) -> Result<(), Self::Error> {
+        for op in operations.iter() {
+            self.bytes += match op {
+                Operation::Write(b) => b.len(),
+                Operation::Read(b) => b.len(),
+                Operation::Transfer(r, _) => r.len(),
+                Operation::TransferInPlace(b) => b.len(),
+                Operation::DelayNs(_) => 0,
+            };
+        }
+        self.sim.transaction(operations)
+    }
+}
+
+#[test]
+fn no_reading_call_clocks_more_than_nine_bytes() {
+    // The tick budget: every read() is a few short transactions, whatever
+    // the diagnosis is doing. Over a minute of readings with a wiring
+    // fault, an open RTD and a repair, the worst call moves 9 bytes (an
+    // RTD read with its fault path and a cycle start), 72 us at the
+    // board's 1 MHz SPI clock, of a 1 ms tick.
+    let settings = Settings {
+        diagnosis_every: 50,
+        ..SETTINGS
+    };
+    let dev = Counting {
+        sim: SimulatedMax31865::new(settings, 40.0),
+        bytes: 0,
+    };
+    let mut drv = Max31865::new(dev, settings);
+    drv.configure().unwrap();
+    let mut worst = 0;
+    for k in 0..3000 {
+        let sim = &mut drv.device_mut().sim;
+        sim.fault = match k {
+            500..800 => fault::RTDIN_LOW,
+            1200..1300 => fault::RTD_HIGH,
+            1500..1520 => fault::RTD_HIGH | fault::REFIN_HIGH,
+            _ => 0,
+        };
+        drv.device_mut().bytes = 0;
+        let _ = drv.read();
+        worst = worst.max(drv.device_mut().bytes);
+    }
+    assert_eq!(worst, 9);
 }

@@ -115,7 +115,12 @@ schema! {
     oil_max: "estimator"."oil_max" ["C"] = Some(150.0), "Hottest temperature the fluid model accepts.";
     telemetry_hz: "estimator"."telemetry_hz" ["Hz"] = Some(2.0), "Telemetry rate (0: none; at most tick_hz / 2).";
     rtd_r0: "estimator"."rtd_r0" ["ohm"] = Some(100.0), "RTD resistance at 0 C (PT100).";
-    rtd_reference: "estimator"."rtd_reference" ["ohm"] = Some(430.0), "MAX31865 reference resistor.";
+    rtd_reference: "estimator"."rtd_reference" ["ohm"] = Some(430.0), "MAX31865 reference resistor (must exceed the RTD's resistance at oil_max, else the converter saturates).";
+    rtd_wires: "estimator"."rtd_wires" ["-"] = Some(3.0), "RTD connection: 2, 3 or 4 wires (MAX31865 configuration bit D4).";
+    mains_hz: "estimator"."mains_hz" ["Hz"] = Some(50.0), "Mains frequency the converter's notch filter rejects: 50 or 60 (conversion every 20 or 16.7 ms).";
+    rtd_a: "estimator"."rtd_a" ["1/C"] = Some(3.9083e-3), "Callendar-Van Dusen A of the RTD (IEC 60751 by default; a calibrated probe's own).";
+    rtd_b: "estimator"."rtd_b" ["1/C^2"] = Some(-5.775e-7), "Callendar-Van Dusen B (IEC 60751 by default).";
+    rtd_c: "estimator"."rtd_c" ["1/C^4"] = Some(-4.183e-12), "Callendar-Van Dusen C, below 0 C only (IEC 60751 by default).";
 }
 
 /// A complete, unvalidated parameter set as read from a file.
@@ -151,6 +156,15 @@ pub enum Problem {
     },
     /// Inconsistent with another field; the text says which and why.
     Inconsistent(&'static str),
+    /// Must exceed a bound computed from other fields; the text says which.
+    NotAbove {
+        /// The value the field must exceed.
+        bound: f64,
+        /// Where the bound comes from.
+        why: &'static str,
+    },
+    /// Not one of the accepted values (listed in the text).
+    NotOneOf(&'static str),
     /// Representable in `f64` but not in the scalar type asked for.
     NotRepresentable(&'static str),
     /// A fraction where a count is needed.
@@ -180,6 +194,10 @@ impl fmt::Display for ParamError {
                 write!(f, "{} = {}: must lie in [{}, {}]", self.field, self.value, min, max)
             }
             Problem::Inconsistent(why) => write!(f, "{} = {}: {}", self.field, self.value, why),
+            Problem::NotAbove { bound, why } => {
+                write!(f, "{} = {}: must exceed {} ({})", self.field, self.value, bound, why)
+            }
+            Problem::NotOneOf(values) => write!(f, "{} = {}: must be {}", self.field, self.value, values),
             Problem::NotRepresentable(ty) => {
                 write!(f, "{} = {}: not representable as {}", self.field, self.value, ty)
             }
@@ -376,7 +394,67 @@ impl RawEstimator {
         within(p(8), self.telemetry_hz, 0.0, self.tick_hz / 2.0)?;
         positive(p(9), self.rtd_r0)?;
         positive(p(10), self.rtd_reference)?;
+        let wires = within(p(11), self.rtd_wires, 2.0, 4.0)?;
+        whole(p(11), wires)?;
+        let mains = finite(p(12), self.mains_hz)?;
+        if mains != 50.0 && mains != 60.0 {
+            return Err(err(p(12), mains, Problem::NotOneOf("50 or 60")));
+        }
+        // Around IEC 60751's 3.9083e-3, -5.775e-7, -4.183e-12: a calibrated
+        // probe's coefficients differ in the third or fourth digit.
+        within(p(13), self.rtd_a, 1.0e-3, 1.0e-2)?;
+        within(p(14), self.rtd_b, -1.0e-5, 1.0e-5)?;
+        within(p(15), self.rtd_c, -1.0e-9, 1.0e-9)?;
+        // The converter inverts R(t): it must rise over the oil's range.
+        let mut t = self.oil_min;
+        for i in 0..=64 {
+            let slope = self.rtd_slope(t);
+            if !(slope > 0.0) {
+                return Err(err(
+                    p(14),
+                    self.rtd_b,
+                    Problem::Inconsistent(
+                        "the RTD's resistance must rise with temperature over estimator.oil_min..oil_max",
+                    ),
+                ));
+            }
+            t = self.oil_min + (self.oil_max - self.oil_min) * f64::from(i + 1) / 64.0;
+        }
+        // The MAX31865's 15-bit code is R / R_ref * 2^15: the hottest oil
+        // must stay below full scale (two codes of margin), else every
+        // reading saturates at 32767 and reads as a sensor fault.
+        let bound = self.rtd_resistance(self.oil_max) * 32768.0 / 32766.0;
+        if !(self.rtd_reference > bound) {
+            return Err(err(
+                p(10),
+                self.rtd_reference,
+                Problem::NotAbove {
+                    bound,
+                    why: "the RTD's resistance at estimator.oil_max: the converter would saturate",
+                },
+            ));
+        }
         Ok(())
+    }
+
+    /// Resistance [ohm] of the RTD at `t` [C] by Callendar-Van Dusen with
+    /// this section's `rtd_r0`, `rtd_a`, `rtd_b`, `rtd_c` (IEC 60751 form:
+    /// the `C` term below 0 C only).
+    pub fn rtd_resistance(&self, t: f64) -> f64 {
+        let mut r = 1.0 + self.rtd_a * t + self.rtd_b * t * t;
+        if t < 0.0 {
+            r += self.rtd_c * (t - 100.0) * t * t * t;
+        }
+        self.rtd_r0 * r
+    }
+
+    /// `dR/dt` of the RTD at `t` [ohm/C] (see [`RawEstimator::rtd_resistance`]).
+    pub fn rtd_slope(&self, t: f64) -> f64 {
+        let mut d = self.rtd_a + 2.0 * self.rtd_b * t;
+        if t < 0.0 {
+            d += self.rtd_c * (4.0 * t * t * t - 300.0 * t * t);
+        }
+        self.rtd_r0 * d
     }
 }
 

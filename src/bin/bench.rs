@@ -243,6 +243,8 @@ fn exit(ok: bool) -> ! {
     loop {}
 }
 
+compensator::qemu_hard_fault_handler!();
+
 #[panic_handler]
 fn panic(_: &core::panic::PanicInfo) -> ! {
     exit(false)

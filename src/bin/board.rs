@@ -1,7 +1,10 @@
-//! Firmware for a real STM32F405 board: a PT100 in the oil read by a
-//! MAX31865 over SPI1, the estimator every 1 ms tick, telemetry over RTT.
+//! Firmware for a real STM32F405 board: an RTD in the oil read by a
+//! MAX31865 over SPI1, the estimator every tick, telemetry over RTT.
+//! `docs/firmware.md` walks from a blank board to live telemetry.
 //!
-//! Wiring (MAX31865 breakout, 3-wire PT100, 430 ohm reference):
+//! Wiring (MAX31865 breakout; PT100 with a 430 ohm reference by default,
+//! wire count, mains filter and the probe's Callendar-Van Dusen
+//! coefficients from the parameter file's `[estimator]` section):
 //!
 //! | MAX31865 | STM32F405 |
 //! |---|---|
@@ -13,28 +16,33 @@
 //!
 //! Clocks: 8 MHz HSE -> 168 MHz SYSCLK; SysTick interrupts at the tick rate
 //! of the parameter file (1 kHz by default); TIM5 provides the chip-select
-//! delays. The converter runs in automatic conversion mode (50 Hz filter,
-//! a new reading every 20 ms) and is read every 20 ticks.
+//! delays. The converter runs in automatic conversion mode (a reading every
+//! 20 ms at 50 Hz, 16.7 ms at 60 Hz), read once per conversion period; its
+//! fault-detection cycle runs at start-up and every 10 s.
 //!
-//! Build and flash (probe-rs):
+//! Conventions: the stack sits alone in the core-coupled RAM
+//! (`link/memory-board.x`: an overflow faults instead of corrupting `.bss`); a
+//! `HardFault` is logged with its registers, then halts at a breakpoint
+//! under a debugger or resets the chip without one; debug builds keep the
+//! debug port clocked in sleep (`wfi`) so that RTT and reflashing keep
+//! working; defmt timestamps are real time (microseconds, from the SysTick
+//! reload actually programmed); telemetry lines carry their time in ms,
+//! the format `cargo xtask flash --csv` decodes.
 //!
 //! ```text
-//! cargo xtask build                 # builds target/firmware/thumbv7em-none-eabihf/release/board
-//! probe-rs run --chip STM32F405RGTx target/firmware/thumbv7em-none-eabihf/release/board
+//! cargo xtask flash [--params device.toml] [--csv telemetry.csv]
 //! ```
-//!
-//! With your own device: `COMPENSATOR_PARAMS=path/to/device.toml cargo xtask build`
-//! (the file is validated at build time; a bad field fails the build).
 #![no_std]
 #![no_main]
 
 use compensator::Params;
+use compensator::clock::TickClock;
 use compensator::estimator::{Estimator, EstimatorConfig};
 use compensator::sensor::TemperatureSource;
-use compensator::sensor::max31865::{Mains, Max31865, Settings, Wires};
+use compensator::sensor::max31865::{Max31865, Settings};
 use core::sync::atomic::{AtomicU32, Ordering};
 use cortex_m::peripheral::syst::SystClkSource;
-use cortex_m_rt::{entry, exception};
+use cortex_m_rt::{ExceptionFrame, entry, exception};
 use defmt::{error, info, warn};
 use defmt_rtt as _;
 use embedded_hal::spi::MODE_1;
@@ -48,21 +56,74 @@ use stm32f4xx_hal::spi::Spi;
 
 include!(concat!(env!("OUT_DIR"), "/params.rs"));
 
+/// The core clock [Hz] (8 MHz HSE through the PLL).
+const SYSCLK_HZ: u32 = 168_000_000;
+
 /// Ticks elapsed (incremented by the SysTick interrupt).
 static TICKS: AtomicU32 = AtomicU32::new(0);
+/// Core cycles per tick, as programmed into SysTick (0 until it starts).
+static CYCLES_PER_TICK: AtomicU32 = AtomicU32::new(0);
+
+/// The real-time clock of the tick counter (`None` before SysTick starts).
+fn clock() -> Option<TickClock> {
+    TickClock::new(CYCLES_PER_TICK.load(Ordering::Relaxed), SYSCLK_HZ)
+}
 
 #[exception]
 fn SysTick() {
     TICKS.fetch_add(1, Ordering::Relaxed);
 }
 
-defmt::timestamp!("{=u32:ms}", TICKS.load(Ordering::Relaxed));
+// Real time whatever `tick_hz` is (0 before SysTick starts).
+defmt::timestamp!(
+    "{=u64:us}",
+    clock().map_or(0, |c| c.micros(TICKS.load(Ordering::Relaxed)))
+);
+
+#[exception]
+unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
+    // SAFETY: the System Control Block's fault status registers (CFSR,
+    // HFSR, BFAR), always mapped on ARMv7-M, read-only here.
+    let (cfsr, hfsr, bfar) = unsafe {
+        (
+            (0xE000_ED28 as *const u32).read_volatile(),
+            (0xE000_ED2C as *const u32).read_volatile(),
+            (0xE000_ED38 as *const u32).read_volatile(),
+        )
+    };
+    error!(
+        "HardFault: pc {=u32:#010x}, lr {=u32:#010x}, xpsr {=u32:#010x}, CFSR {=u32:#010x}, HFSR {=u32:#010x}, BFAR {=u32:#010x}",
+        frame.pc(),
+        frame.lr(),
+        frame.xpsr(),
+        cfsr,
+        hfsr,
+        bfar
+    );
+    if cortex_m::peripheral::DCB::is_debugger_attached() {
+        // probe-rs stops here and prints the backtrace.
+        cortex_m::asm::bkpt();
+    }
+    // In the field: start again rather than hang.
+    cortex_m::peripheral::SCB::sys_reset()
+}
 
 #[entry]
 fn main() -> ! {
     let (Some(dp), Some(mut cp)) = (pac::Peripherals::take(), cortex_m::Peripherals::take()) else {
         defmt::panic!("peripherals already taken");
     };
+    // Debug builds: keep the debug port clocked while the core sleeps in
+    // `wfi` (DBGMCU_CR DBG_SLEEP/STOP/STANDBY) and a bus master clocked
+    // (DMA1), so that RTT and reflashing work between ticks. Release
+    // builds save that power.
+    #[cfg(debug_assertions)]
+    {
+        dp.DBGMCU
+            .cr()
+            .modify(|_, w| w.dbg_sleep().set_bit().dbg_stop().set_bit().dbg_standby().set_bit());
+        dp.RCC.ahb1enr().modify(|_, w| w.dma1en().set_bit());
+    }
     let params = match Params::<f32>::new(&RAW_PARAMS) {
         Ok(p) => p,
         Err(e) => defmt::panic!("parameters rejected: {=str}", e.field),
@@ -72,7 +133,7 @@ fn main() -> ! {
         Err(e) => defmt::panic!("estimator settings rejected: {=str}", e.field),
     };
 
-    let mut rcc = dp.RCC.freeze(Config::hse(8.MHz()).sysclk(168.MHz()));
+    let mut rcc = dp.RCC.freeze(Config::hse(8.MHz()).sysclk(SYSCLK_HZ.Hz()));
     let sysclk = rcc.clocks.sysclk().raw();
 
     let gpioa = dp.GPIOA.split(&mut rcc);
@@ -84,25 +145,28 @@ fn main() -> ! {
     let delay = dp.TIM5.delay_us(&mut rcc);
     // The chip-select pin cannot fail (its error type is `Infallible`).
     let Ok(device) = ExclusiveDevice::new(spi, cs, delay);
-    let settings = Settings {
-        r0: RAW_PARAMS.estimator.rtd_r0 as f32,
-        reference: RAW_PARAMS.estimator.rtd_reference as f32,
-        wires: Wires::Three,
-        mains: Mains::Hz50,
-        fault_band: (RAW_PARAMS.estimator.oil_min as f32, RAW_PARAMS.estimator.oil_max as f32),
-    };
+    // Wire count, mains filter and the probe's curve from the parameter
+    // file; the converter flags readings outside the oil's range.
+    let settings = Settings::from_params(&RAW_PARAMS.estimator);
     let mut sensor = Max31865::new(device, settings);
     if sensor.configure().is_err() {
-        error!("MAX31865 not configured (SPI error); continuing, samples will be flagged");
+        error!("MAX31865 not configured (SPI error); it is retried at every reading, samples are flagged");
     }
 
-    // The first good sample starts the estimator at its equilibrium.
+    // The start-up fault-detection cycle, then the first good sample starts
+    // the estimator at its equilibrium (a reading every conversion period,
+    // one second at most).
     let mut initial = None;
-    for _ in 0..50 {
-        cortex_m::asm::delay(sysclk / 50);
-        if let Ok(Some(t)) = sensor.read() {
-            initial = Some(t);
-            break;
+    let period_cycles = (sysclk as f32 * settings.mains.conversion_period()) as u32;
+    for _ in 0..60 {
+        cortex_m::asm::delay(period_cycles);
+        match sensor.read() {
+            Ok(Some(t)) => {
+                initial = Some(t);
+                break;
+            }
+            Ok(None) => {}
+            Err(fault) => warn!("start-up reading: {}", fault),
         }
     }
     let start = match initial {
@@ -116,18 +180,21 @@ fn main() -> ! {
         Ok(e) => e,
         Err(e) => defmt::panic!("estimator: {}", e),
     };
-    info!(
-        "compensator estimator: parameters {=str}, start {=f32} C, tick {=f32} ms",
-        PARAMS_SOURCE,
-        start,
-        config.tick() * 1e3
-    );
 
     // SysTick counts 24 bits: at 168 MHz a tick of at most ~99.8 ms.
     let reload = (sysclk as f32 * config.tick()) as u32 - 1;
     if reload > 0x00FF_FFFF {
         defmt::panic!("estimator.tick_hz: below what SysTick can time at {=u32} Hz", sysclk);
     }
+    CYCLES_PER_TICK.store(reload + 1, Ordering::Relaxed);
+    info!(
+        "compensator estimator: parameters {=str}, start {=f32} C, tick {=u32} us, sensor {}-wire {=u32} Hz",
+        PARAMS_SOURCE,
+        start,
+        clock().map_or(0, |c| c.micros(1) as u32),
+        RAW_PARAMS.estimator.rtd_wires as u32,
+        RAW_PARAMS.estimator.mains_hz as u32
+    );
     cp.SYST.set_clock_source(SystClkSource::Core);
     cp.SYST.set_reload(reload);
     cp.SYST.clear_current();
@@ -152,7 +219,9 @@ fn main() -> ! {
         };
         let estimate = estimator.tick(sample);
         if estimator.telemetry_due() {
-            info!("{}", estimate);
+            // The same line as the QEMU twin's: `cargo xtask` decodes it.
+            let ms = clock().map_or(0, |c| c.millis(now));
+            info!("{=u32} ms {}", ms, estimate);
         }
     }
 }

@@ -5,13 +5,19 @@
 //!
 //! The model keeps the register file of the datasheet (auto-incrementing
 //! reads and writes, write address = read | 0x80), converts the oil
-//! temperature to the RTD code by Callendar-Van Dusen, and injects faults:
-//! a persistent fault cause (sets the RTD word's fault bit and the status
-//! register until the cause goes away; clearing only clears the latch), a
-//! forced code, or a failing bus.
+//! temperature to the RTD code by Callendar-Van Dusen (the settings'
+//! coefficients), and injects faults: a persistent fault cause (status
+//! bits; RTD high/low and over/under-voltage are latched by every
+//! conversion read, the REFIN-/RTDIN- wiring bits only by a fault-detection
+//! cycle; the latch sets the RTD word's fault bit until cleared, and
+//! clearing only clears the latch), a forced code, a failing bus, or a
+//! MISO line stuck high (every byte reads 0xFF).
+//!
+//! Timing is not modelled: a fault-detection cycle (configuration bits
+//! D3:D2 set to 01) completes at once (D3:D2 read back 00), and the RTD
+//! registers hold their last value while automatic conversion is off.
 
-use super::max31865::{REG_CONFIG, REG_FAULT_STATUS, REG_RTD_MSB, Settings, code_of, config};
-use super::rtd;
+use super::max31865::{REG_CONFIG, REG_FAULT_STATUS, REG_RTD_MSB, Settings, code_of, config, fault};
 use embedded_hal::spi::{ErrorKind, ErrorType, Operation, SpiDevice};
 
 /// The simulated bus failure.
@@ -37,8 +43,14 @@ pub struct SimulatedMax31865 {
     pub forced_code: Option<u16>,
     /// Every transaction fails.
     pub bus_error: bool,
+    /// MISO stuck high (no chip): every byte read is 0xFF.
+    pub miso_stuck_high: bool,
+    /// Fault-detection cycles run so far.
+    pub detection_cycles: u32,
     registers: [u8; 8],
     latched: u8,
+    /// The last converted RTD word (held while conversion is off).
+    word: u16,
 }
 
 impl SimulatedMax31865 {
@@ -50,8 +62,11 @@ impl SimulatedMax31865 {
             fault: 0,
             forced_code: None,
             bus_error: false,
+            miso_stuck_high: false,
+            detection_cycles: 0,
             registers: [0; 8],
             latched: 0,
+            word: 0,
         }
     }
 
@@ -61,13 +76,23 @@ impl SimulatedMax31865 {
     }
 
     fn register(&mut self, addr: u8) -> u8 {
+        if self.miso_stuck_high {
+            return 0xFF;
+        }
         let addr = addr & 0x07;
         if addr == REG_RTD_MSB || addr == REG_RTD_MSB + 1 {
-            self.latched |= self.fault;
-            let code = self
-                .forced_code
-                .unwrap_or_else(|| code_of(&self.settings, rtd::resistance(self.settings.r0, self.temperature)));
-            let word = (code << 1) | u16::from(self.latched != 0);
+            if self.registers[REG_CONFIG as usize] & config::AUTO != 0 {
+                // Converting: the code of the RTD now; conversion faults latch.
+                self.latched |= self.fault & (fault::RTD_HIGH | fault::RTD_LOW | fault::VOLTAGE);
+                let code = self.forced_code.unwrap_or_else(|| {
+                    code_of(
+                        &self.settings,
+                        self.settings.cvd.resistance(self.settings.r0, self.temperature),
+                    )
+                });
+                self.word = code << 1;
+            }
+            let word = (self.word & !1) | u16::from(self.latched != 0);
             return if addr == REG_RTD_MSB {
                 (word >> 8) as u8
             } else {
@@ -87,7 +112,14 @@ impl SimulatedMax31865 {
                 if value & config::FAULT_CLEAR != 0 {
                     self.latched = 0;
                 }
-                self.registers[0] = value & !config::FAULT_CLEAR;
+                if value & config::FAULT_CYCLE == config::FAULT_CYCLE_AUTO && value & config::V_BIAS != 0 {
+                    // The detection cycle: the REFIN-/RTDIN- comparisons
+                    // (and over/under-voltage) latch; done at once.
+                    self.detection_cycles += 1;
+                    self.latched |= self.fault & (fault::WIRING | fault::VOLTAGE);
+                }
+                // Fault clear and the automatic cycle self-clear.
+                self.registers[0] = value & !(config::FAULT_CLEAR | config::FAULT_CYCLE);
             }
             0x03..=0x06 => self.registers[addr as usize] = value,
             _ => {} // read-only

@@ -11,7 +11,7 @@
 //!   `.text`, `.rodata`, `.data` in flash; `.data`, `.bss`, `.uninit` in RAM).
 //! * Stack: the QEMU twin measures its own peak by stack painting.
 
-use crate::firmware::{self, Image};
+use crate::firmware::Image;
 use crate::qemu;
 use compensator::dynamics::TwinConfig;
 use object::{Object, ObjectSection};
@@ -82,6 +82,7 @@ pub struct Costs {
     /// `(telemetry, mean, worst)` instructions per estimator tick.
     pub estimator: Vec<(bool, f64, f64)>,
     /// Instructions per SysTick count.
+    #[cfg_attr(not(feature = "host"), allow(dead_code))]
     pub per_count: f64,
 }
 
@@ -171,6 +172,7 @@ fn run_image(elf: &Path, machine: qemu::Machine) -> Result<Vec<String>, String> 
 /// What the firmware images measured on QEMU.
 pub struct Firmware {
     m4: Costs,
+    #[cfg_attr(not(feature = "host"), allow(dead_code))]
     m3: Costs,
     /// Peak stack of the QEMU twin run [bytes].
     stack: u64,
@@ -275,6 +277,7 @@ pub fn budget(fw: &Firmware) -> Result<(String, Vec<String>), String> {
 
 /// The full report: budget, pieces, the scheme cost table and the
 /// accuracy-against-cost table (host simulations).
+#[cfg(feature = "host")]
 pub fn report(fw: &Firmware) -> Result<(String, Vec<String>), String> {
     let (m4, m3) = (&fw.m4, &fw.m3);
     let (budget_table, over) = budget(fw)?;
@@ -389,6 +392,7 @@ pub fn report(fw: &Firmware) -> Result<(String, Vec<String>), String> {
 
 /// Worst error (% of the step) over the paper cases of one configuration;
 /// infinite where the scheme is unstable at that step.
+#[cfg(feature = "host")]
 struct Accuracy {
     scheme: String,
     substeps: u32,
@@ -397,6 +401,7 @@ struct Accuracy {
     fixed: f64,
 }
 
+#[cfg(feature = "host")]
 fn accuracy_points(configs: &[(String, u32)]) -> Result<Vec<Accuracy>, String> {
     use compensator::dynamics::Scheme;
     use compensator_cli::dynamics::Precision;
@@ -437,12 +442,14 @@ fn accuracy_points(configs: &[(String, u32)]) -> Result<Vec<Accuracy>, String> {
     Ok(out)
 }
 
-/// `cargo xtask bench [--write]`.
+/// `cargo xtask bench [--write]` (the accuracy table needs the `host`
+/// feature; `main` re-runs xtask with it).
+#[cfg(feature = "host")]
 pub fn cmd(root: &Path, args: &[String]) -> Result<i32, String> {
-    let tc = crate::toolchain::get(root, &firmware::TARGETS)?;
+    let tc = crate::toolchain::get(root, &crate::firmware::TARGETS)?;
     eprintln!("xtask: toolchain: {}", tc.description);
     qemu::ensure()?;
-    let elfs = firmware::build_all_with(&tc, root)?;
+    let elfs = crate::firmware::build_all_with(&tc, root)?;
     let (text, over) = report(&measure_firmware(&elfs, None)?)?;
     print!("{text}");
     if args.iter().any(|a| a == "--write") {

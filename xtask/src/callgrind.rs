@@ -5,10 +5,11 @@
 //! Each workload of `host-tests/benches/host.rs` runs in its own valgrind
 //! process; the `setup` workload (reading the preset) is subtracted, and
 //! the rest divided by the operation count. A workload more than
-//! [`TOLERANCE`] off its baseline fails the check.
+//! [`TOLERANCE`] off its baseline fails the check. The workloads and the
+//! count come from the bench itself (`host list`), so that xtask needs no
+//! host-side crate of the workspace.
 
 use crate::process;
-use host_tests::bench::{COUNT, WORKLOADS};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
@@ -50,6 +51,29 @@ fn bench_executable(root: &Path) -> Result<PathBuf, String> {
         .ok_or_else(|| "no executable for the host bench".into())
 }
 
+/// The bench's operation count and workload names (`host list`).
+fn workloads(exe: &Path) -> Result<(f64, Vec<String>), String> {
+    let out = process::capture(Command::new(exe).arg("list"), Duration::from_secs(60));
+    if !out.ok() {
+        return Err(format!("{} list: {}", exe.display(), out.stderr.trim()));
+    }
+    let count = out
+        .stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("count ")?.trim().parse::<f64>().ok())
+        .ok_or("the host bench reported no operation count")?;
+    let names: Vec<String> = out
+        .stdout
+        .lines()
+        .filter_map(|l| l.strip_prefix("workload "))
+        .map(|w| w.trim().to_string())
+        .collect();
+    if names.is_empty() {
+        return Err("the host bench reported no workload".into());
+    }
+    Ok((count, names))
+}
+
 /// Total instructions (Ir) of one run of `exe workload`.
 fn instructions(exe: &Path, workload: &str, dir: &Path) -> Result<f64, String> {
     let file = dir.join(format!("{workload}.out"));
@@ -80,12 +104,13 @@ pub fn measure(root: &Path) -> Result<Vec<(String, f64)>, String> {
         return Err("valgrind is missing (apt-get install valgrind)".into());
     }
     let exe = bench_executable(root)?;
+    let (count, workloads) = workloads(&exe)?;
     let dir = root.join("target/callgrind");
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let setup = instructions(&exe, "setup", &dir)?;
-    WORKLOADS
+    workloads
         .iter()
-        .map(|w| Ok((w.to_string(), (instructions(&exe, w, &dir)? - setup) / f64::from(COUNT))))
+        .map(|w| Ok((w.to_string(), (instructions(&exe, w, &dir)? - setup) / count)))
         .collect()
 }
 

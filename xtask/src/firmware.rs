@@ -49,7 +49,13 @@ impl Image {
         target: M4,
         features: "board",
     };
-    /// All images.
+    /// A deliberate HardFault on QEMU (the fault handler's test).
+    pub const FAULT: Image = Image {
+        bin: "fault",
+        target: M4,
+        features: "qemu",
+    };
+    /// The images a parameter file goes into.
     pub const ALL: [Image; 4] = [Image::TWIN, Image::BENCH_M4, Image::BENCH_M3, Image::BOARD];
 }
 
@@ -59,40 +65,108 @@ pub fn target_dir(root: &Path) -> PathBuf {
     root.join("target/firmware")
 }
 
+/// How an image is built.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Options<'a> {
+    /// The parameter file (absolute; `None`: `presets/paper.toml`, or the
+    /// `COMPENSATOR_PARAMS` xtask resolved and checked).
+    pub params: Option<&'a Path>,
+    /// The dev profile (debug assertions: the board keeps its debug port
+    /// clocked in sleep) instead of release.
+    pub debug: bool,
+}
+
+/// A built image.
+#[derive(Clone, Debug)]
+pub struct Built {
+    /// The ELF.
+    pub elf: PathBuf,
+    /// The build script's output directory of the `compensator` package
+    /// (for the QEMU twin: its replay schedule, `replay.txt`).
+    pub out_dir: Option<PathBuf>,
+}
+
 /// Builds `image` in release; returns the ELF's path.
 pub fn build(tc: &Toolchain, root: &Path, image: &Image, params: Option<&Path>) -> Result<PathBuf, String> {
+    build_with(tc, root, image, Options { params, debug: false }).map(|b| b.elf)
+}
+
+/// Builds `image` (only it: `--package compensator --bin ...`, no host
+/// crate of the workspace); returns the ELF and the build script's output
+/// directory.
+pub fn build_with(tc: &Toolchain, root: &Path, image: &Image, options: Options<'_>) -> Result<Built, String> {
     let mut cmd = tc.cargo();
     cmd.current_dir(root)
-        .args([
-            "build",
-            "--release",
-            "--quiet",
-            "--package",
-            "compensator",
-            "--bin",
-            image.bin,
-        ])
-        .args([
-            "--target",
-            image.target,
-            "--no-default-features",
-            "--features",
-            image.features,
-        ])
-        .arg("--target-dir")
-        .arg(target_dir(root))
-        .args(tc.build_args());
-    if let Some(p) = params {
-        cmd.env("COMPENSATOR_PARAMS", p);
+        .args(["build", "--quiet", "--package", "compensator", "--bin", image.bin]);
+    if !options.debug {
+        cmd.arg("--release");
     }
-    if process::run(&mut cmd, Duration::from_secs(1200)) != Some(0) {
+    cmd.args([
+        "--target",
+        image.target,
+        "--no-default-features",
+        "--features",
+        image.features,
+        "--message-format=json-render-diagnostics",
+    ])
+    .arg("--target-dir")
+    .arg(target_dir(root))
+    .args(tc.build_args());
+    match options.params {
+        Some(p) => {
+            cmd.env("COMPENSATOR_PARAMS", p);
+        }
+        None => {
+            // Resolved by xtask against the user's directory; never left for
+            // the build script to guess.
+            cmd.env_remove("COMPENSATOR_PARAMS");
+        }
+    }
+    let out = process::capture_stdout(&mut cmd, Duration::from_secs(1200));
+    if !out.ok() {
         return Err(format!("building {} for {} failed", image.bin, image.target));
     }
-    Ok(target_dir(root).join(image.target).join("release").join(image.bin))
+    let (elf, out_dir) = artifacts(&out.stdout, image.bin);
+    let profile = if options.debug { "debug" } else { "release" };
+    Ok(Built {
+        elf: elf.unwrap_or_else(|| target_dir(root).join(image.target).join(profile).join(image.bin)),
+        out_dir,
+    })
+}
+
+/// The executable named `bin` and the `compensator` build script's output
+/// directory, from cargo's JSON messages.
+fn artifacts(json_lines: &str, bin: &str) -> (Option<PathBuf>, Option<PathBuf>) {
+    let (mut elf, mut out_dir) = (None, None);
+    for line in json_lines.lines() {
+        let Ok(v) = serde_json::from_str::<serde_json::Value>(line) else {
+            continue;
+        };
+        let is_ours = v["package_id"].as_str().is_some_and(|id| {
+            id.contains("/compensator#") || id.contains("compensator@") || id.starts_with("compensator ")
+        });
+        match v["reason"].as_str() {
+            Some("build-script-executed") if is_ours => {
+                out_dir = v["out_dir"].as_str().map(PathBuf::from);
+            }
+            Some("compiler-artifact") if v["target"]["name"].as_str() == Some(bin) => {
+                if let Some(e) = v["executable"].as_str() {
+                    elf = Some(PathBuf::from(e));
+                }
+            }
+            _ => {}
+        }
+    }
+    (elf, out_dir)
 }
 
 /// Builds every image with the given toolchain.
 pub fn build_all_with(tc: &Toolchain, root: &Path) -> Result<Vec<(Image, PathBuf)>, String> {
+    build_all_params(tc, root, None)
+}
+
+/// Builds every image with the parameter file `params`.
+pub fn build_all_params(tc: &Toolchain, root: &Path, params: Option<&Path>) -> Result<Vec<(Image, PathBuf)>, String> {
     Image::ALL
         .iter()
         .map(|img| {
@@ -100,18 +174,64 @@ pub fn build_all_with(tc: &Toolchain, root: &Path) -> Result<Vec<(Image, PathBuf
                 "xtask: building {} ({}, features {})",
                 img.bin, img.target, img.features
             );
-            build(tc, root, img, None).map(|p| (*img, p))
+            build(tc, root, img, params).map(|p| (*img, p))
         })
         .collect()
 }
 
-/// `cargo xtask build`.
-pub fn build_all(root: &Path) -> Result<(), String> {
+/// `cargo xtask build`: every image, with the parameter file resolved and
+/// checked by the caller.
+pub fn build_all(root: &Path, params: Option<&Path>) -> Result<(), String> {
     let tc = crate::toolchain::get(root, &TARGETS)?;
     eprintln!("xtask: toolchain: {}", tc.description);
-    for (img, path) in build_all_with(&tc, root)? {
+    for (img, path) in build_all_params(&tc, root, params)? {
         println!("{} ({}): {}", img.bin, img.target, path.display());
     }
+    Ok(())
+}
+
+/// A parameter file the CLI refuses (a PT1000 on the 430 ohm board) fails a
+/// plain `cargo build` of the board image, run from `presets/` with the
+/// file's path relative to there, with one line naming the field and no
+/// panic: the build script's contract, for users who build without xtask.
+pub fn check_refused_file(tc: &Toolchain, root: &Path) -> Result<(), String> {
+    let text = std::fs::read_to_string(root.join("presets/paper.toml")).map_err(|e| e.to_string())?;
+    let file = root.join("target/xtask/pt1000-on-430-ohm.toml");
+    std::fs::create_dir_all(file.parent().expect("has a parent")).map_err(|e| e.to_string())?;
+    std::fs::write(&file, format!("{text}\n[estimator]\nrtd_r0 = 1000\n")).map_err(|e| e.to_string())?;
+    let presets = root.join("presets");
+    let mut cmd = tc.cargo();
+    cmd.current_dir(&presets)
+        // What a shell sets: the directory the user typed the command in.
+        .env("PWD", &presets)
+        .env("COMPENSATOR_PARAMS", "../target/xtask/pt1000-on-430-ohm.toml")
+        .args([
+            "build",
+            "--quiet",
+            "--release",
+            "--package",
+            "compensator",
+            "--bin",
+            "board",
+        ])
+        .args(["--target", M4, "--no-default-features", "--features", "board"])
+        .arg("--target-dir")
+        .arg(target_dir(root))
+        .args(tc.build_args());
+    let out = process::capture(&mut cmd, Duration::from_secs(600));
+    let naming: Vec<&str> = out
+        .stderr
+        .lines()
+        .filter(|l| l.contains("estimator.rtd_reference"))
+        .collect();
+    let expected = format!("{}: estimator.rtd_reference = 430: must exceed", file.display());
+    if out.code == Some(0) || naming.len() != 1 || !naming[0].contains(&expected) || out.stderr.contains("panicked") {
+        return Err(format!(
+            "a refused parameter file should fail the build with one line naming estimator.rtd_reference; cargo said (exit {:?}):\n{}",
+            out.code, out.stderr
+        ));
+    }
+    eprintln!("xtask: {}", naming[0].trim());
     Ok(())
 }
 

@@ -73,6 +73,54 @@ pub fn capture(cmd: &mut Command, timeout: Duration) -> Output {
     }
 }
 
+/// Runs `cmd` capturing its standard output only (standard error goes to
+/// the terminal: compiler diagnostics stay visible); kills it after
+/// `timeout`.
+pub fn capture_stdout(cmd: &mut Command, timeout: Duration) -> Output {
+    cmd.stdin(Stdio::null()).stdout(Stdio::piped()).stderr(Stdio::inherit());
+    let mut child = match cmd.spawn() {
+        Ok(c) => c,
+        Err(e) => {
+            return Output {
+                code: None,
+                stdout: String::new(),
+                stderr: e.to_string(),
+                timed_out: false,
+            };
+        }
+    };
+    let mut out = child.stdout.take().expect("piped");
+    let t_out = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = out.read_to_string(&mut s);
+        s
+    });
+    let deadline = Instant::now() + timeout;
+    let mut timed_out = false;
+    let status = loop {
+        match child.try_wait() {
+            Ok(Some(st)) => break Some(st),
+            Ok(None) if Instant::now() >= deadline => {
+                timed_out = true;
+                eprintln!(
+                    "xtask: {:?} did not finish within {timeout:?}; killed",
+                    cmd.get_program()
+                );
+                kill_tree(&mut child);
+                break child.wait().ok();
+            }
+            Ok(None) => std::thread::sleep(Duration::from_millis(20)),
+            Err(_) => break None,
+        }
+    };
+    Output {
+        code: if timed_out { None } else { status.and_then(|s| s.code()) },
+        stdout: t_out.join().unwrap_or_default(),
+        stderr: String::new(),
+        timed_out,
+    }
+}
+
 /// Runs `cmd` with inherited output; kills it after `timeout`. Returns the
 /// exit code (`None` on a signal, a start failure, or the deadline).
 pub fn run(cmd: &mut Command, timeout: Duration) -> Option<i32> {

@@ -23,7 +23,7 @@ pub const NETDUINO: Machine = Machine {
     cpu: "cortex-m4",
 };
 /// QEMU's Netduino 2 (STM32F205, Cortex-M3, no FPU): the same memory map
-/// as the STM32F405, so one `memory.x` serves both targets.
+/// as the STM32F405, so one memory layout (`link/memory-qemu.x`) serves both targets.
 pub const NETDUINO2: Machine = Machine {
     name: "netduino2",
     cpu: "cortex-m3",
@@ -83,7 +83,8 @@ pub enum Show {
 pub struct Run {
     /// QEMU's exit code (the firmware's semihosting exit code); 124 on timeout.
     pub code: i32,
-    /// Decoded log lines, `LEVEL message` (no locations).
+    /// Decoded log lines, `LEVEL message` (no locations), every digit as
+    /// the firmware sent it.
     pub lines: Vec<String>,
 }
 
@@ -161,11 +162,13 @@ pub fn run(elf: &Path, machine: Machine, icount: bool, timeout: Duration, show: 
                             let line = format!("{level:<5} {}", frame.display_message());
                             if show == Show::Stream {
                                 let mut o = stdout.lock();
-                                let _ = write!(o, "{line}");
-                                if let Some(loc) = locations.as_ref().and_then(|l| l.get(&frame.index())) {
-                                    if level != "INFO" && level != "PRINT" {
-                                        let _ = write!(o, "  ({}:{})", loc.file.display(), loc.line);
-                                    }
+                                // Telemetry rounded for reading (`lines` keeps every digit).
+                                let _ = write!(o, "{}", crate::telemetry::humanize(&line));
+                                if let Some(loc) = locations.as_ref().and_then(|l| l.get(&frame.index()))
+                                    && level != "INFO"
+                                    && level != "PRINT"
+                                {
+                                    let _ = write!(o, "  ({}:{})", loc.file.display(), loc.line);
                                 }
                                 let _ = writeln!(o);
                             }
