@@ -356,6 +356,8 @@ pub struct Estimator {
     steady_ticks: u32,
     /// Re-seats of the twin so far (saturating).
     reseats: u32,
+    /// Consistency checks run so far (saturating).
+    checks: u32,
     /// The last check re-seated the twin (raises `TWIN_RESEATED` until a
     /// check finds it in agreement).
     reseated: bool,
@@ -483,6 +485,7 @@ impl Estimator {
             steady_anchor: initial,
             steady_ticks: 0,
             reseats: 0,
+            checks: 0,
             reseated: false,
         })
     }
@@ -497,6 +500,12 @@ impl Estimator {
             return f32::INFINITY;
         }
         st.slowest_time_constant
+    }
+
+    /// Consistency checks run since start (saturating): each compared the
+    /// settled twin with the closed form, and re-seated it or not.
+    pub fn consistency_checks(&self) -> u32 {
+        self.checks
     }
 
     /// Steady ticks the consistency check waits for at the last Stability
@@ -752,6 +761,7 @@ impl Estimator {
         if self.failed_jobs != 0 || !st.stable || self.steady_ticks < st.settle_ticks {
             return;
         }
+        self.checks = self.checks.saturating_add(1);
         let [xi, _, pi_a, pi_b] = self.twin.raw_state();
         let [xi_eq, _, pi_a_eq, pi_b_eq] = st.y_equilibrium;
         // Written so that a NaN state fails the check too.
