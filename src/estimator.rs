@@ -351,8 +351,8 @@ pub struct Estimator {
     last: Option<StateEstimate>,
     /// Filtered temperature at the start of the current steady stretch [C].
     steady_anchor: f32,
-    /// Ticks the filtered temperature has stayed within [`STEADY_BAND`] of
-    /// `steady_anchor` (or since the last re-seat).
+    /// Ticks that ran a job while the filtered temperature stayed within
+    /// [`STEADY_BAND`] of `steady_anchor` (or since the last re-seat).
     steady_ticks: u32,
     /// Re-seats of the twin so far (saturating).
     reseats: u32,
@@ -567,12 +567,6 @@ impl Estimator {
         }
         self.filtered += self.config.filter_gain * (self.held - self.filtered);
         let t = self.filtered;
-        if libm::fabsf(t - self.steady_anchor) <= STEADY_BAND {
-            self.steady_ticks = self.steady_ticks.saturating_add(1);
-        } else {
-            self.steady_anchor = t;
-            self.steady_ticks = 0;
-        }
         let (lo, hi) = self.config.valid;
         if !(t >= lo && t <= hi) {
             flags.insert(Flags::OUT_OF_RANGE);
@@ -675,6 +669,16 @@ impl Estimator {
 
     fn update(&mut self, t: f32, flags: &mut Flags) -> Result<StateEstimate, ModelError> {
         if !self.telemetry_due() {
+            // The steady stretch, counted in ticks that run a job (a
+            // telemetry tick only publishes): the window in time is at
+            // least as long, and the telemetry tick, the costliest, is
+            // spared. A drift out of the band shows at the next job tick.
+            if libm::fabsf(t - self.steady_anchor) <= STEADY_BAND {
+                self.steady_ticks = self.steady_ticks.saturating_add(1);
+            } else {
+                self.steady_anchor = t;
+                self.steady_ticks = 0;
+            }
             let job = self.next_job;
             self.next_job = job.next();
             // A temperature the model refuses leaves the job's previous
