@@ -528,3 +528,22 @@ fn closed_stop_case() -> RawParams {
     raw.validate().unwrap();
     raw
 }
+
+#[test]
+fn flag_names_follow_the_bit_order() {
+    let flags = [
+        (Flags::AT_STOP, "AT_STOP"),
+        (Flags::OUT_OF_RANGE, "OUT_OF_RANGE"),
+        (Flags::NOT_UNIQUE, "NOT_UNIQUE"),
+        (Flags::UNSTABLE, "UNSTABLE"),
+        (Flags::SENSOR_FAULT, "SENSOR_FAULT"),
+        (Flags::SPIKE, "SPIKE"),
+        (Flags::DEGRADED, "DEGRADED"),
+        (Flags::TWIN_RESEATED, "TWIN_RESEATED"),
+    ];
+    assert_eq!(Flags::NAMES.len(), flags.len());
+    for (f, name) in flags {
+        assert_eq!(f.0.count_ones(), 1, "{name}");
+        assert_eq!(Flags::NAMES[f.0.trailing_zeros() as usize], name);
+    }
+}
