@@ -402,7 +402,7 @@ fn drive(raw: &RawParams, name: &str, legs: &[(f32, f32, f32)]) -> u32 {
         if from == to {
             let window = estimator_for(raw, to).settle_ticks();
             assert!(
-                window <= 30_000,
+                window <= 100_000,
                 "{name}: a settling window of {window} ticks at {to} C"
             );
             n = n.max(window + 1500);
@@ -458,11 +458,20 @@ const ENVELOPE: [(f32, f32, f32); 12] = [
     (34.0, 34.0, 2.0),
 ];
 
+/// Random designs of the envelope test: 4, or `COMPENSATOR_ENVELOPE_DESIGNS`
+/// for a longer run.
+fn envelope_designs() -> usize {
+    std::env::var("COMPENSATOR_ENVELOPE_DESIGNS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(4)
+}
+
 #[test]
 fn a_correct_twin_is_never_reseated_across_the_envelope() {
     let mut runs = vec![("paper".to_string(), paper_raw())];
     let mut rng = Rng::new(2024);
-    for i in 0..4 {
+    for i in 0..envelope_designs() {
         runs.push((format!("random design {i}"), physical_params(&mut rng)));
     }
     for (name, raw) in &runs {
