@@ -387,6 +387,9 @@ struct Statics {
     stable: bool,
     /// `SETTLE_TIME_CONSTANTS / tick` [1/s] (constant).
     settle_per_second: f32,
+    /// Lower bound of the slowest decay rate of the linearisation, in the
+    /// twin's time unit (0: none, not stable); the next search's hint.
+    slowest_rate: f32,
     /// Time constant of the slowest mode of the linearisation [s].
     slowest_time_constant: f32,
     /// Steady ticks before the consistency check: [`SETTLE_TIME_CONSTANTS`]
@@ -458,6 +461,7 @@ impl Estimator {
             y_equilibrium: [0.0; 4],
             stable: true,
             settle_per_second: SETTLE_TIME_CONSTANTS / config.tick(),
+            slowest_rate: 0.0,
             slowest_time_constant: f32::INFINITY,
             settle_ticks: u32::MAX,
             losses: f32::NAN,
@@ -636,7 +640,12 @@ impl Estimator {
                 };
                 let poly = characteristic_polynomial(&sys.jacobian(&statics.y_equilibrium));
                 statics.stable = quartic_hurwitz(&poly);
-                let sigma = if statics.stable { slowest_decay_rate(&poly) } else { 0.0 };
+                let sigma = if statics.stable {
+                    slowest_decay_rate(&poly, statics.slowest_rate)
+                } else {
+                    0.0
+                };
+                statics.slowest_rate = sigma;
                 if sigma > 0.0 {
                     statics.slowest_time_constant = twin.model().scales.time / sigma;
                     let ticks = statics.slowest_time_constant * statics.settle_per_second;
@@ -833,11 +842,18 @@ fn shifted(a: &[f32; 4], sigma: f32) -> [f32; 4] {
 /// within a factor two, two bisections within 25 %; the stable end is
 /// returned. Eight tests of ~30 flops: no eigenvalue iteration, bounded
 /// cost, and exact for complex modes too (underdamped designs).
-pub fn slowest_decay_rate(a: &[f32; 4]) -> f32 {
+///
+/// `hint` (a previous result, or 0) is tried first: when `hint` is still
+/// below the rate and `1.25 hint` is not, `hint` is the answer (two tests,
+/// the usual case at a steady temperature); otherwise the search runs.
+pub fn slowest_decay_rate(a: &[f32; 4], hint: f32) -> f32 {
+    let stable = |sigma: f32| quartic_hurwitz(&shifted(a, sigma));
+    if hint > 0.0 && stable(hint) && !stable(1.25 * hint) {
+        return hint;
+    }
     let top = 0.25 * a[0];
     // 2^-k, exactly, for k in 0..=32.
     let scaled = |k: u32| top * f32::from_bits((127 - k) << 23);
-    let stable = |sigma: f32| quartic_hurwitz(&shifted(a, sigma));
     if !(top > 0.0) || !stable(scaled(32)) {
         return 0.0;
     }

@@ -236,11 +236,22 @@ fn the_slowest_decay_rate_is_bounded_within_a_quarter() {
         ([11001.001, 10_011_011.0, 10_010_011.0, 1.0e4], 1e-3),
     ];
     for (poly, rate) in cases {
-        let got = slowest_decay_rate(&poly);
-        assert!(got <= rate * 1.0001 && got >= 0.75 * rate, "{poly:?}: {got} vs {rate}");
+        // Without a hint, and with hints right, too high, too low, absurd:
+        // the same guarantee.
+        for hint in [0.0, 0.9 * rate, 2.0 * rate, 0.3 * rate, 1e30, -1.0, f32::NAN] {
+            let got = slowest_decay_rate(&poly, hint);
+            assert!(
+                got <= rate * 1.0001 && got >= 0.75 * rate,
+                "{poly:?}, hint {hint}: {got} vs {rate}"
+            );
+        }
+        // A hint within the answer's precision is kept.
+        assert_eq!(slowest_decay_rate(&poly, 0.9 * rate), 0.9 * rate);
     }
     // Not Hurwitz: (s - 1)(s + 1)(s + 2)(s + 3) = s^4 + 5 s^3 + 5 s^2 - 5 s - 6.
-    assert_eq!(slowest_decay_rate(&[5.0, 5.0, -5.0, -6.0]), 0.0);
+    for hint in [0.0, 0.5, 1.0] {
+        assert_eq!(slowest_decay_rate(&[5.0, 5.0, -5.0, -6.0], hint), 0.0);
+    }
 }
 
 #[test]
