@@ -8,6 +8,7 @@
 pub mod accuracy;
 pub mod bench;
 pub mod random;
+pub mod survey;
 pub use compensator_reference::statics as reference;
 
 use std::path::PathBuf;

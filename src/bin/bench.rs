@@ -228,7 +228,12 @@ fn main() -> ! {
         error!("parameters rejected");
         exit(false)
     };
-    let configs: [(Scheme, u8); 12] = [
+    let configs: [(Scheme, u8); 17] = [
+        (Scheme::Sdirk3, 1),
+        (Scheme::Sdirk3, 2),
+        (Scheme::Sdirk3, 4),
+        (Scheme::Sdirk2, 2),
+        (Scheme::Sdirk2, 4),
         (Scheme::LinearlyImplicitEuler, 1),
         (Scheme::LinearlyImplicitEuler, 4),
         (Scheme::Ros2, 1),

@@ -8,6 +8,7 @@
 //! * [`linear`]: linearisation at an equilibrium (Eq. 37): eigenvalues,
 //!   natural frequencies, damping ratios, stability.
 
+pub mod dirk;
 pub mod fsi;
 pub mod linear;
 pub mod reduced;

@@ -106,7 +106,7 @@ impl<F: Float, T: Real> ReducedTwin<F, T> {
         let y: [T; 4] = model.equilibrium_state(&eq);
         Ok(ReducedTwin {
             coefficients: model.coefficients(&eq.fluid)?,
-            stepper: Stepper::new(config.scheme, config.step(model.scales.time.to_f64())),
+            stepper: Stepper::new(config.scheme.generic(), config.step(model.scales.time.to_f64())),
             substeps: config.substeps,
             state: [y[0], T::ZERO],
             model,

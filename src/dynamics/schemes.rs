@@ -18,6 +18,14 @@
 //! | [`Scheme::Rk4`] | 4 | 4 | explicit (|h lambda| < 2.8) | Kutta 1901 |
 //!
 //! The cost is fixed by the scheme: no iteration depends on the data.
+//!
+//! The FSI twin ships neither: its scheme is an SDIRK whose stage equations
+//! are solved with the chamber pressures eliminated exactly
+//! ([`super::dirk`], [`Scheme::Sdirk3`]). The linearly implicit schemes
+//! here linearise the orifice's square root over a whole step, which
+//! overshoots (and can diverge) where a stiff chamber's orifice drop is near
+//! zero; they stay for comparison and for generic systems (the reduced
+//! model).
 
 // Matrix code indexes rows and columns explicitly, as the algorithms are
 // written (EISPACK, Hairer & Wanner); iterator chains would obscure them.
@@ -99,16 +107,24 @@ pub enum Scheme {
     Ros3,
     /// Four-stage stiffly accurate Rosenbrock method RODAS3, order 3.
     Rodas3,
+    /// Alexander's two-stage L-stable SDIRK, order 2, stages solved with
+    /// the pressures eliminated exactly (FSI model only, [`super::dirk`]).
+    Sdirk2,
+    /// Alexander's three-stage L-stable SDIRK, order 3 (FSI model only,
+    /// [`super::dirk`]).
+    Sdirk3,
 }
 
 impl Scheme {
     /// Every scheme, for benchmarks.
-    pub const ALL: [Scheme; 5] = [
+    pub const ALL: [Scheme; 7] = [
         Scheme::Rk4,
         Scheme::LinearlyImplicitEuler,
         Scheme::Ros2,
         Scheme::Ros3,
         Scheme::Rodas3,
+        Scheme::Sdirk2,
+        Scheme::Sdirk3,
     ];
 
     /// Short name (`"ros2"`...).
@@ -119,6 +135,8 @@ impl Scheme {
             Scheme::Ros2 => "ros2",
             Scheme::Ros3 => "ros3",
             Scheme::Rodas3 => "rodas3",
+            Scheme::Sdirk2 => "sdirk2",
+            Scheme::Sdirk3 => "sdirk3",
         }
     }
 
@@ -127,8 +145,28 @@ impl Scheme {
         match self {
             Scheme::Rk4 => 4,
             Scheme::LinearlyImplicitEuler => 1,
-            Scheme::Ros2 => 2,
-            Scheme::Ros3 | Scheme::Rodas3 => 3,
+            Scheme::Ros2 | Scheme::Sdirk2 => 2,
+            Scheme::Ros3 | Scheme::Rodas3 | Scheme::Sdirk3 => 3,
+        }
+    }
+
+    /// The SDIRK tableau of an SDIRK scheme ([`super::dirk`]).
+    pub const fn dirk(self) -> Option<&'static super::dirk::Tableau> {
+        match self {
+            Scheme::Sdirk2 => Some(&super::dirk::SDIRK2),
+            Scheme::Sdirk3 => Some(&super::dirk::SDIRK3),
+            _ => None,
+        }
+    }
+
+    /// The scheme a generic [`OdeSystem`] runs for this choice: itself, or
+    /// for an SDIRK (which needs the FSI model's structure) the L-stable
+    /// Rosenbrock scheme of the same order.
+    pub const fn generic(self) -> Scheme {
+        match self {
+            Scheme::Sdirk2 => Scheme::Ros2,
+            Scheme::Sdirk3 => Scheme::Ros3,
+            s => s,
         }
     }
 
@@ -160,7 +198,7 @@ fn tableau(scheme: Scheme) -> Tableau {
             c: z,
             m: [1.0, 0.0, 0.0, 0.0],
         },
-        Scheme::Ros2 => {
+        Scheme::Ros2 | Scheme::Sdirk2 => {
             let g = 1.0 + core::f64::consts::FRAC_1_SQRT_2;
             let mut a = z;
             let mut c = z;
@@ -174,7 +212,7 @@ fn tableau(scheme: Scheme) -> Tableau {
                 m: [1.5 / g, 0.5 / g, 0.0, 0.0],
             }
         }
-        Scheme::Ros3 => {
+        Scheme::Ros3 | Scheme::Sdirk3 => {
             let mut a = z;
             let mut c = z;
             a[1][0] = 1.0;
@@ -237,6 +275,23 @@ pub enum StepError {
     Singular,
     /// The new state is not finite.
     NonFinite,
+    /// The state left its physical bounds (a chamber pressure far outside
+    /// `[p_c, p_p]`, the plunger far beyond a stop): the scheme is unstable
+    /// at this step length. An L-stable scheme or more steps per tick cure it.
+    Diverged,
+}
+
+impl core::fmt::Display for StepError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            StepError::Singular => "the stage matrix is singular",
+            StepError::NonFinite => "the state is not finite",
+            StepError::Diverged => {
+                "the state left its physical bounds: the scheme is unstable at this step \
+                 (use an L-stable scheme or more substeps)"
+            }
+        })
+    }
 }
 
 impl<T: Real> Stepper<T> {
@@ -277,9 +332,19 @@ impl<T: Real> Stepper<T> {
 
     /// Advances `y` by one step of `sys`.
     pub fn step<S: OdeSystem<T, N>, const N: usize>(&self, sys: &S, y: &[T; N]) -> Result<[T; N], StepError> {
+        self.step_fraction(sys, y, T::ONE)
+    }
+
+    /// Advances `y` by `frac` (in `(0, 1]`) of the prepared step.
+    pub fn step_fraction<S: OdeSystem<T, N>, const N: usize>(
+        &self,
+        sys: &S,
+        y: &[T; N],
+        frac: T,
+    ) -> Result<[T; N], StepError> {
         let next = match self.scheme {
-            Scheme::Rk4 => self.rk4(sys, y),
-            _ => self.rosenbrock(sys, y)?,
+            Scheme::Rk4 => self.rk4(sys, y, frac),
+            _ => self.rosenbrock(sys, y, if frac == T::ONE { T::ONE } else { T::ONE / frac })?,
         };
         if next.iter().all(|v| v.is_finite()) {
             Ok(next)
@@ -288,8 +353,16 @@ impl<T: Real> Stepper<T> {
         }
     }
 
-    fn rosenbrock<S: OdeSystem<T, N>, const N: usize>(&self, sys: &S, y: &[T; N]) -> Result<[T; N], StepError> {
-        let (f0, lu) = sys.linearise(y, self.inv_gamma_h).ok_or(StepError::Singular)?;
+    /// One Rosenbrock step of `h / inv_frac`.
+    fn rosenbrock<S: OdeSystem<T, N>, const N: usize>(
+        &self,
+        sys: &S,
+        y: &[T; N],
+        inv_frac: T,
+    ) -> Result<[T; N], StepError> {
+        let (f0, lu) = sys
+            .linearise(y, self.inv_gamma_h * inv_frac)
+            .ok_or(StepError::Singular)?;
         let mut u = [[T::ZERO; N]; MAX_STAGES];
         let mut f = f0;
         for i in 0..self.stages {
@@ -307,7 +380,7 @@ impl<T: Real> Stepper<T> {
             }
             let mut rhs = f;
             for (j, uj) in u.iter().enumerate().take(i) {
-                let cij = self.c_over_h[i][j];
+                let cij = self.c_over_h[i][j] * inv_frac;
                 if cij != T::ZERO {
                     let su = lu.scale(uj);
                     for k in 0..N {
@@ -329,9 +402,10 @@ impl<T: Real> Stepper<T> {
         Ok(next)
     }
 
-    fn rk4<S: OdeSystem<T, N>, const N: usize>(&self, sys: &S, y: &[T; N]) -> [T; N] {
-        let half = self.h * T::HALF;
-        let sixth = self.rk4_sixth_h;
+    fn rk4<S: OdeSystem<T, N>, const N: usize>(&self, sys: &S, y: &[T; N], frac: T) -> [T; N] {
+        let h = self.h * frac;
+        let half = h * T::HALF;
+        let sixth = self.rk4_sixth_h * frac;
         let shifted = |base: &[T; N], k: &[T; N], s: T| {
             let mut out = *base;
             for i in 0..N {
@@ -342,7 +416,7 @@ impl<T: Real> Stepper<T> {
         let k1 = sys.rhs(y);
         let k2 = sys.rhs(&shifted(y, &k1, half));
         let k3 = sys.rhs(&shifted(y, &k2, half));
-        let k4 = sys.rhs(&shifted(y, &k3, self.h));
+        let k4 = sys.rhs(&shifted(y, &k3, h));
         let mut next = *y;
         for i in 0..N {
             next[i] += sixth * (k1[i] + T::TWO * k2[i] + T::TWO * k3[i] + k4[i]);

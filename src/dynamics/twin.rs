@@ -11,7 +11,8 @@
 //! fluid properties at the sensor rate) and the integration scalar `T`
 //! (`f32`, `f64` or fixed point).
 
-use super::fsi::{Coefficients, Contact, DynamicState, Fsi, Model, apply_stops, contact_for};
+use super::dirk::Dirk;
+use super::fsi::{Coefficients, Contact, DynamicState, Fsi, Model};
 use super::schemes::{Scheme, StepError, Stepper};
 use crate::equilibrium::equilibrium;
 use crate::error::ModelError;
@@ -54,7 +55,7 @@ impl TwinConfig {
     /// steps per 1 ms tick. The accuracy/cost trade-off against the other
     /// schemes is in the project's `docs/dynamics.md`.
     pub const SHIPPED: TwinConfig = TwinConfig {
-        scheme: Scheme::Ros3,
+        scheme: Scheme::Sdirk3,
         tick: 1.0e-3,
         substeps: 2,
     };
@@ -70,14 +71,51 @@ pub struct TickReport {
     pub impact: bool,
 }
 
+/// Bound on the chamber pressures, in units of `dp` beyond `[p_c, p_p]`,
+/// past which a tick is reported as [`StepError::Diverged`]. The physical
+/// excursions stay far inside it: a plunger stopped dead on a stop swings a
+/// chamber by at most its quasi-steady pumping `sigma w / g_l` plus the
+/// water-hammer-like transient, well under one `dp` on every surveyed design
+/// (`host-tests/tests/survey.rs` records the reference's largest excursion).
+pub const PRESSURE_MARGIN: f64 = 4.0;
+
+/// Iterations of the release-time search on a stop (Illinois regula falsi
+/// on the held force; each costs one held step, two closed forms per stage
+/// for the SDIRK schemes).
+pub const RELEASE_ITERATIONS: u8 = 4;
+
+/// Iterations of the impact-time search on the step's cubic Hermite
+/// interpolant (no model evaluation).
+pub const IMPACT_ITERATIONS: u8 = 6;
+
+/// Steps per held substep.
+pub const HELD_STEPS: u8 = 4;
+
+/// The integrator behind a twin.
+#[derive(Clone, Copy, Debug)]
+enum Engine<T> {
+    /// SDIRK with the pressures eliminated exactly ([`super::dirk`]).
+    Dirk(Dirk<T>),
+    /// A generic scheme (Rosenbrock, RK4) on the [`Fsi`] system.
+    Generic(Stepper<T>),
+}
+
 /// The dynamic twin.
 #[derive(Clone, Copy, Debug)]
 pub struct Twin<F, T> {
     model: Model<F>,
     coefficients: Coefficients<T>,
-    stepper: Stepper<T>,
+    engine: Engine<T>,
     substeps: u8,
+    /// The substep length times `a_x` (model units): `xi' = a_x w`.
+    h_a_x: T,
+    /// `1 / HELD_STEPS`: the length of a held step, in substeps.
+    held_part: T,
+    /// Pressure bounds `[-PRESSURE_MARGIN, 1 + PRESSURE_MARGIN]`.
+    pressure_bounds: (T, T),
     state: [T; 4],
+    /// What rounding has left out of `xi` so far ([`Real::mul_add_compensated`]).
+    xi_carry: T,
     config: TwinConfig,
 }
 
@@ -87,11 +125,21 @@ impl<F: Float, T: Real> Twin<F, T> {
         config.validate()?;
         let model = Model::new(params)?;
         let eq = equilibrium(params, temperature)?;
+        let h = config.step(model.scales.time.to_f64());
+        let engine = match config.scheme.dirk() {
+            Some(tableau) => Engine::Dirk(Dirk::new(tableau, h)),
+            None => Engine::Generic(Stepper::new(config.scheme, h)),
+        };
+        let coefficients: Coefficients<T> = model.coefficients(&eq.fluid)?;
         Ok(Twin {
-            coefficients: model.coefficients(&eq.fluid)?,
-            stepper: Stepper::new(config.scheme, config.step(model.scales.time.to_f64())),
+            h_a_x: T::from_f64(h) * coefficients.a_x,
+            held_part: T::from_f64(1.0 / HELD_STEPS as f64),
+            coefficients,
+            engine,
             substeps: config.substeps,
+            pressure_bounds: (T::from_f64(-PRESSURE_MARGIN), T::from_f64(1.0 + PRESSURE_MARGIN)),
             state: model.equilibrium_state(&eq),
+            xi_carry: T::ZERO,
             model,
             config,
         })
@@ -124,30 +172,38 @@ impl<F: Float, T: Real> Twin<F, T> {
         self.coefficients.set_hydraulic(&self.model, fluid)
     }
 
-    /// Advances one tick. On a failed step the state is left at the last
-    /// good substep and the error is returned.
+    /// Advances one tick of `substeps` substeps. On a failed substep the
+    /// state is left at the last good one and the error is returned: a
+    /// state that is not finite or beyond the physical bounds
+    /// ([`PRESSURE_MARGIN`]) is [`StepError::Diverged`] /
+    /// [`StepError::NonFinite`], never silently kept.
     ///
-    /// Stops are handled per substep:
-    /// * on a stop, the plunger stays held only if both the actual static
-    ///   force and the quasi-steady one (the force the pressures settle to
-    ///   within tens of microseconds) push into the stop; otherwise it is
-    ///   released at the substep's start. A held substep whose final force
-    ///   pulls away is redone in free motion from its start: the pressure
-    ///   transient that flips the force is much shorter than a substep, so
-    ///   the release belongs at the start (interpolating the force would
-    ///   place it far too late). A release substep that ends a little beyond
-    ///   the stop but moving away from it is put on the stop, velocity kept;
-    /// * a free substep that ends beyond a stop, or on it moving into it,
-    ///   ends on it at rest (inelastic impact).
+    /// The end stops are a constraint, handled as events inside each
+    /// substep, so that the pressures always see the motion the plunger
+    /// actually makes:
+    /// * held on a stop (on it, at rest, the static force of the current
+    ///   pressures pushing into it), the substep is integrated held (`w = 0`
+    ///   throughout). If the force at its end pulls away, the release time
+    ///   is located (Illinois on the held force, [`RELEASE_ITERATIONS`]
+    ///   held steps): held up to it, free after it;
+    /// * moving freely, a substep that ends beyond a stop is redone up to
+    ///   the impact (located on the step's cubic Hermite interpolant of
+    ///   `xi`), the plunger stops there (inelastic: `w = 0`), and the rest of
+    ///   the substep is integrated held.
     ///
-    /// The cost is bounded: one scheme step per substep, two when a held
-    /// substep turns out to release (the quasi-steady test makes that rare).
+    /// Whatever the tick's phase, a release and an impact are placed where
+    /// the force and the motion put them, not at a substep's boundary. The
+    /// cost is bounded: a quiet substep is one step; one with an event is
+    /// at most two free and `RELEASE_ITERATIONS + 2` held steps.
     pub fn tick(&mut self) -> Result<TickReport, StepError> {
         let mut impact = false;
         for _ in 0..self.substeps {
-            let (next, hit) = self.substep()?;
+            let mut carry = self.xi_carry;
+            let (next, hit) = self.substep(&self.state, &mut carry)?;
+            self.check(&next)?;
             impact |= hit;
             self.state = next;
+            self.xi_carry = carry;
         }
         Ok(TickReport {
             contact: self.coefficients.contact(&self.state),
@@ -155,46 +211,200 @@ impl<F: Float, T: Real> Twin<F, T> {
         })
     }
 
-    fn substep(&self) -> Result<([T; 4], bool), StepError> {
+    /// A state the twin can continue from: finite, pressures within the
+    /// physical bounds.
+    fn check(&self, y: &[T; 4]) -> Result<(), StepError> {
+        if !y.iter().all(|v| v.is_finite()) {
+            return Err(StepError::NonFinite);
+        }
+        let (lo, hi) = self.pressure_bounds;
+        if y[2] < lo || y[2] > hi || y[3] < lo || y[3] > hi {
+            return Err(StepError::Diverged);
+        }
+        Ok(())
+    }
+
+    /// One step of `frac` of a substep from `y`, in `contact`.
+    /// `xi_carry`: the compensated summation's carry of `xi` (free motion).
+    fn step(&self, y: &[T; 4], frac: T, contact: Contact, xi_carry: &mut T) -> Result<[T; 4], StepError> {
         let c = &self.coefficients;
-        let mut contact = c.contact(&self.state);
-        if contact != Contact::Free {
-            let [xi, w, ..] = self.state;
-            if contact_for(xi, w, c.quasi_steady_force(xi)) != contact {
-                contact = Contact::Free;
+        match &self.engine {
+            Engine::Dirk(d) => Ok(d.step(c, y, frac, contact, xi_carry)),
+            Engine::Generic(s) => {
+                let sys = Fsi {
+                    coefficients: c,
+                    contact,
+                };
+                let mut next = s.step_fraction(&sys, y, frac)?;
+                if contact != Contact::Free {
+                    next[0] = y[0];
+                    next[1] = T::ZERO;
+                }
+                Ok(next)
             }
         }
-        let held_at_start = c.contact(&self.state);
-        if contact != Contact::Free {
-            let held = Fsi {
-                coefficients: c,
-                contact,
+    }
+
+    /// One substep from `y`; `carry` is `xi`'s compensated-summation carry.
+    fn substep(&self, y: &[T; 4], carry: &mut T) -> Result<([T; 4], bool), StepError> {
+        let c = &self.coefficients;
+        let held = c.contact(y);
+        if held == Contact::Free {
+            return self.free_part(y, T::ONE, carry);
+        }
+        // On the stop exactly: nothing left to carry.
+        *carry = T::ZERO;
+        // Held: the plunger on the stop at rest; the pressures evolve, in
+        // HELD_STEPS equal steps (a pressure transient after a change of
+        // temperature decides when the plunger lifts off: it is followed,
+        // not stepped over).
+        // Positive: the force pulls away from the stop (a release).
+        let away = |s: &[T; 4]| match held {
+            Contact::Open => -c.static_force(s),
+            _ => c.static_force(s),
+        };
+        let part = self.held_part;
+        let mut start = [y[0], T::ZERO, y[2], y[3]];
+        let mut t0 = T::ZERO;
+        for _ in 0..HELD_STEPS {
+            let end = self.step(&start, part, held, carry)?;
+            let f1 = away(&end);
+            if f1 > T::ZERO {
+                // Release inside this step: Illinois on the held force over
+                // its fraction, bracket [0 (into the stop), 1 (away)].
+                let (lo_f, at) = self.release(&start, end, f1, held, &away)?;
+                return self.free_part(&at, T::ONE - (t0 + part * lo_f), carry);
+            }
+            start = end;
+            t0 += part;
+        }
+        Ok((start, false))
+    }
+
+    /// Locates the release inside a held step of `held_part` from `start`
+    /// whose end `end` pulls away with force `f1`: the first bracketed
+    /// fraction of the step at which the force pulls away, and the state
+    /// there.
+    fn release(
+        &self,
+        start: &[T; 4],
+        end: [T; 4],
+        f1: T,
+        held: Contact,
+        away: &impl Fn(&[T; 4]) -> T,
+    ) -> Result<(T, [T; 4]), StepError> {
+        let (mut lo, mut f_lo) = (T::ZERO, away(start));
+        let (mut hi, mut f_hi) = (T::ONE, f1);
+        let mut at_hi = end;
+        let mut side = 0i8;
+        for _ in 0..RELEASE_ITERATIONS {
+            let span = f_hi - f_lo;
+            let mut t = if span > T::ZERO {
+                lo - f_lo * (hi - lo) / span
+            } else {
+                (lo + hi) * T::HALF
             };
-            let mut next = self.stepper.step(&held, &self.state)?;
-            // The stop's reaction cancels the motion exactly.
-            next[0] = self.state[0];
-            next[1] = T::ZERO;
-            if c.contact(&next) == contact {
-                return Ok((next, false));
+            if !(t > lo && t < hi) {
+                t = (lo + hi) * T::HALF;
+            }
+            let mut no_carry = T::ZERO;
+            let s = self.step(start, t * self.held_part, held, &mut no_carry)?;
+            let f = away(&s);
+            if f > T::ZERO {
+                (hi, f_hi, at_hi) = (t, f, s);
+                if side == -1 {
+                    f_lo = f_lo * T::HALF;
+                }
+                side = -1;
+            } else {
+                (lo, f_lo) = (t, f);
+                if side == 1 {
+                    f_hi = f_hi * T::HALF;
+                }
+                side = 1;
             }
         }
-        let free = Fsi {
-            coefficients: c,
-            contact: Contact::Free,
-        };
-        let mut next = self.stepper.step(&free, &self.state)?;
-        let [xi, w, ..] = &mut next;
-        let leaving = match held_at_start {
-            Contact::Closed => *xi < T::ZERO && *w > T::ZERO,
-            Contact::Open => *xi > T::ONE && *w < T::ZERO,
-            Contact::Free => false,
-        };
-        if leaving {
-            *xi = xi.clamp_to(T::ZERO, T::ONE);
-            return Ok((next, false));
+        Ok((hi, at_hi))
+    }
+
+    /// Free motion over `frac` of a substep from `y`; an impact on a stop
+    /// inside it ends the motion there and holds the plunger for the rest.
+    fn free_part(&self, y: &[T; 4], frac: T, carry: &mut T) -> Result<([T; 4], bool), StepError> {
+        if !(frac > T::ZERO) {
+            return Ok((*y, false));
         }
-        let hit = apply_stops(xi, w);
-        Ok((next, hit))
+        let mut tried = *carry;
+        let next = self.step(y, frac, Contact::Free, &mut tried)?;
+        let (x0, x1) = (y[0], next[0]);
+        let (stop, contact) = if x1 < T::ZERO {
+            (T::ZERO, Contact::Closed)
+        } else if x1 > T::ONE {
+            (T::ONE, Contact::Open)
+        } else {
+            *carry = tried;
+            return Ok((next, false));
+        };
+        // Impact time on the cubic Hermite interpolant of xi over the step
+        // (theta in [0, 1]), first crossing of the stop: Illinois.
+        let hx = self.h_a_x * frac;
+        let (d0, d1) = (hx * y[1], hx * next[1]);
+        let p = |t: T| {
+            // Hermite basis on [0, 1].
+            let t2 = t * t;
+            let t3 = t2 * t;
+            let h00 = T::TWO * t3 - (t2 + t2 + t2) + T::ONE;
+            let h10 = t3 - T::TWO * t2 + t;
+            let h01 = (t2 + t2 + t2) - T::TWO * t3;
+            let h11 = t3 - t2;
+            h00 * x0 + h10 * d0 + h01 * x1 + h11 * d1 - stop
+        };
+        let sign = if contact == Contact::Closed { -T::ONE } else { T::ONE };
+        // Positive: beyond the stop.
+        let (mut lo, mut f_lo) = (T::ZERO, sign * (x0 - stop));
+        let (mut hi, mut f_hi) = (T::ONE, sign * (x1 - stop));
+        let mut side = 0i8;
+        for _ in 0..IMPACT_ITERATIONS {
+            let span = f_hi - f_lo;
+            let mut t = if span > T::ZERO {
+                lo - f_lo * (hi - lo) / span
+            } else {
+                (lo + hi) * T::HALF
+            };
+            if !(t > lo && t < hi) {
+                t = (lo + hi) * T::HALF;
+            }
+            let f = sign * p(t);
+            if f > T::ZERO {
+                (hi, f_hi) = (t, f);
+                if side == -1 {
+                    f_lo = f_lo * T::HALF;
+                }
+                side = -1;
+            } else {
+                (lo, f_lo) = (t, f);
+                if side == 1 {
+                    f_hi = f_hi * T::HALF;
+                }
+                side = 1;
+            }
+        }
+        let theta = lo;
+        let mut at = if theta > T::ZERO {
+            self.step(y, frac * theta, Contact::Free, carry)?
+        } else {
+            *y
+        };
+        // Inelastic impact: on the stop, at rest.
+        at[0] = stop;
+        at[1] = T::ZERO;
+        *carry = T::ZERO;
+        let rest = frac * (T::ONE - theta);
+        let end = if rest > T::ZERO {
+            self.step(&at, rest, contact, carry)?
+        } else {
+            at
+        };
+        Ok((end, true))
     }
 
     /// The state in SI units.
