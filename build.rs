@@ -127,7 +127,10 @@ fn main() {
 }
 
 /// Temperature pieces of the replay: (start [s], end [s], from [C], to [C]).
-const PIECES: [(f64, f64, f64, f64); 7] = [
+/// A piece with `from == to` is a hold, checked at its end against the
+/// reference; one that starts more than `spike_threshold` away from the
+/// level before it is a real step the spike filter must accept.
+const PIECES: [(f64, f64, f64, f64); 10] = [
     (0.0, 3.0, 26.0, 26.0),   // cold start: window closed
     (3.0, 55.0, 26.0, 78.0),  // warm-up ramp, 1 C/s
     (55.0, 58.0, 78.0, 78.0), // hot hold
@@ -135,6 +138,11 @@ const PIECES: [(f64, f64, f64, f64); 7] = [
     (62.0, 66.0, 60.0, 60.0), // step up
     (66.0, 68.0, 90.0, 90.0), // outside the validated range
     (68.0, 74.0, 50.0, 50.0), // back, through a sensor outage
+    // The cold excursion: hot oil, then cold (outside the validated range,
+    // window closed), then warming back onto the closed stop.
+    (74.0, 76.0, 80.0, 80.0),
+    (76.0, 79.0, 10.0, 10.0),
+    (79.0, 82.0, 30.0, 30.0),
 ];
 
 /// Injected sensor faults: (start [s], end [s], `Injected` variant of the
@@ -325,23 +333,48 @@ fn replay_rs(core: &compensator_params::RawCore, est: &compensator_params::RawEs
         replay.out_of_range.is_some()
     );
     s += "/// Checkpoints from the f64 reference, over the sensor's quantization\n";
-    s += "/// (half a code either side): (time s, temperature C, half code C,\n";
-    s += "/// x min/max m, p_a min/max Pa, p_b min/max Pa).\n";
+    s += "/// (half a code either side), at the end of every hold: (time s,\n";
+    s += "/// temperature C, half code C, x min/max m, p_a min/max Pa, p_b min/max\n";
+    s += "/// Pa, whether OUT_OF_RANGE is due: None when the quantization\n";
+    s += "/// interval straddles a bound of the validated range).\n";
     let (valid_lo, valid_hi) = (est.valid_min, est.valid_max);
     let holds: Vec<(f64, f64)> = replay
         .pieces
         .iter()
-        .filter(|p| p.2 == p.3 && (valid_lo..=valid_hi).contains(&p.3))
+        .filter(|p| p.2 == p.3)
         .map(|p| (p.1 - 0.001, p.3))
         .collect();
-    s += &format!("const CHECKPOINTS: [(f32, f32, f32, [f32; 6]); {}] = [\n", holds.len());
+    s += &format!(
+        "const CHECKPOINTS: [(f32, f32, f32, [f32; 6], Option<bool>); {}] = [\n",
+        holds.len()
+    );
     for (t, temp) in holds {
         let half = half_code(est, temp);
         let lo = compensator_reference::statics::equilibrium(core, temp - half);
         let hi = compensator_reference::statics::equilibrium(core, temp + half);
         // x and p_b rise with temperature, p_a falls.
         let bounds = [lo.x, hi.x, hi.p_a, lo.p_a, lo.p_b, hi.p_b].map(|v| v as f32);
-        s += &format!("    ({t:?}, {temp:?}, {:?}, {bounds:?}),\n", half as f32);
+        let outside = if temp + half < valid_lo || temp - half > valid_hi {
+            Some(true)
+        } else if temp - half >= valid_lo && temp + half <= valid_hi {
+            Some(false)
+        } else {
+            None
+        };
+        s += &format!("    ({t:?}, {temp:?}, {:?}, {bounds:?}, {outside:?}),\n", half as f32);
+    }
+    s += "];\n";
+    s += "/// Real steps (beyond the spike threshold from the level before):\n";
+    s += "/// (start s, level C, half code C).\n";
+    let steps: Vec<(f64, f64)> = replay
+        .pieces
+        .windows(2)
+        .filter(|w| w[1].2 == w[1].3 && (w[1].2 - w[0].3).abs() > est.spike_threshold)
+        .map(|w| (w[1].0, w[1].2))
+        .collect();
+    s += &format!("const REAL_STEPS: [(f32, f32, f32); {}] = [\n", steps.len());
+    for (t, level) in steps {
+        s += &format!("    ({t:?}, {level:?}, {:?}),\n", half_code(est, level) as f32);
     }
     s += "];\n";
     s

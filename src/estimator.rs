@@ -23,13 +23,24 @@
 //! 4. the twin advances one tick;
 //! 5. flows and the compensation error follow from the twin's state.
 //!
+//! A consistency check catches a twin that settled where the physics does
+//! not: once the filtered temperature has stayed within [`STEADY_BAND`] for
+//! [`SETTLE_TIME_CONSTANTS`] of the twin's slowest time constants (the
+//! decay rate of the slowest mode of the linearisation, found by the
+//! Stability job), every Equilibrium job compares the twin's state with the
+//! closed-form equilibrium it just computed (clamped to the stops). A twin
+//! further than [`X_TOLERANCE`] of the stroke or [`P_TOLERANCE`] of `dp`
+//! away is re-seated on the equilibrium, counted
+//! ([`StateEstimate::reseats`]) and flagged [`Flags::TWIN_RESEATED`]. The
+//! thresholds and their reasons are in the project's `docs/firmware.md`.
+//!
 //! The cost of a tick is bounded by the twin's step, the fluid properties
 //! and the larger of one job or the telemetry packing: what the firmware's
 //! budget measures. Nothing here allocates or panics; every failure becomes
 //! a flag.
 
 use crate::dynamics::fsi::{Contact, Fsi};
-use crate::dynamics::linear::hurwitz_stable;
+use crate::dynamics::linear::characteristic_polynomial;
 use crate::dynamics::schemes::OdeSystem;
 use crate::dynamics::{Twin, TwinConfig};
 use crate::equilibrium::{a_parameter, equilibrium_for};
@@ -39,6 +50,37 @@ use crate::params::{ParamError, Params, RawEstimator};
 use crate::scalar::Real;
 use crate::sensor::SensorFault;
 use crate::{asymptotic, compensation};
+
+/// Band [C] the filtered temperature must stay within to count as steady
+/// for the consistency check. Over the band the closed form moves by
+/// `|dx/dt| * 0.05 K`: 0.12 % of the stroke on the paper preset (37 um/K,
+/// 1.5 mm), below 1 % on designs whose free displacement changes by up to
+/// 2.5 strokes over 30-80 C; the pressures by at most 0.05 % of `dp`. It is
+/// wider than the filter's response to one code of the MAX31865 (0.034 C),
+/// so sensor noise does not keep the temperature unsteady.
+pub const STEADY_BAND: f32 = 0.05;
+
+/// Time constants of the twin's slowest mode the temperature must have been
+/// steady before the twin is compared with the closed form. A linear mode
+/// decays by `exp(-10) = 4.5e-5` over them: a full-stroke or full-`dp`
+/// transient ends 200 times inside the tolerances, leaving room for the
+/// nonlinear orifice law and the travel onto a stop.
+pub const SETTLE_TIME_CONSTANTS: f32 = 10.0;
+
+/// Fewest steady ticks before the check (three rounds of the four jobs, so
+/// that the twin's fluid properties and the equilibrium it is compared with
+/// belong to the steady temperature).
+pub const MIN_SETTLE_TICKS: u32 = 16;
+
+/// Agreement required of a settled twin: displacement, as a fraction of the
+/// stroke. Ten times the twin's accuracy goal at steady state (1e-3), so a
+/// correct twin never trips it; a false equilibrium sits tens of percent
+/// away (the paper preset's 40 -> 0 C step: 54 % of `dp`).
+pub const X_TOLERANCE: f32 = 1e-2;
+
+/// Agreement required of a settled twin: each chamber pressure, as a
+/// fraction of `dp` (as [`X_TOLERANCE`]).
+pub const P_TOLERANCE: f32 = 1e-2;
 
 /// Estimator settings in `f32` (from the `[estimator]` section).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -124,9 +166,15 @@ impl Flags {
     /// The estimate is not trustworthy: no usable sample for a while, the
     /// oil model refused the temperature, or the twin had to be reset.
     pub const DEGRADED: Flags = Flags(1 << 6);
+    /// The twin disagreed with the closed-form equilibrium although the
+    /// temperature had been steady for several of its slowest time
+    /// constants (a false equilibrium, or a state corrupted otherwise): it
+    /// was re-seated on the equilibrium. Raised from the re-seat until a
+    /// later check (one settling window on) finds the twin in agreement.
+    pub const TWIN_RESEATED: Flags = Flags(1 << 7);
 
     /// Names of the flags, in bit order.
-    pub const NAMES: [&'static str; 7] = [
+    pub const NAMES: [&'static str; 8] = [
         "AT_STOP",
         "OUT_OF_RANGE",
         "NOT_UNIQUE",
@@ -134,6 +182,7 @@ impl Flags {
         "SENSOR_FAULT",
         "SPIKE",
         "DEGRADED",
+        "TWIN_RESEATED",
     ];
 
     /// No flag set.
@@ -171,6 +220,7 @@ impl defmt::Format for Flags {
             defmt::intern!("SENSOR_FAULT"),
             defmt::intern!("SPIKE"),
             defmt::intern!("DEGRADED"),
+            defmt::intern!("TWIN_RESEATED"),
         ];
         let mut first = true;
         for (i, name) in names.iter().enumerate() {
@@ -215,6 +265,10 @@ pub struct StateEstimate {
     pub x_equilibrium: f32,
     /// `dx/dt` of the equilibrium branch (Eq. 31) [m/K].
     pub dx_dt: f32,
+    /// Times the consistency check has re-seated the twin on the
+    /// closed-form equilibrium since start (saturating; 0 for a twin that
+    /// never settled at a false state).
+    pub reseats: u32,
     /// Conditions.
     pub flags: Flags,
 }
@@ -250,7 +304,7 @@ impl defmt::Format for StateEstimate {
     fn format(&self, f: defmt::Formatter) {
         defmt::write!(
             f,
-            "t={=f32} C x={=f32} um v={=f32} mm/s p_a={=f32} p_b={=f32} kPa Q_a={=f32} Q_b={=f32} Q_throt={=f32} Q0={=f32} err={=f32} l/min [{}]",
+            "t={=f32} C x={=f32} um v={=f32} mm/s p_a={=f32} p_b={=f32} kPa Q_a={=f32} Q_b={=f32} Q_throt={=f32} Q0={=f32} err={=f32} l/min reseats={=u32} [{}]",
             self.temperature,
             self.x * 1e6,
             self.v * 1e3,
@@ -261,6 +315,7 @@ impl defmt::Format for StateEstimate {
             self.q_throt * 6e4,
             self.q_total * 6e4,
             self.compensation_error * 6e4,
+            self.reseats,
             self.flags
         )
     }
@@ -294,6 +349,18 @@ pub struct Estimator {
     /// The job of the next tick that is not a telemetry tick.
     next_job: Job,
     last: Option<StateEstimate>,
+    /// Filtered temperature at the start of the current steady stretch [C].
+    steady_anchor: f32,
+    /// Ticks that ran a job while the filtered temperature stayed within
+    /// [`STEADY_BAND`] of `steady_anchor` (or since the last re-seat).
+    steady_ticks: u32,
+    /// Re-seats of the twin so far (saturating).
+    reseats: u32,
+    /// Consistency checks run so far (saturating).
+    checks: u32,
+    /// The last check re-seated the twin (raises `TWIN_RESEATED` until a
+    /// check finds it in agreement).
+    reseated: bool,
 }
 
 /// Results that depend on the temperature only. Each tick that is not a
@@ -313,9 +380,22 @@ struct Statics {
     window_factor: f32,
     x_equilibrium: f32,
     dx_dt: f32,
-    /// The equilibrium in the twin's model units (for the linearisation).
+    /// The equilibrium in the twin's model units `(x / L, v / V,
+    /// (p_a - p_c) / dp, (p_b - p_c) / dp)` (for the linearisation and the
+    /// consistency check).
     y_equilibrium: [f32; 4],
     stable: bool,
+    /// `SETTLE_TIME_CONSTANTS / tick` [1/s] (constant).
+    settle_per_second: f32,
+    /// Lower bound of the slowest decay rate of the linearisation, in the
+    /// twin's time unit (0: none, not stable); the next search's hint.
+    slowest_rate: f32,
+    /// Time constant of the slowest mode of the linearisation [s].
+    slowest_time_constant: f32,
+    /// Steady ticks before the consistency check: [`SETTLE_TIME_CONSTANTS`]
+    /// of the slowest time constant, at least [`MIN_SETTLE_TICKS`];
+    /// `u32::MAX` (never) while the linearisation is not stable.
+    settle_ticks: u32,
     /// Machine losses at the last refreshed temperature [m^3/s].
     losses: f32,
 }
@@ -328,9 +408,11 @@ enum Job {
     /// non-telemetry ticks (4 ms at the defaults), five times the
     /// MAX31865's 50 Hz.
     Fluid,
-    /// Closed-form equilibrium and `dx/dt` (Eqs. 5, 31).
+    /// Closed-form equilibrium and `dx/dt` (Eqs. 5, 31), then the twin's
+    /// consistency check against it once the temperature is steady.
     Equilibrium,
-    /// Routh-Hurwitz stability of the linearisation at the equilibrium.
+    /// Routh-Hurwitz stability of the linearisation at the equilibrium, and
+    /// the decay rate of its slowest mode (the settling window).
     Stability,
     /// The machine's losses (compensation error).
     Losses,
@@ -378,6 +460,10 @@ impl Estimator {
             dx_dt: f32::NAN,
             y_equilibrium: [0.0; 4],
             stable: true,
+            settle_per_second: SETTLE_TIME_CONSTANTS / config.tick(),
+            slowest_rate: 0.0,
+            slowest_time_constant: f32::INFINITY,
+            settle_ticks: u32::MAX,
             losses: f32::NAN,
         };
         let mut twin = twin;
@@ -400,7 +486,32 @@ impl Estimator {
             statics,
             next_job: Job::Fluid,
             last: None,
+            steady_anchor: initial,
+            steady_ticks: 0,
+            reseats: 0,
+            checks: 0,
+            reseated: false,
         })
+    }
+
+    /// The time constant of the twin's slowest mode at the last Stability
+    /// job [s]: `1 / sigma`, with `sigma` a lower bound (within 25 %) of the
+    /// smallest decay rate `-Re(lambda)` of the linearisation at the
+    /// equilibrium. Infinite while the linearisation is not stable.
+    pub fn slowest_time_constant(&self) -> f32 {
+        self.statics.slowest_time_constant
+    }
+
+    /// Consistency checks run since start (saturating): each compared the
+    /// settled twin with the closed form, and re-seated it or not.
+    pub fn consistency_checks(&self) -> u32 {
+        self.checks
+    }
+
+    /// Steady ticks the consistency check waits for at the last Stability
+    /// job (`u32::MAX`: it does not run, the linearisation is not stable).
+    pub fn settle_ticks(&self) -> u32 {
+        self.statics.settle_ticks
     }
 
     /// The settings.
@@ -411,6 +522,12 @@ impl Estimator {
     /// The twin.
     pub fn twin(&self) -> &Twin<f32, f32> {
         &self.twin
+    }
+
+    /// The twin, mutable: to inject a fault (a wrong state, with
+    /// [`Twin::set_state`]) and watch the consistency check undo it.
+    pub fn twin_mut(&mut self) -> &mut Twin<f32, f32> {
+        &mut self.twin
     }
 
     /// One tick with this tick's sample (see the module docs).
@@ -477,10 +594,12 @@ impl Estimator {
                     compensation_error: f32::NAN,
                     x_equilibrium: f32::NAN,
                     dx_dt: f32::NAN,
+                    reseats: self.reseats,
                     flags,
                 });
                 e.tick = self.tick;
                 e.temperature = t;
+                e.reseats = self.reseats;
                 e.flags = flags;
                 e
             }
@@ -519,7 +638,27 @@ impl Estimator {
                     coefficients: twin.coefficients(),
                     contact: Contact::Free,
                 };
-                statics.stable = hurwitz_stable(&sys.jacobian(&statics.y_equilibrium));
+                let poly = characteristic_polynomial(&sys.jacobian(&statics.y_equilibrium));
+                statics.stable = quartic_hurwitz(&poly);
+                let sigma = if statics.stable {
+                    slowest_decay_rate(&poly, statics.slowest_rate)
+                } else {
+                    0.0
+                };
+                statics.slowest_rate = sigma;
+                if sigma > 0.0 {
+                    statics.slowest_time_constant = twin.model().scales.time / sigma;
+                    let ticks = statics.slowest_time_constant * statics.settle_per_second;
+                    // Saturating conversion; NaN is impossible here (sigma > 0).
+                    statics.settle_ticks = if ticks < u32::MAX as f32 {
+                        (ticks as u32).saturating_add(1).max(MIN_SETTLE_TICKS)
+                    } else {
+                        u32::MAX
+                    };
+                } else {
+                    statics.slowest_time_constant = f32::INFINITY;
+                    statics.settle_ticks = u32::MAX;
+                }
             }
             Job::Losses => {
                 statics.losses = match (&p.machine, machine_mu_ref) {
@@ -535,6 +674,16 @@ impl Estimator {
 
     fn update(&mut self, t: f32, flags: &mut Flags) -> Result<StateEstimate, ModelError> {
         if !self.telemetry_due() {
+            // The steady stretch, counted in ticks that run a job (a
+            // telemetry tick only publishes): the window in time is at
+            // least as long, and the telemetry tick, the costliest, is
+            // spared. A drift out of the band shows at the next job tick.
+            if libm::fabsf(t - self.steady_anchor) <= STEADY_BAND {
+                self.steady_ticks = self.steady_ticks.saturating_add(1);
+            } else {
+                self.steady_anchor = t;
+                self.steady_ticks = 0;
+            }
             let job = self.next_job;
             self.next_job = job.next();
             // A temperature the model refuses leaves the job's previous
@@ -548,12 +697,20 @@ impl Estimator {
                 t,
                 &mut self.statics,
             ) {
-                Ok(()) => self.failed_jobs &= !job.bit(),
+                Ok(()) => {
+                    self.failed_jobs &= !job.bit();
+                    if job == Job::Equilibrium {
+                        self.check_twin();
+                    }
+                }
                 Err(_) => self.failed_jobs |= job.bit(),
             }
         }
         if self.failed_jobs != 0 {
             flags.insert(Flags::DEGRADED);
+        }
+        if self.reseated {
+            flags.insert(Flags::TWIN_RESEATED);
         }
         let p = &self.params;
         if self.twin.tick().is_err() {
@@ -594,8 +751,41 @@ impl Estimator {
             compensation_error,
             x_equilibrium: st.x_equilibrium,
             dx_dt: st.dx_dt,
+            reseats: self.reseats,
             flags: *flags,
         })
+    }
+
+    /// The consistency check, right after a successful Equilibrium job:
+    /// once the temperature has been steady for the settling window, the
+    /// twin must sit within [`X_TOLERANCE`] of the stroke and
+    /// [`P_TOLERANCE`] of `dp` of the closed-form equilibrium (clamped to
+    /// the stops, in the twin's model units, where both are fractions
+    /// already). Otherwise it is put there at rest, counted, flagged, and
+    /// given a new window before the next check. Skipped while any job's
+    /// results are stale (the equilibrium may not be the twin's) or the
+    /// linearisation is unstable (no attracting equilibrium to agree with).
+    fn check_twin(&mut self) {
+        let st = &self.statics;
+        if self.failed_jobs != 0 || !st.stable || self.steady_ticks < st.settle_ticks {
+            return;
+        }
+        self.checks = self.checks.saturating_add(1);
+        let [xi, _, pi_a, pi_b] = self.twin.raw_state();
+        let [xi_eq, _, pi_a_eq, pi_b_eq] = st.y_equilibrium;
+        // Written so that a NaN state fails the check too.
+        let agrees = libm::fabsf(xi - xi_eq) <= X_TOLERANCE
+            && libm::fabsf(pi_a - pi_a_eq) <= P_TOLERANCE
+            && libm::fabsf(pi_b - pi_b_eq) <= P_TOLERANCE;
+        if agrees {
+            self.reseated = false;
+        } else {
+            let at_rest = self.twin.model().scales.to_si(&st.y_equilibrium);
+            self.twin.set_state(&at_rest);
+            self.reseats = self.reseats.saturating_add(1);
+            self.reseated = true;
+            self.steady_ticks = 0;
+        }
     }
 
     /// Takes `t` [C] as the filter's input.
@@ -609,4 +799,83 @@ impl Estimator {
     pub fn telemetry_due(&self) -> bool {
         self.config.telemetry_every > 0 && self.tick.is_multiple_of(self.config.telemetry_every)
     }
+}
+
+/// The Routh-Hurwitz conditions of `s^4 + a3 s^3 + a2 s^2 + a1 s + a0`
+/// (coefficients `[a3, a2, a1, a0]`, as [`characteristic_polynomial`]
+/// returns them): `true` when every root has a negative real part. The
+/// same verdict as `dynamics::linear::hurwitz_stable`, from coefficients
+/// already at hand.
+pub fn quartic_hurwitz(a: &[f32; 4]) -> bool {
+    let [a3, a2, a1, a0] = *a;
+    a3 > 0.0 && a2 > 0.0 && a1 > 0.0 && a0 > 0.0 && a3 * a2 > a1 && a3 * a2 * a1 > a1 * a1 + a3 * a3 * a0
+}
+
+/// Coefficients of `p(s - sigma)` for the monic quartic `p` with
+/// coefficients `[a3, a2, a1, a0]`: the characteristic polynomial of
+/// `M + sigma I` when `p` is `M`'s. Taylor shift by four passes of
+/// synthetic division at `-sigma` (ten multiply-adds).
+fn shifted(a: &[f32; 4], sigma: f32) -> [f32; 4] {
+    let r = -sigma;
+    let [mut c3, mut c2, mut c1, mut c0] = *a;
+    c3 += r;
+    c2 += r * c3;
+    c1 += r * c2;
+    c0 += r * c1;
+    c3 += r;
+    c2 += r * c3;
+    c1 += r * c2;
+    c3 += r;
+    c2 += r * c3;
+    c3 += r;
+    [c3, c2, c1, c0]
+}
+
+/// A lower bound, within 25 %, of the smallest decay rate
+/// `min(-Re(lambda))` over the roots of the monic quartic `[a3, a2, a1, a0]`
+/// (in the polynomial's time unit), or 0 when the polynomial is not Hurwitz
+/// or the rate is below `a3 / 4 * 2^-32`.
+///
+/// `M + sigma I` is Hurwitz exactly when `sigma` is below that rate, and the
+/// rate is at most the mean `a3 / 4`: a binary search over `sigma =
+/// a3 / 4 * 2^-k` (`k` = 0..32, five Routh-Hurwitz tests) brackets it
+/// within a factor two, two bisections within 25 %; the stable end is
+/// returned. Eight tests of ~30 flops: no eigenvalue iteration, bounded
+/// cost, and exact for complex modes too (underdamped designs).
+///
+/// `hint` (a previous result, or 0) is tried first: when `hint` is still
+/// below the rate and `1.25 hint` is not, `hint` is the answer (two tests,
+/// the usual case at a steady temperature); otherwise the search runs.
+pub fn slowest_decay_rate(a: &[f32; 4], hint: f32) -> f32 {
+    let stable = |sigma: f32| quartic_hurwitz(&shifted(a, sigma));
+    if hint > 0.0 && stable(hint) && !stable(1.25 * hint) {
+        return hint;
+    }
+    let top = 0.25 * a[0];
+    // 2^-k, exactly, for k in 0..=32.
+    let scaled = |k: u32| top * f32::from_bits((127 - k) << 23);
+    if !(top > 0.0) || !stable(scaled(32)) {
+        return 0.0;
+    }
+    // Invariant: sigma(lo) is not below the rate (or lo = 0, the mean),
+    // sigma(hi) is.
+    let (mut lo, mut hi) = (0u32, 32u32);
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        if stable(scaled(mid)) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    let (mut below, mut above) = (scaled(hi), scaled(lo));
+    for _ in 0..2 {
+        let mid = 0.5 * (below + above);
+        if stable(mid) {
+            below = mid;
+        } else {
+            above = mid;
+        }
+    }
+    below
 }

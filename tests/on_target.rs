@@ -33,6 +33,7 @@ fn close(actual: f32, expected: f64, rtol: f64, atol: f64) -> bool {
 #[defmt_test::tests]
 mod tests {
     use super::{EXPECTED, RAW_PARAMS, close};
+    use compensator::dynamics::fsi::DynamicState;
     use compensator::dynamics::linear::{hurwitz_stable, linearise};
     use compensator::dynamics::{Twin, TwinConfig};
     use compensator::equilibrium::equilibrium;
@@ -124,6 +125,48 @@ mod tests {
             let model = compensator::dynamics::Model::new(p).unwrap();
             let jac = compensator::dynamics::linear::jacobian_at_equilibrium(&model, t).unwrap();
             assert!(hurwitz_stable(&jac) == l.stable);
+        }
+    }
+
+    #[test]
+    fn a_forced_wrong_state_is_reseated_on_the_reference(p: &mut Params<f32>) {
+        // Steady at each expectation's temperature for the settling window,
+        // then the twin forced to the far stop with its pressures swapped:
+        // the next round of jobs puts it back on the host's equilibrium.
+        let (stroke, dp) = (p.plunger.stroke as f64, p.pressure_drop as f64);
+        let config = EstimatorConfig::new(&RAW_PARAMS.estimator).unwrap();
+        for &(t, _, _, pa, pb, x, _) in EXPECTED.iter().filter(|e| e.0 == 30.0 || e.0 == 60.0) {
+            let mut est = Estimator::new(p, config, t).unwrap();
+            let window = est.settle_ticks();
+            assert!(window < 20_000, "settling window {=u32} ticks at {=f32}", window, t);
+            for k in 0..window + 100 {
+                est.tick(if k % 20 == 0 { Ok(Some(t)) } else { Ok(None) });
+            }
+            let far = if x > 0.5 * stroke { 0.0 } else { p.plunger.stroke };
+            est.twin_mut().set_state(&DynamicState {
+                x: far,
+                v: 0.0,
+                p_a: pb as f32,
+                p_b: pa as f32,
+            });
+            let mut e = est.tick(Ok(None));
+            for _ in 0..4 {
+                if e.reseats > 0 {
+                    break;
+                }
+                e = est.tick(Ok(None));
+            }
+            assert!(e.reseats == 1, "not re-seated at {=f32}", t);
+            assert!(e.flags.contains(Flags::TWIN_RESEATED));
+            assert!(
+                close(e.x, x, 0.0, 1e-3 * stroke),
+                "x at {=f32}: {=f32} vs {=f64}",
+                t,
+                e.x,
+                x
+            );
+            assert!(close(e.p_a, pa, 0.0, 1e-3 * dp), "p_a at {=f32}", t);
+            assert!(close(e.p_b, pb, 0.0, 1e-3 * dp), "p_b at {=f32}", t);
         }
     }
 

@@ -86,7 +86,7 @@ fn twin_cost<T: Real>(params: &Params<f32>, scheme: Scheme, substeps: u8, scalar
 #[cfg(target_abi = "eabihf")]
 fn pieces(params: &Params<f32>) -> Result<(), &'static str> {
     use compensator::asymptotic::sensitivity_at;
-    use compensator::dynamics::fsi::{Contact, Fsi, Model};
+    use compensator::dynamics::fsi::{Contact, DynamicState, Fsi, Model};
     use compensator::dynamics::linear::hurwitz_stable;
     use compensator::dynamics::schemes::OdeSystem;
     use compensator::equilibrium::{a_parameter, equilibrium_for};
@@ -139,6 +139,39 @@ fn pieces(params: &Params<f32>) -> Result<(), &'static str> {
     let e = est.tick(Ok(Some(40.0)));
     let (_, c) = counts(|| info!("estimate {}", black_box(e)));
     info!("[measure] piece name=telemetry total={=u32}", c);
+
+    // The tick that re-seats the twin (consistency check): an estimator
+    // steady at 55 C for its settling window, its twin forced off the
+    // equilibrium; the next round of jobs re-seats it. Its worst tick is
+    // that one (the Equilibrium job, the check and the re-seat).
+    let mut est = Estimator::new(params, config, 55.0).map_err(|_| "estimator cannot start")?;
+    let settle = est.settle_ticks();
+    if settle > 100_000 {
+        return Err("no settling window at 55 C: the consistency check cannot run");
+    }
+    for k in 0..settle + 100 {
+        est.tick(if k % 20 == 0 { Ok(Some(55.0)) } else { Ok(None) });
+    }
+    let s = est.twin().state();
+    est.twin_mut().set_state(&DynamicState {
+        x: if s.x > 0.5 * params.plunger.stroke {
+            0.0
+        } else {
+            params.plunger.stroke
+        },
+        v: 0.0,
+        p_a: s.p_b,
+        p_b: s.p_a,
+    });
+    let mut worst = 0u32;
+    for _ in 0..5 {
+        let (_, c) = counts(|| black_box(est.tick(black_box(Ok(None)))));
+        worst = worst.max(c);
+    }
+    if est.tick(Ok(None)).reseats != 1 {
+        return Err("the forced wrong state was not re-seated");
+    }
+    info!("[measure] piece name=estimator-reseat-tick total={=u32}", worst);
 
     // The whole estimator tick, as the firmware runs it: a sample every
     // 20 ticks, a 30 -> 40 C step; with telemetry packed at its cadence

@@ -4,13 +4,17 @@
 //!    temperature, `A`, chamber pressures, displacement and flows, with the
 //!    balance temperature, the Eq. (32) verdict and the linearisation.
 //! 2. Replays a temperature profile (holds, a 1 C/s ramp, steps, a trip
-//!    outside the validated range) through a simulated MAX31865 read by the
-//!    real driver, with injected sensor faults, and runs the estimator every
-//!    1 ms tick, printing its telemetry.
+//!    outside the validated range, a cold excursion 80 -> 10 -> 30 C)
+//!    through a simulated MAX31865 read by the real driver, with injected
+//!    sensor faults, and runs the estimator every 1 ms tick, printing its
+//!    telemetry.
 //! 3. Checks itself against bounds computed on the host at build time (the
-//!    f64 reference's equilibrium at the end of every hold; the flags each
-//!    injected fault must raise; no NaN), reports the peak stack measured
-//!    by stack painting, and exits 0 (all checks pass) or 1.
+//!    f64 reference's equilibrium at the end of every hold, inside the
+//!    validated range or not, and OUT_OF_RANGE exactly outside it; each
+//!    real step accepted after `spike_limit` rejected samples; the flags
+//!    each injected fault must raise; no NaN; no re-seat of the twin),
+//!    reports the peak stack measured by stack painting, and exits 0 (all
+//!    checks pass) or 1.
 #![no_std]
 #![no_main]
 
@@ -200,6 +204,14 @@ fn replay(params: &Params<f32>, config: EstimatorConfig) -> bool {
     let mut next_checkpoint = 0;
     let mut out_of_range_seen = false;
     let mut nan_ticks = 0u32;
+    // Real steps: the spike filter rejects `spike_limit` samples, then
+    // accepts the next; checked once the last of them is due (one sample
+    // period of phase on top).
+    let sample_period = sensor_every as f32 * tick;
+    let step_due = (config.spike_limit + 2) as f32 * sample_period;
+    let mut next_step = 0;
+    let mut step_spikes = 0u32;
+    let mut reseats = 0u32;
     info!(
         "replaying {=f32} s: ticks of {=f32} ms, sensor every {=u32} ticks, telemetry every {=u32} ticks",
         end,
@@ -237,8 +249,27 @@ fn replay(params: &Params<f32>, config: EstimatorConfig) -> bool {
         if !e.is_finite() {
             nan_ticks += 1;
         }
+        reseats = e.reseats;
+        if next_step < REAL_STEPS.len() && time >= REAL_STEPS[next_step].0 {
+            let (start, level, half) = REAL_STEPS[next_step];
+            step_spikes += u32::from(e.flags.contains(Flags::SPIKE));
+            if time >= start + step_due {
+                let at_level = (e.temperature - level).abs() <= half + 1e-3;
+                info!(
+                    "real step to {=f32} C at {=f32} s: {=u32} samples rejected as spikes, then the filter at {=f32} C",
+                    level, start, step_spikes, e.temperature
+                );
+                checks.check(
+                    at_level && step_spikes == config.spike_limit,
+                    "a real step accepted after spike_limit rejected samples",
+                    start,
+                );
+                next_step += 1;
+                step_spikes = 0;
+            }
+        }
         if next_checkpoint < CHECKPOINTS.len() && time >= CHECKPOINTS[next_checkpoint].0 {
-            let (_, temp, half, [x_lo, x_hi, pa_lo, pa_hi, pb_lo, pb_hi]) = CHECKPOINTS[next_checkpoint];
+            let (_, temp, half, [x_lo, x_hi, pa_lo, pa_hi, pb_lo, pb_hi], outside) = CHECKPOINTS[next_checkpoint];
             let (dx, dp) = (X_TOLERANCE * params.plunger.stroke, P_TOLERANCE * params.pressure_drop);
             let within = |v: f32, lo: f32, hi: f32, tol: f32| v >= lo - tol && v <= hi + tol;
             let ok = within(e.temperature, temp - half, temp + half, 1e-3)
@@ -262,6 +293,13 @@ fn replay(params: &Params<f32>, config: EstimatorConfig) -> bool {
             if x_hi == 0.0 {
                 checks.check(e.flags.contains(Flags::AT_STOP), "AT_STOP on the closed stop", time);
             }
+            if let Some(outside) = outside {
+                checks.check(
+                    e.flags.contains(Flags::OUT_OF_RANGE) == outside,
+                    "OUT_OF_RANGE exactly outside the validated range",
+                    time,
+                );
+            }
             next_checkpoint += 1;
         }
         if estimator.telemetry_due() {
@@ -269,6 +307,11 @@ fn replay(params: &Params<f32>, config: EstimatorConfig) -> bool {
         }
     }
     checks.check(next_checkpoint == CHECKPOINTS.len(), "every checkpoint reached", end);
+    checks.check(next_step == REAL_STEPS.len(), "every real step checked", end);
+    // A correct twin settles on the closed form by itself: the estimator's
+    // consistency check never has to re-seat it.
+    info!("twin re-seated {=u32} times by the consistency check", reseats);
+    checks.check(reseats == 0, "the twin never needed re-seating", end);
     for (i, &(t0, _, kind, flag)) in REPLAY_FAULTS.iter().enumerate() {
         let ok = seen[i].contains(flag);
         info!("injected {} at {=f32} s raised [{}]", kind, t0, seen[i]);
