@@ -20,7 +20,7 @@ fn setup(initial: f32) -> (Params<f32>, EstimatorConfig, Estimator) {
 fn run(est: &mut Estimator, ticks: usize, sample: Result<Option<f32>, SensorFault>) -> StateEstimate {
     let mut last = None;
     for k in 0..ticks {
-        let s = if k % 20 == 0 { sample } else { Ok(None) };
+        let s = if k.is_multiple_of(20) { sample } else { Ok(None) };
         last = Some(est.tick(s));
     }
     last.unwrap()
@@ -59,9 +59,9 @@ fn the_estimate_follows_the_twin_driven_directly() {
     let mut twin = Twin::<f32, f32>::new(&p, TwinConfig::SHIPPED, 40.0).unwrap();
     let tau = 0.2;
     let mut worst = 0.0f32;
-    for k in 0..5000 {
+    for k in 0..5000u32 {
         let t = 40.0 + 2.0 * (k as f32 * 1e-3);
-        let e = est.tick(if k % 20 == 0 { Ok(Some(t)) } else { Ok(None) });
+        let e = est.tick(if k.is_multiple_of(20) { Ok(Some(t)) } else { Ok(None) });
         twin.set_temperature(t - 2.0 * tau).unwrap();
         twin.tick().unwrap();
         if k > 2000 {
@@ -366,8 +366,8 @@ fn the_check_holds_its_fire_while_the_temperature_moves() {
     run(&mut est, 1000, Ok(Some(50.0)));
     est.twin_mut().set_state(&wrong_state(&raw, 50.0));
     let mut worst = (0.0f64, 0.0f64);
-    for k in 0..3000 {
-        let e = est.tick(if k % 20 == 0 { Ok(Some(54.0)) } else { Ok(None) });
+    for k in 0..3000u32 {
+        let e = est.tick(if k.is_multiple_of(20) { Ok(Some(54.0)) } else { Ok(None) });
         assert_eq!(e.reseats, 0, "tick {k}, filtered {} C", e.temperature);
         assert!(!e.flags.contains(Flags::TWIN_RESEATED));
         if k == 3 {
@@ -386,8 +386,8 @@ fn the_check_holds_its_fire_while_the_temperature_moves() {
     let mut est = estimator_for(&raw, 40.0);
     run(&mut est, 1000, Ok(Some(40.0)));
     let mut in_transit = 0;
-    for k in 0..2000 {
-        let e = est.tick(if k % 20 == 0 { Ok(Some(60.0)) } else { Ok(None) });
+    for k in 0..2000u32 {
+        let e = est.tick(if k.is_multiple_of(20) { Ok(Some(60.0)) } else { Ok(None) });
         assert_eq!(e.reseats, 0, "tick {k}");
         if (e.temperature - 60.0).abs() < 0.01 {
             let (dx, _) = off_reference(&raw, e.temperature, e.x, e.p_a, e.p_b);
@@ -421,7 +421,7 @@ fn drive(raw: &RawParams, name: &str, legs: &[(f32, f32, f32)]) -> u32 {
         let checks = est.consistency_checks();
         for j in 0..n {
             let t = from + (to - from) * j as f32 / n as f32;
-            let e = est.tick(if k % 20 == 0 { Ok(Some(t)) } else { Ok(None) });
+            let e = est.tick(if k.is_multiple_of(20) { Ok(Some(t)) } else { Ok(None) });
             k += 1;
             if e.reseats > prev.reseats {
                 let (dx, dp) = off_reference(raw, e.temperature, prev.x, prev.p_a, prev.p_b);
