@@ -102,16 +102,10 @@ impl<T: Float> Slot<T> {
     }
 }
 
-/// The value of [`regularised_root`] alone (no division for the slope).
+/// The value of [`regularised_root`] alone.
 #[inline]
 pub fn regularised_root_value<T: Real>(u: T, u_tr: T) -> T {
-    let uu = u * u;
-    let r = uu + u_tr * u_tr;
-    if r == uu && uu > T::ZERO {
-        let s = u.abs().sqrt();
-        return if u < T::ZERO { -s } else { s };
-    }
-    u / r.sqrt().sqrt()
+    regularised_root(u, u_tr).0
 }
 
 /// C1 square-root law `u / (u^2 + u_tr^2)^(1/4)` and its derivative.
@@ -119,29 +113,32 @@ pub fn regularised_root_value<T: Real>(u: T, u_tr: T) -> T {
 /// Equals `sign(u) sqrt(|u|)` to a relative `u_tr^2 / (4 u^2)` for
 /// `|u| >> u_tr`, has the finite slope `1 / sqrt(u_tr)` at zero, and is odd.
 /// Returns `(value, d value / du)`. Works in any [`Real`], including fixed
-/// point.
+/// point: everything is scaled by `m = max(|u|, u_tr)` first,
 ///
-/// Where `u_tr^2` is below the resolution of `u^2` (every operating point
-/// in `f32`; all of them in Q16.16, where `u_tr^2` underflows), the law is
-/// the plain root in the scalar's own arithmetic, and it is evaluated as
-/// such: one square root and one division for the slope, instead of two
-/// square roots and two divisions. The results are those of the general
-/// formula rounded the same way.
+/// ```text
+/// r  = sign(u) (|u|/m) sqrt(m) / S^(1/4)
+/// r' = ((|u|/m)^2 / 2 + (u_tr/m)^2) / (sqrt(m) S^(5/4)),   S = (|u|/m)^2 + (u_tr/m)^2 in [1, 2]
+/// ```
+///
+/// so no square of a small drop is ever formed (in Q12.20, `u^2` and
+/// `u_tr^2` both vanish below `u ~ 1e-3`: the unscaled law returned the
+/// saturated 2048 at `u = 5e-4`). A zero `u_tr` is the plain root, with
+/// the saturated (or infinite) slope at `u = 0`.
 #[inline]
 pub fn regularised_root<T: Real>(u: T, u_tr: T) -> (T, T) {
-    let uu = u * u;
-    let tt = u_tr * u_tr;
-    let r = uu + tt;
-    if r == uu && uu > T::ZERO {
-        let s = u.abs().sqrt();
-        let value = if u < T::ZERO { -s } else { s };
-        return (value, T::HALF / s);
+    let a = u.abs();
+    let t = u_tr.abs();
+    let m = a.max(t);
+    if !(m > T::ZERO) {
+        return (T::ZERO, T::ONE / m.max(T::ZERO));
     }
-    let r14 = r.sqrt().sqrt(); // r^(1/4)
-    let value = u / r14;
-    // d/du = (u^2 / 2 + u_tr^2) / r^(5/4)
-    let slope = (T::HALF * uu + tt) / (r * r14);
-    (value, slope)
+    let (ra, rt) = (a / m, t / m);
+    let s = ra * ra + rt * rt;
+    let s14 = s.sqrt().sqrt();
+    let sm = m.sqrt();
+    let value = ra * sm / s14;
+    let slope = (T::HALF * ra * ra + rt * rt) / (sm * s * s14);
+    (if u < T::ZERO { -value } else { value }, slope)
 }
 
 #[cfg(test)]
@@ -161,19 +158,35 @@ mod tests {
     }
 
     #[test]
-    fn plain_root_branch_agrees_with_the_general_law() {
-        // f32 takes the plain-root branch at operating points; the f64
-        // general formula is the reference.
+    fn regularised_root_keeps_its_resolution_in_fixed_point() {
+        use crate::scalar::Fixed;
+        for &(u, tr) in &[(5e-4, 1e-5), (1e-5, 1e-5), (2e-6, 1e-5), (0.3, 1e-5), (-7e-4, 1e-5)] {
+            let (v, d) = regularised_root(Fixed::from_f64(u), Fixed::from_f64(tr));
+            let (v64, d64) = regularised_root(u, tr);
+            // One LSB of Q12.20 on the inputs moves the value by at most
+            // 1e-6 / (2 sqrt(u_tr)) ~ 2e-4 near zero.
+            assert!(
+                (v.to_f64() - v64).abs() <= 3e-4 * (1.0 + v64.abs()),
+                "value at {u}: {v:?} vs {v64}"
+            );
+            assert!((d.to_f64() - d64).abs() <= 2e-2 * d64, "slope at {u}: {d:?} vs {d64}");
+        }
+    }
+
+    #[test]
+    fn f32_agrees_with_f64() {
+        // The scaled law in f32 against the same law in f64: a few
+        // roundings (three roots, three divisions).
         for i in 1..2000 {
             let u = i as f32 * 5e-4 - 0.4;
             let (v32, s32) = regularised_root(u, 1e-5f32);
             let (v64, s64) = regularised_root(u as f64, 1e-5f64);
             assert!(
-                ((v32 as f64) - v64).abs() <= 2.0 * f32::EPSILON as f64 * v64.abs(),
+                ((v32 as f64) - v64).abs() <= 6.0 * f32::EPSILON as f64 * v64.abs(),
                 "value at {u}"
             );
             assert!(
-                ((s32 as f64) - s64).abs() <= 4.0 * f32::EPSILON as f64 * s64.abs(),
+                ((s32 as f64) - s64).abs() <= 10.0 * f32::EPSILON as f64 * s64.abs(),
                 "slope at {u}"
             );
         }

@@ -11,6 +11,7 @@
 
 use crate::random::{Rng, walther_through};
 use compensator::dynamics::TwinConfig;
+use compensator::dynamics::config::{Choice, choose};
 use compensator::dynamics::linear::linearise;
 use compensator::params::RawCore;
 use compensator::{Params, RawParams};
@@ -279,4 +280,181 @@ impl Solved {
             trajectory_pct,
         })
     }
+}
+
+/// The precisions the survey checks, with their trajectory goals (max
+/// `|x - x_ref|` in % of the step).
+pub const PRECISIONS: [(Precision, &str, f64); 3] = [
+    (Precision::F64, "f64", 0.1),
+    (Precision::F32, "f32", 0.5),
+    (Precision::Fixed, "Q12.20", 1.0),
+];
+
+/// End state within this fraction of the stroke and of `dp` of the closed form.
+pub const END_TOLERANCE: f64 = 1e-3;
+
+/// Figures of one precision over a survey.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Figures {
+    /// Steps simulated.
+    pub steps: usize,
+    /// Largest end-state deviation (stroke or `dp` fraction).
+    pub worst_end: f64,
+    /// Steps whose end state is off by more than [`END_TOLERANCE`].
+    pub end_failures: usize,
+    /// Steps whose trajectory is measured (the plunger moves by 1 % of the stroke or more).
+    pub trajectories: usize,
+    /// Largest trajectory error [% of the step].
+    pub worst_trajectory: f64,
+    /// Trajectories beyond the precision's goal.
+    pub trajectory_failures: usize,
+}
+
+/// What a survey found.
+#[derive(Clone, Debug, Default)]
+pub struct Report {
+    /// Designs surveyed.
+    pub designs: usize,
+    /// How many designs got each substep count: `(substeps, designs)`.
+    pub substeps: Vec<(u8, usize)>,
+    /// Designs whose chooser estimate stayed above its target.
+    pub chooser_misses: usize,
+    /// Per precision, in [`PRECISIONS`]' order.
+    pub figures: [Figures; 3],
+    /// Every failure, one line each (design index, step, precision, what).
+    pub failures: Vec<String>,
+}
+
+impl Report {
+    fn merge(&mut self, other: Report) {
+        self.designs += other.designs;
+        for (n, c) in other.substeps {
+            match self.substeps.iter_mut().find(|(m, _)| *m == n) {
+                Some((_, d)) => *d += c,
+                None => self.substeps.push((n, c)),
+            }
+        }
+        self.substeps.sort();
+        self.chooser_misses += other.chooser_misses;
+        for (a, b) in self.figures.iter_mut().zip(other.figures) {
+            a.steps += b.steps;
+            a.worst_end = a.worst_end.max(b.worst_end);
+            a.end_failures += b.end_failures;
+            a.trajectories += b.trajectories;
+            a.worst_trajectory = a.worst_trajectory.max(b.worst_trajectory);
+            a.trajectory_failures += b.trajectory_failures;
+        }
+        self.failures.extend(other.failures);
+    }
+
+    /// A markdown table of the figures.
+    pub fn table(&self) -> String {
+        let mut s = String::from(
+            "| precision | steps | worst end state (stroke, dp) | end > 1e-3 | trajectories | worst trajectory | beyond goal (goal) |\n\
+             | --- | --- | --- | --- | --- | --- | --- |\n",
+        );
+        for ((_, name, goal), f) in PRECISIONS.iter().zip(&self.figures) {
+            s += &format!(
+                "| {name} | {} | {:.1e} | {} | {} | {:.3} % | {} ({goal} %) |\n",
+                f.steps, f.worst_end, f.end_failures, f.trajectories, f.worst_trajectory, f.trajectory_failures
+            );
+        }
+        s
+    }
+}
+
+/// The configuration [`choose`] picks for `raw` at the survey's tick.
+pub fn chosen(raw: &RawParams) -> Result<Choice, String> {
+    let p = Params::<f64>::new(raw).map_err(|e| e.to_string())?;
+    let e = &raw.estimator;
+    choose(&p, TICK, (e.valid_min, e.valid_max), e.oil_min).map_err(|e| e.to_string())
+}
+
+/// One design through its steps in every precision, with the chosen configuration.
+pub fn survey_design(index: usize, raw: &RawParams, seed: u64) -> Report {
+    let mut r = Report {
+        designs: 1,
+        ..Report::default()
+    };
+    let choice = match chosen(raw) {
+        Ok(c) => c,
+        Err(e) => {
+            r.failures.push(format!("design {index}: no configuration: {e}"));
+            return r;
+        }
+    };
+    r.substeps.push((choice.config.substeps, 1));
+    r.chooser_misses += usize::from(!choice.goal_met);
+    let mut rng = Rng::new(seed ^ (index as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    for step in steps(raw, &mut rng) {
+        let solved = match Solved::new(raw, step) {
+            Ok(s) => s,
+            Err(e) => {
+                r.failures.push(format!("design {index} {step:?}: reference: {e}"));
+                continue;
+            }
+        };
+        for ((precision, name, goal), f) in PRECISIONS.iter().zip(r.figures.iter_mut()) {
+            f.steps += 1;
+            match solved.outcome(*precision, choice.config) {
+                Err(e) => {
+                    f.end_failures += 1;
+                    r.failures.push(format!("design {index} {step:?} {name}: {e}"));
+                }
+                Ok(o) => {
+                    let end = o.x_end.max(o.p_end);
+                    f.worst_end = f.worst_end.max(end);
+                    if end > END_TOLERANCE {
+                        f.end_failures += 1;
+                        r.failures.push(format!(
+                            "design {index} {step:?} {name}: end state off by {:.2e} of the stroke, {:.2e} of dp",
+                            o.x_end, o.p_end
+                        ));
+                    }
+                    if let Some(t) = o.trajectory_pct {
+                        f.trajectories += 1;
+                        f.worst_trajectory = f.worst_trajectory.max(t);
+                        if t > *goal {
+                            f.trajectory_failures += 1;
+                            r.failures.push(format!(
+                                "design {index} {step:?} {name}: trajectory off by {t:.3} % of the step with {} substeps (goal {goal} %)",
+                                choice.config.substeps
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    r
+}
+
+/// `count` designs from `seed` (see [`designs`]), surveyed on all cores.
+pub fn survey(count: usize, seed: u64) -> Report {
+    let all = designs(count, seed);
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(count.max(1));
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let mut report = Report::default();
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..threads)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut r = Report::default();
+                    loop {
+                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(raw) = all.get(i) else { break };
+                        r.merge(survey_design(i, raw, seed));
+                    }
+                    r
+                })
+            })
+            .collect();
+        for h in handles {
+            report.merge(h.join().expect("a survey thread panicked"));
+        }
+    });
+    report.failures.sort();
+    report
 }
