@@ -17,6 +17,10 @@
 //!    reader as the host tools, so that a device is only ever flashed with
 //!    a valid parameter set. A refused file fails the build with one line
 //!    naming the field (`cargo::error`, no backtrace).
+//!    It also chooses the twin's configuration for the file (SDIRK3 and the
+//!    substeps per tick that follow its dynamics to 0.1 % of a step:
+//!    `compensator::dynamics::config::choose`, run here on the host), so
+//!    that the cost per tick is decided before anything is flashed.
 //! 3. For the QEMU images only (feature `qemu`): the QEMU twin's replay
 //!    schedule, adapted to the device's validated and oil ranges, and the
 //!    bounds it checks itself against (`$OUT_DIR/replay.rs`, and the same
@@ -88,6 +92,26 @@ fn main() {
             return;
         }
     };
+    // The twin's configuration for this design, from its own dynamics.
+    let choice = match twin_configuration(&raw) {
+        Ok(c) => c,
+        Err(e) => {
+            println!(
+                "cargo::error=parameter file {}: no twin configuration: {e}",
+                params.display()
+            );
+            return;
+        }
+    };
+    if !choice.goal_met {
+        println!(
+            "cargo::warning=parameter file {}: the twin's {} substeps per tick are estimated {:.3} % of a step off (target {} %)",
+            params.display(),
+            choice.config.substeps,
+            choice.estimated_error_pct,
+            compensator::dynamics::config::TARGET_PCT
+        );
+    }
     let array = |v: &[f64]| v.iter().map(|x| format!("{x:?}")).collect::<Vec<_>>().join(", ");
     let machine = match &raw.machine {
         Some(m) => format!(
@@ -104,7 +128,15 @@ fn main() {
          machine: {machine},\n    \
          estimator: ::compensator::params::RawEstimator::from_array([{}]),\n}};\n\
          /// Where the parameters came from.\n\
-         pub const PARAMS_SOURCE: &str = {:?};\n",
+         pub const PARAMS_SOURCE: &str = {:?};\n\
+         /// The twin's scheme, by name (`compensator::dynamics::Scheme::from_name`),\n\
+         /// chosen at build time for this parameter file.\n\
+         pub const TWIN_SCHEME: &str = {:?};\n\
+         /// The twin's steps per tick, chosen at build time for this parameter\n\
+         /// file from its own dynamics (`compensator::dynamics::config::choose`).\n\
+         pub const TWIN_SUBSTEPS: u8 = {};\n\
+         /// The chooser's estimate of the twin's error [% of a step].\n\
+         pub const TWIN_ESTIMATED_ERROR_PCT: f32 = {:?};\n",
         params.display(),
         array(&raw.core.to_array()),
         array(&raw.estimator.to_array()),
@@ -112,6 +144,9 @@ fn main() {
             .file_name()
             .map(|f| f.to_string_lossy().into_owned())
             .unwrap_or_default(),
+        choice.config.scheme.name(),
+        choice.config.substeps,
+        choice.estimated_error_pct as f32,
     );
     fs::write(out.join("params.rs"), code).expect("write params.rs");
     #[cfg(feature = "qemu")]
@@ -124,6 +159,15 @@ fn main() {
         fs::write(out.join("replay.txt"), replay.schedule()).expect("write replay.txt");
         fs::write(out.join("expectations.rs"), expectations(&raw.core)).expect("write expectations.rs");
     }
+}
+
+/// The twin's configuration for `raw` at its tick over its validated range
+/// and down to its coldest oil (`compensator::dynamics::config::choose`).
+fn twin_configuration(raw: &compensator_params::RawParams) -> Result<compensator::dynamics::config::Choice, String> {
+    let p = compensator::Params::<f64>::new(raw).map_err(|e| e.to_string())?;
+    let e = &raw.estimator;
+    compensator::dynamics::config::choose(&p, 1.0 / e.tick_hz, (e.valid_min, e.valid_max), e.oil_min)
+        .map_err(|e| e.to_string())
 }
 
 /// Temperature pieces of the replay: (start [s], end [s], from [C], to [C]).

@@ -1,52 +1,43 @@
-//! # compensator
+//! # compensator-firmware
 //!
-//! A `no_std`, allocation-free digital twin of the passive throttle-based
-//! temperature flow compensator of "Asymptotic analysis and reduced-order
-//! modeling of a passive throttle-based temperature flow compensator", with
-//! the physics fixed in `MODEL.md` of the project's shared notes.
+//! The firmware around the `compensator` model crate: the images in
+//! `src/bin` (`twin` and `bench` on QEMU, `board` on an STM32F405, `fault`
+//! for the fault handler's test), and the hardware glue they share.
 //!
-//! The paper's three levels:
+//! * [`clock`]: real time from the tick counter (defmt timestamps).
+//! * `qemu` (QEMU images): semihosting exit, the shared panic and
+//!   HardFault handling, the defmt logger over semihosting.
 //!
-//! | level | module | paper |
-//! |---|---|---|
-//! | quasi-static equilibrium | [`equilibrium`], [`compensation`] | Eqs. 2-10 |
-//! | asymptotic closed forms, sensitivities, Eq. 32 | [`asymptotic`] | Eqs. 11-32 |
-//! | reduced-order FSI model, fixed-step twin, linearisation | [`dynamics`] | Eqs. 33-37 |
-//!
-//! On top: [`estimator`] (what the firmware runs every tick) and [`sensor`]
-//! (the temperature source: PT100 through a MAX31865).
-//!
-//! Building blocks: [`params`] (validated parameter sets), [`fluid`] (oil
-//! properties), [`throttle`] (throttle laws), [`scalar`] (the `f32` / `f64` /
-//! fixed-point scalar traits).
-//!
-//! Nothing in this crate allocates or panics: bad parameters give a
-//! [`params::ParamError`] naming the field, a model evaluation outside its
-//! range gives a [`ModelError`].
+//! The parameter file becomes constants at build time (`build.rs`), which
+//! also chooses the twin's configuration for it.
 #![cfg_attr(not(test), no_std)]
 #![deny(missing_docs)]
 #![forbid(unsafe_op_in_unsafe_fn)]
 
-pub mod asymptotic;
 pub mod clock;
-pub mod compensation;
-pub mod dynamics;
-pub mod equilibrium;
-mod error;
-pub mod estimator;
-pub mod fluid;
-pub mod linalg;
-pub mod mathf;
-pub mod params;
-pub mod scalar;
-pub mod sensor;
-pub mod throttle;
 
 #[cfg(all(feature = "qemu", target_os = "none"))]
 pub mod qemu;
 #[cfg(all(feature = "qemu", target_os = "none"))]
 mod qemu_log;
 
-pub use error::ModelError;
-pub use params::{ParamError, Params, RawParams};
-pub use scalar::{Float, Real};
+use compensator::dynamics::{Scheme, TwinConfig};
+use compensator::estimator::EstimatorConfig;
+
+/// Puts the twin configuration chosen at build time (`TWIN_SCHEME`,
+/// `TWIN_SUBSTEPS` of the generated `params.rs`) into `config`, keeping
+/// its tick.
+///
+/// Errors: an unknown scheme name or a substep count outside
+/// `1..=MAX_SUBSTEPS` (a build script out of step with the model).
+pub fn use_built_twin(config: &mut EstimatorConfig, scheme: &str, substeps: u8) -> Result<(), &'static str> {
+    let scheme = Scheme::from_name(scheme).ok_or("unknown twin scheme")?;
+    let twin = TwinConfig {
+        scheme,
+        substeps,
+        ..config.twin
+    };
+    twin.validate().map_err(|_| "twin configuration out of range")?;
+    config.twin = twin;
+    Ok(())
+}

@@ -12,7 +12,7 @@ use cortex_m_rt as _; // vector table; defmt-test generates `main`
 include!(concat!(env!("OUT_DIR"), "/params.rs"));
 include!(concat!(env!("OUT_DIR"), "/expectations.rs"));
 
-compensator::qemu_hard_fault_handler!();
+compensator_firmware::qemu_hard_fault_handler!();
 
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo) -> ! {
@@ -134,7 +134,8 @@ mod tests {
         // then the twin forced to the far stop with its pressures swapped:
         // the next round of jobs puts it back on the host's equilibrium.
         let (stroke, dp) = (p.plunger.stroke as f64, p.pressure_drop as f64);
-        let config = EstimatorConfig::new(&RAW_PARAMS.estimator).unwrap();
+        let mut config = EstimatorConfig::new(&RAW_PARAMS.estimator).unwrap();
+        compensator_firmware::use_built_twin(&mut config, TWIN_SCHEME, TWIN_SUBSTEPS).unwrap();
         for &(t, _, _, pa, pb, x, _) in EXPECTED.iter().filter(|e| e.0 == 30.0 || e.0 == 60.0) {
             let mut est = Estimator::new(p, config, t).unwrap();
             let window = est.settle_ticks();
@@ -197,7 +198,8 @@ mod tests {
         assert!((t - 45.0).abs() < 0.05, "read {=f32}", t);
         sensor.device_mut().bus_error = true;
         assert!(sensor.read() == Err(SensorFault::Bus));
-        let config = EstimatorConfig::new(&RAW_PARAMS.estimator).unwrap();
+        let mut config = EstimatorConfig::new(&RAW_PARAMS.estimator).unwrap();
+        compensator_firmware::use_built_twin(&mut config, TWIN_SCHEME, TWIN_SUBSTEPS).unwrap();
         let mut est = Estimator::new(p, config, 45.0).unwrap();
         for sample in [
             Err(SensorFault::Bus),

@@ -36,10 +36,10 @@
 #![no_main]
 
 use compensator::Params;
-use compensator::clock::TickClock;
 use compensator::estimator::{Estimator, EstimatorConfig};
 use compensator::sensor::TemperatureSource;
 use compensator::sensor::max31865::{Max31865, Settings};
+use compensator_firmware::clock::TickClock;
 use core::sync::atomic::{AtomicU32, Ordering};
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{ExceptionFrame, entry, exception};
@@ -128,10 +128,13 @@ fn main() -> ! {
         Ok(p) => p,
         Err(e) => defmt::panic!("parameters rejected: {=str}", e.field),
     };
-    let config = match EstimatorConfig::new(&RAW_PARAMS.estimator) {
+    let mut config = match EstimatorConfig::new(&RAW_PARAMS.estimator) {
         Ok(c) => c,
         Err(e) => defmt::panic!("estimator settings rejected: {=str}", e.field),
     };
+    if let Err(what) = compensator_firmware::use_built_twin(&mut config, TWIN_SCHEME, TWIN_SUBSTEPS) {
+        defmt::panic!("twin configuration: {=str}", what);
+    }
 
     let mut rcc = dp.RCC.freeze(Config::hse(8.MHz()).sysclk(SYSCLK_HZ.Hz()));
     let sysclk = rcc.clocks.sysclk().raw();

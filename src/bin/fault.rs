@@ -1,6 +1,6 @@
 //! A deliberate HardFault on QEMU (an undefined instruction): `cargo xtask
 //! test` checks that the handler the QEMU images share
-//! (`compensator::qemu_hard_fault_handler!`) reports the fault and ends the
+//! (`compensator_firmware::qemu_hard_fault_handler!`) reports the fault and ends the
 //! run with exit code 1 at once, instead of spinning until the host's
 //! deadline.
 #![no_std]
@@ -9,7 +9,7 @@
 use cortex_m as _; // the critical-section implementation defmt needs
 use cortex_m_rt::entry;
 
-compensator::qemu_hard_fault_handler!();
+compensator_firmware::qemu_hard_fault_handler!();
 
 #[entry]
 fn main() -> ! {
@@ -19,5 +19,5 @@ fn main() -> ! {
 
 #[panic_handler]
 fn panic(_: &core::panic::PanicInfo) -> ! {
-    compensator::qemu::exit(false)
+    compensator_firmware::qemu::exit(false)
 }

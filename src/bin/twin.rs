@@ -34,7 +34,7 @@ include!(concat!(env!("OUT_DIR"), "/params.rs"));
 include!(concat!(env!("OUT_DIR"), "/replay.rs"));
 
 // A fault reports its registers and exits 1 (not a spin until the deadline).
-compensator::qemu_hard_fault_handler!();
+compensator_firmware::qemu_hard_fault_handler!();
 
 /// Numerical margin of the checkpoints beyond the reference's interval:
 /// displacement, as a fraction of the stroke (f32 steady state: ~2e-6).
@@ -104,16 +104,24 @@ fn main() -> ! {
             exit(false)
         }
     };
-    let config = match EstimatorConfig::new(&RAW_PARAMS.estimator) {
+    let mut config = match EstimatorConfig::new(&RAW_PARAMS.estimator) {
         Ok(c) => c,
         Err(e) => {
             error!("estimator settings rejected: {=str}", e.field);
             exit(false)
         }
     };
+    if let Err(what) = compensator_firmware::use_built_twin(&mut config, TWIN_SCHEME, TWIN_SUBSTEPS) {
+        error!("twin configuration: {=str}", what);
+        exit(false)
+    }
     info!(
         "compensator twin on the emulated Cortex-M4F; parameters {=str}",
         PARAMS_SOURCE
+    );
+    info!(
+        "twin: {=str}, {=u8} steps per tick (chosen at build time, estimated within {=f32} % of a step)",
+        TWIN_SCHEME, TWIN_SUBSTEPS, TWIN_ESTIMATED_ERROR_PCT
     );
     static_characteristic(&params);
     let ok = replay(&params, config);

@@ -81,7 +81,7 @@ pub struct Options<'a> {
 pub struct Built {
     /// The ELF.
     pub elf: PathBuf,
-    /// The build script's output directory of the `compensator` package
+    /// The build script's output directory of the `compensator-firmware` package
     /// (for the QEMU twin: its replay schedule, `replay.txt`).
     pub out_dir: Option<PathBuf>,
 }
@@ -91,13 +91,19 @@ pub fn build(tc: &Toolchain, root: &Path, image: &Image, params: Option<&Path>) 
     build_with(tc, root, image, Options { params, debug: false }).map(|b| b.elf)
 }
 
-/// Builds `image` (only it: `--package compensator --bin ...`, no host
+/// Builds `image` (only it: `--package compensator-firmware --bin ...`, no host
 /// crate of the workspace); returns the ELF and the build script's output
 /// directory.
 pub fn build_with(tc: &Toolchain, root: &Path, image: &Image, options: Options<'_>) -> Result<Built, String> {
     let mut cmd = tc.cargo();
-    cmd.current_dir(root)
-        .args(["build", "--quiet", "--package", "compensator", "--bin", image.bin]);
+    cmd.current_dir(root).args([
+        "build",
+        "--quiet",
+        "--package",
+        "compensator-firmware",
+        "--bin",
+        image.bin,
+    ]);
     if !options.debug {
         cmd.arg("--release");
     }
@@ -134,7 +140,7 @@ pub fn build_with(tc: &Toolchain, root: &Path, image: &Image, options: Options<'
     })
 }
 
-/// The executable named `bin` and the `compensator` build script's output
+/// The executable named `bin` and the `compensator-firmware` build script's output
 /// directory, from cargo's JSON messages.
 fn artifacts(json_lines: &str, bin: &str) -> (Option<PathBuf>, Option<PathBuf>) {
     let (mut elf, mut out_dir) = (None, None);
@@ -142,9 +148,9 @@ fn artifacts(json_lines: &str, bin: &str) -> (Option<PathBuf>, Option<PathBuf>) 
         let Ok(v) = serde_json::from_str::<serde_json::Value>(line) else {
             continue;
         };
-        let is_ours = v["package_id"].as_str().is_some_and(|id| {
-            id.contains("/compensator#") || id.contains("compensator@") || id.starts_with("compensator ")
-        });
+        let is_ours = v["package_id"]
+            .as_str()
+            .is_some_and(|id| id.contains("#compensator-firmware@") || id.starts_with("compensator-firmware "));
         match v["reason"].as_str() {
             Some("build-script-executed") if is_ours => {
                 out_dir = v["out_dir"].as_str().map(PathBuf::from);
@@ -210,7 +216,7 @@ pub fn check_refused_file(tc: &Toolchain, root: &Path) -> Result<(), String> {
             "--quiet",
             "--release",
             "--package",
-            "compensator",
+            "compensator-firmware",
             "--bin",
             "board",
         ])
@@ -283,7 +289,14 @@ pub fn on_target_tests(tc: &Toolchain, root: &Path) -> Result<(), String> {
     let runner = format!("{} qemu-runner", exe.display());
     let mut cmd = tc.cargo();
     cmd.current_dir(root)
-        .args(["test", "--release", "--package", "compensator", "--test", "on_target"])
+        .args([
+            "test",
+            "--release",
+            "--package",
+            "compensator-firmware",
+            "--test",
+            "on_target",
+        ])
         .args(["--target", M4, "--no-default-features", "--features", "qemu"])
         .arg("--target-dir")
         .arg(target_dir(root))

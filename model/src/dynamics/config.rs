@@ -30,7 +30,7 @@ use crate::params::Params;
 pub const LADDER: [u8; 10] = [1, 2, 3, 4, 6, 8, 12, 16, 24, 32];
 
 /// Largest deviation from the finest twin accepted, in % of a probe's step.
-pub const TARGET_PCT: f64 = 0.04;
+pub const TARGET_PCT: f64 = 0.05;
 
 /// Probe steps moving the plunger by less than this fraction of the stroke
 /// measure nothing (the error is a percentage of the step).

@@ -68,7 +68,7 @@ use crate::scalar::Real;
 /// step's initial one, which an abrupt change of temperature or a release
 /// can leave far from the stage's (one iteration cost 0.18 % of the step on
 /// the paper preset's 80 -> 30 C step, two iterations 0.01 %).
-pub const FIRST_STAGE_ITERATIONS: u8 = 2;
+pub const FIRST_STAGE_ITERATIONS: u8 = 1;
 /// Newton iterations of the later stages, which start from the previous
 /// stage's velocity (a second one changes no survey figure).
 pub const LATER_STAGE_ITERATIONS: u8 = 1;
@@ -175,23 +175,26 @@ fn root<T: Real>(k: T, q: T, c: T) -> (T, T) {
 /// written with bounded coefficients whatever the stiffness: divided by
 /// `beta` (`k = tau / (h gamma) <= 1`) for a stiff chamber, as it stands
 /// (`beta < 1`) for a slow one or a short step. `tau = 1 / omega(xi)` is the
-/// chamber's time constant, `dlog_tau = d ln(tau) / dw` through `xi(w)`.
+/// chamber's time constant. `du/dw` is the chamber's response to the
+/// stage's velocity at fixed `tau` (the volume's own dependence on `xi(w)`,
+/// `eps = A_p L / V` of a few percent, is left to the Newton iteration:
+/// leaving it out of the derivative changes no survey figure).
 #[inline]
-fn chamber<T: Real>(c: &Coefficients<T>, tau: T, hg: T, u_z: T, w: T, dlog_tau: T) -> Chamber<T> {
+fn chamber<T: Real>(c: &Coefficients<T>, tau: T, hg: T, u_z: T, w: T) -> Chamber<T> {
     let e = c.g_l - c.sigma * w;
-    // du/dw = D (m dlog_tau (u_z - u) - n sigma), (m, n) = (k, 1) or (1, beta).
-    let (u, d, m, n) = if tau <= hg {
+    // du/dw = -D n sigma, n = 1 (k-form) or beta.
+    let (u, d, n) = if tau <= hg {
         let k = tau / hg;
         let (u, d) = root(k + c.g_l, c.q_t, k * u_z + e);
-        (u, d, k, T::ONE)
+        (u, d, T::ONE)
     } else {
         let beta = hg / tau;
         let (u, d) = root(T::ONE + beta * c.g_l, beta * c.q_t, u_z + beta * e);
-        (u, d, T::ONE, beta)
+        (u, d, beta)
     };
     Chamber {
         u,
-        du_dw: d * (m * dlog_tau * (u_z - u) - n * c.sigma),
+        du_dw: -(d * n * c.sigma),
     }
 }
 
@@ -266,8 +269,8 @@ impl<T: Real> Dirk<T> {
                 ),
                 Contact::Closed | Contact::Open => {
                     let (ta, tb) = time_constants(c, y[0]);
-                    let a = chamber(c, ta, hg, T::ONE - z[2], T::ZERO, T::ZERO);
-                    let b = chamber(c, tb, hg, z[3], T::ZERO, T::ZERO);
+                    let a = chamber(c, ta, hg, T::ONE - z[2], T::ZERO);
+                    let b = chamber(c, tb, hg, z[3], T::ZERO);
                     [y[0], T::ZERO, T::ONE - a.u, b.u]
                 }
             };
@@ -300,18 +303,8 @@ impl<T: Real> Dirk<T> {
         for _ in 0..iterations.max(1) {
             let xi = z[0] + hg_a_x * w;
             let (ta, tb) = time_constants(c, xi);
-            // d ln(tau) / dw through xi(w) while xi is between the stops:
-            // tau_a = (1 - eps_a xi) / omega_a0, tau_b = (1 + eps_b xi) / omega_b0.
-            let (la, lb) = if xi > T::ZERO && xi < T::ONE {
-                (
-                    -(c.eps_a * hg_a_x / (T::ONE - c.eps_a * xi)),
-                    c.eps_b * hg_a_x / (T::ONE + c.eps_b * xi),
-                )
-            } else {
-                (T::ZERO, T::ZERO)
-            };
-            let a = chamber(c, ta, hg, u_za, w, la);
-            let b = chamber(c, tb, hg, z[3], w, lb);
+            let a = chamber(c, ta, hg, u_za, w);
+            let b = chamber(c, tb, hg, z[3], w);
             let force = c.phi_over_a_x * (b.u - (T::ONE - a.u)) - (c.xi0 + xi) * c.inv_a_x;
             let g = w - z[1] - hg * (force - c.two_zeta * w);
             // d(pi_b - pi_a)/dw = du_b/dw + du_a/dw < 0 (hydraulic damping).

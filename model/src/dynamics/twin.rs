@@ -88,12 +88,13 @@ pub const RELEASE_ITERATIONS: u8 = 4;
 /// interpolant (no model evaluation).
 pub const IMPACT_ITERATIONS: u8 = 6;
 
-/// Steps per held substep.
-pub const HELD_STEPS: u8 = 1;
+/// Steps of a held piece whose force changes quickly (a transient that
+/// may release the plunger; see `Twin::tick`).
+pub const HELD_STEPS: u8 = 4;
 
 /// Pieces of a graded substep (see [`Twin::tick`]): the first is
 /// `2^-(GRADED_PIECES - 1)` of the substep.
-pub const GRADED_PIECES: u8 = 9;
+pub const GRADED_PIECES: u8 = 7;
 
 /// Relative change of the capillary conductance `g_l` between ticks above
 /// which the next tick is graded: about 0.3 C of a mineral oil's viscosity
@@ -405,12 +406,12 @@ impl<F: Float, T: Real> Twin<F, T> {
     }
 
     /// Held on a stop from `y` over `frac` of a substep: the plunger at
-    /// rest, the pressures in `HELD_STEPS` equal steps (the pressure
-    /// transient after a change of temperature decides when the plunger
-    /// lifts off: it is followed, not stepped over). When the held force
-    /// pulls away at a step's end and `events` remain, the release is
-    /// located (Illinois on the held force) and the piece goes on free from
-    /// there.
+    /// rest, the pressures in one step while the hold is quiet, else in
+    /// `HELD_STEPS` equal steps (a pressure transient after a change of
+    /// temperature decides when the plunger lifts off: it is followed, not
+    /// stepped over). When the held force pulls away at a step's end and
+    /// `events` remain, the release is located (Illinois on the held force)
+    /// and the piece goes on free from there.
     fn held_piece(
         &self,
         y: &[T; 4],
@@ -423,12 +424,21 @@ impl<F: Float, T: Real> Twin<F, T> {
         // On the stop exactly: nothing is left to carry.
         *carry = T::ZERO;
         let away = |s: &[T; 4]| away_from(c, held, s);
+        let y0 = [y[0], T::ZERO, y[2], y[3]];
+        // One step first: a quiet hold (the force into the stop and
+        // changing by less than half of what is left of it) is done.
+        let whole = self.step(&y0, frac, held, carry)?;
+        let (f0, f1) = (away(&y0), away(&whole));
+        if f1 <= T::ZERO && (f1 - f0).abs() <= T::HALF * f1.abs() {
+            return Ok((whole, false));
+        }
+        // A transient: followed in HELD_STEPS steps, the release located.
         let part = if frac == T::ONE {
             self.held_part
         } else {
             frac * self.held_part
         };
-        let mut start = [y[0], T::ZERO, y[2], y[3]];
+        let mut start = y0;
         let mut t0 = T::ZERO;
         for _ in 0..HELD_STEPS {
             let end = self.step(&start, part, held, carry)?;
