@@ -166,8 +166,7 @@ fn main() {
 fn twin_configuration(raw: &compensator_params::RawParams) -> Result<compensator::dynamics::config::Choice, String> {
     let p = compensator::Params::<f64>::new(raw).map_err(|e| e.to_string())?;
     let e = &raw.estimator;
-    compensator::dynamics::config::choose(&p, 1.0 / e.tick_hz, (e.valid_min, e.valid_max), e.oil_min)
-        .map_err(|e| e.to_string())
+    compensator::dynamics::config::choose(&p, 1.0 / e.tick_hz, (e.valid_min, e.valid_max)).map_err(|e| e.to_string())
 }
 
 /// Temperature pieces of the replay: (start [s], end [s], from [C], to [C]).

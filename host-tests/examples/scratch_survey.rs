@@ -26,13 +26,9 @@ fn main() {
     for (i, raw) in designs(n, 0xD5).iter().enumerate() {
         let cfg = if auto {
             let p = compensator::Params::<f64>::new(raw).unwrap();
-            let ch = compensator::dynamics::config::choose(
-                &p,
-                1e-3,
-                (raw.estimator.valid_min, raw.estimator.valid_max),
-                raw.estimator.oil_min,
-            )
-            .unwrap();
+            let ch =
+                compensator::dynamics::config::choose(&p, 1e-3, (raw.estimator.valid_min, raw.estimator.valid_max))
+                    .unwrap();
             *hist.entry(ch.config.substeps).or_insert(0) += 1;
             if !ch.goal_met || verbose {
                 println!(

@@ -89,7 +89,10 @@ pub fn scattered(base: &RawCore, rng: &mut Rng) -> RawCore {
 }
 
 /// `count` designs, alternately around `presets/paper.toml` and
-/// `presets/model-example.toml`, from `seed`.
+/// `presets/model-example.toml`, from `seed`. A design whose oil leaves
+/// Walther's range above the preset's coldest oil temperature gets that
+/// range's bottom (to the next whole degree) as `estimator.oil_min`: the
+/// oil range of a device file is where its oil model holds.
 pub fn designs(count: usize, seed: u64) -> Vec<RawParams> {
     let root = crate::repo_root();
     let presets = [
@@ -100,11 +103,16 @@ pub fn designs(count: usize, seed: u64) -> Vec<RawParams> {
     (0..count)
         .map(|i| {
             let base = &presets[i % 2];
-            RawParams {
+            let mut raw = RawParams {
                 core: scattered(&base.core, &mut rng),
                 machine: None,
                 estimator: base.estimator,
+            };
+            let p = Params::<f64>::new(&raw).expect("scattered sets are valid");
+            while p.oil.state(raw.estimator.oil_min).is_err() && raw.estimator.oil_min < raw.estimator.valid_min {
+                raw.estimator.oil_min = raw.estimator.oil_min.floor() + 1.0;
             }
+            raw
         })
         .collect()
 }
@@ -308,6 +316,12 @@ pub struct Figures {
     pub worst_trajectory: f64,
     /// Trajectories beyond the precision's goal.
     pub trajectory_failures: usize,
+    /// Steps from or into cold oil (outside the validated range, where the
+    /// goal is the end state): trajectories measured, and the largest error
+    /// [% of the step].
+    pub cold_trajectories: usize,
+    /// Largest trajectory error of a cold step [% of the step].
+    pub worst_cold_trajectory: f64,
 }
 
 /// What a survey found.
@@ -343,6 +357,8 @@ impl Report {
             a.trajectories += b.trajectories;
             a.worst_trajectory = a.worst_trajectory.max(b.worst_trajectory);
             a.trajectory_failures += b.trajectory_failures;
+            a.cold_trajectories += b.cold_trajectories;
+            a.worst_cold_trajectory = a.worst_cold_trajectory.max(b.worst_cold_trajectory);
         }
         self.failures.extend(other.failures);
     }
@@ -350,13 +366,20 @@ impl Report {
     /// A markdown table of the figures.
     pub fn table(&self) -> String {
         let mut s = String::from(
-            "| precision | steps | worst end state (stroke, dp) | end > 1e-3 | trajectories | worst trajectory | beyond goal (goal) |\n\
-             | --- | --- | --- | --- | --- | --- | --- |\n",
+            "| precision | steps | worst end state (stroke, dp) | end > 1e-3 | trajectories in range | worst | beyond goal (goal) | cold trajectories | worst cold |\n\
+             | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n",
         );
         for ((_, name, goal), f) in PRECISIONS.iter().zip(&self.figures) {
             s += &format!(
-                "| {name} | {} | {:.1e} | {} | {} | {:.3} % | {} ({goal} %) |\n",
-                f.steps, f.worst_end, f.end_failures, f.trajectories, f.worst_trajectory, f.trajectory_failures
+                "| {name} | {} | {:.1e} | {} | {} | {:.3} % | {} ({goal} %) | {} | {:.3} % |\n",
+                f.steps,
+                f.worst_end,
+                f.end_failures,
+                f.trajectories,
+                f.worst_trajectory,
+                f.trajectory_failures,
+                f.cold_trajectories,
+                f.worst_cold_trajectory
             );
         }
         s
@@ -367,7 +390,7 @@ impl Report {
 pub fn chosen(raw: &RawParams) -> Result<Choice, String> {
     let p = Params::<f64>::new(raw).map_err(|e| e.to_string())?;
     let e = &raw.estimator;
-    choose(&p, TICK, (e.valid_min, e.valid_max), e.oil_min).map_err(|e| e.to_string())
+    choose(&p, TICK, (e.valid_min, e.valid_max)).map_err(|e| e.to_string())
 }
 
 /// One design through its steps in every precision, with the chosen configuration.
@@ -411,7 +434,11 @@ pub fn survey_design(index: usize, raw: &RawParams, seed: u64) -> Report {
                             o.x_end, o.p_end
                         ));
                     }
-                    if let Some(t) = o.trajectory_pct {
+                    let cold = matches!(step.kind, Kind::ColdOil | Kind::Rewarm);
+                    if let (Some(t), true) = (o.trajectory_pct, cold) {
+                        f.cold_trajectories += 1;
+                        f.worst_cold_trajectory = f.worst_cold_trajectory.max(t);
+                    } else if let Some(t) = o.trajectory_pct {
                         f.trajectories += 1;
                         f.worst_trajectory = f.worst_trajectory.max(t);
                         if t > *goal {

@@ -86,6 +86,59 @@ fn twin_cost<T: Real>(params: &Params<f32>, scheme: Scheme, substeps: u8, scalar
     Ok(())
 }
 
+/// The twin (f32, the configuration built for the parameter file) through
+/// slow ramps across the temperature at which the window opens: the ticks
+/// with a release from the closed stop and with an impact on it.
+#[cfg(target_abi = "eabihf")]
+fn twin_event_cost(params: &Params<f32>) -> Result<(), &'static str> {
+    let scheme = Scheme::from_name(TWIN_SCHEME).ok_or("unknown twin scheme")?;
+    let config = TwinConfig {
+        scheme,
+        tick: 1e-3,
+        substeps: TWIN_SUBSTEPS,
+    };
+    // Where the equilibrium leaves the closed stop: the first of 26..78 C
+    // (0.1 C apart) with the window open.
+    let mut opening = None;
+    for k in 0..520 {
+        let t = 26.0 + 0.1 * k as f32;
+        if compensator::equilibrium::equilibrium(params, t)
+            .map_err(|_| "equilibrium")?
+            .x
+            > 0.0
+        {
+            opening = Some(t);
+            break;
+        }
+    }
+    let Some(t_open) = opening else {
+        info!("[measure] twin-events skipped=no-opening-in-range");
+        return Ok(());
+    };
+    for (name, from, to) in [
+        ("release", t_open - 2.0, t_open + 2.0),
+        ("impact", t_open + 2.0, t_open - 2.0),
+    ] {
+        let mut twin = Twin::<f32, f32>::new(params, config, from).map_err(|_| "twin cannot start")?;
+        // 1 C/s over 4 C: 4,000 ticks.
+        let (mut total, mut worst, mut failed) = (0u32, 0u32, false);
+        let n = 4000u32;
+        for k in 0..n {
+            let t = from + (to - from) * (k as f32 + 0.5) / n as f32;
+            twin.set_temperature(t).map_err(|_| "twin refuses the ramp")?;
+            let (r, c) = counts(|| twin.tick());
+            failed |= r.is_err();
+            total += c;
+            worst = worst.max(c);
+        }
+        info!(
+            "[measure] twin-events kind={=str} scheme={=str} substeps={=u8} ticks={=u32} total={=u32} worst={=u32} ok={=bool}",
+            name, TWIN_SCHEME, TWIN_SUBSTEPS, n, total, worst, !failed
+        );
+    }
+    Ok(())
+}
+
 #[cfg(target_abi = "eabihf")]
 fn pieces(params: &Params<f32>) -> Result<(), &'static str> {
     use compensator::asymptotic::sensitivity_at;
@@ -265,6 +318,8 @@ fn main() -> ! {
                 twin_cost::<f32>(&params, scheme, substeps, "f32-soft")?;
             }
         }
+        #[cfg(target_abi = "eabihf")]
+        twin_event_cost(&params)?;
         #[cfg(target_abi = "eabihf")]
         pieces(&params)?;
         Ok(())

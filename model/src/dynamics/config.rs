@@ -1,13 +1,12 @@
 //! Choosing the twin's configuration for one design, from its own dynamics.
 //!
 //! How many substeps a 1 ms tick needs depends on the design: an
-//! overdamped plunger (the paper's) is followed to 0.1 % of a step by two
-//! SDIRK3 steps per tick; an underdamped one whose period spans a few ticks,
+//! overdamped plunger (the paper's) is followed to 0.1 % of a step by one
+//! SDIRK3 step per tick; an underdamped one whose period spans a few ticks,
 //! or one whose release from a stop rides a pressure transient of tens of
 //! microseconds, needs more. [`choose`] decides it before anything is
-//! flashed: it runs the twin (`f64`) on probe steps over the envelope
-//! ([`probes`]: both ways across the validated range, from its middle to
-//! either end, into cold oil and back) at each candidate substep count of
+//! flashed: it runs the twin (`f64`) on abrupt probe steps over the
+//! validated range ([`probes`]) at each candidate substep count of
 //! [`LADDER`], measures the largest deviation from the same twin at
 //! [`MAX_SUBSTEPS`] (converged to ~0.01 % of a step), and takes the
 //! cheapest count whose deviation stays within [`TARGET_PCT`] on every
@@ -39,12 +38,15 @@ pub const MIN_STEP: f64 = 0.01;
 /// Longest probe [s]: the errors of a step arise in its first transient.
 pub const MAX_PROBE: f64 = 0.5;
 
-/// The probe steps `(from, to)` [C] for a validated range and the coldest
-/// oil temperature: both ways across the range, from its middle to either
-/// end and back, from either end and the middle into cold oil and back.
-pub fn probes(valid: (f64, f64), cold: f64) -> [(f64, f64); PROBES] {
+/// The probe steps `(from, to)` [C] over a validated range: both ways
+/// across it, from its middle to either end and back, and between its
+/// quarter points both ways. Outside the validated range the twin's
+/// promise is its end state (the closed-form equilibrium), not its
+/// trajectory: cold oil needs no probe.
+pub fn probes(valid: (f64, f64)) -> [(f64, f64); PROBES] {
     let (lo, hi) = valid;
     let mid = 0.5 * (lo + hi);
+    let (q1, q3) = (0.75 * lo + 0.25 * hi, 0.25 * lo + 0.75 * hi);
     [
         (lo, hi),
         (hi, lo),
@@ -52,17 +54,13 @@ pub fn probes(valid: (f64, f64), cold: f64) -> [(f64, f64); PROBES] {
         (hi, mid),
         (mid, lo),
         (lo, mid),
-        (hi, cold),
-        (cold, hi),
-        (mid, cold),
-        (cold, mid),
-        (lo, cold),
-        (cold, lo),
+        (q1, q3),
+        (q3, q1),
     ]
 }
 
 /// Number of probe steps.
-pub const PROBES: usize = 12;
+pub const PROBES: usize = 8;
 
 /// The configuration [`choose`] settled on.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -93,13 +91,12 @@ fn run(p: &Params<f64>, config: TwinConfig, from: f64, to: f64, out: &mut [f64])
 const MAX_TICKS: usize = 500;
 
 /// Chooses the substeps per `tick` [s] of the SDIRK3 twin for `params`
-/// over the validated range `valid` [C] and down to `cold` [C]. Probe
-/// temperatures the oil model refuses (an oil too viscous for Walther's law
-/// at `cold`) are left out: the twin never runs there.
+/// over the validated range `valid` [C]. Probe temperatures the oil model
+/// refuses are left out.
 ///
 /// Errors: a probe's finest twin fails (`NoConvergence`), or `tick` is not
 /// a positive duration (`OutOfRange`).
-pub fn choose(params: &Params<f64>, tick: f64, valid: (f64, f64), cold: f64) -> Result<Choice, ModelError> {
+pub fn choose(params: &Params<f64>, tick: f64, valid: (f64, f64)) -> Result<Choice, ModelError> {
     if !(tick > 0.0 && tick.is_finite()) {
         return Err(ModelError::OutOfRange("tick"));
     }
@@ -113,7 +110,7 @@ pub fn choose(params: &Params<f64>, tick: f64, valid: (f64, f64), cold: f64) -> 
     let mut fine = [[0.0f64; MAX_TICKS + 1]; PROBES];
     let mut used = [(0.0, 0.0, 0usize, 0.0); PROBES];
     let mut count = 0;
-    for (from, to) in probes(valid, cold) {
+    for (from, to) in probes(valid) {
         let Ok(lin) = linearise(params, to) else { continue };
         if params.oil.state(from).is_err() {
             continue;

@@ -122,6 +122,18 @@ pub const SDIRK3: Tableau = {
     }
 };
 
+/// The scheme of a graded substep's short pieces (`Twin::substep`).
+pub const FINE: Tableau = SDIRK3;
+
+/// The implicit (backward) Euler method as a one-stage SDIRK: order 1,
+/// L-stable, stiffly accurate.
+pub const EULER: Tableau = Tableau {
+    stages: 1,
+    gamma: 1.0,
+    a: [[0.0; 3]; 3],
+    order: 1,
+};
+
 /// An SDIRK scheme prepared for a fixed step, in scalar type `T`.
 #[derive(Clone, Copy, Debug)]
 pub struct Dirk<T> {

@@ -93,8 +93,11 @@ pub const IMPACT_ITERATIONS: u8 = 6;
 pub const HELD_STEPS: u8 = 4;
 
 /// Pieces of a graded substep (see [`Twin::tick`]): the first is
-/// `2^-(GRADED_PIECES - 1)` of the substep.
-pub const GRADED_PIECES: u8 = 7;
+/// `2^-(pieces - 1)` of the substep, no longer than [`GRADED_FIRST`].
+pub const GRADED_FIRST: f64 = 0.5e-6;
+
+/// Most pieces of a graded substep (bounds its cost).
+pub const MAX_GRADED_PIECES: u8 = 16;
 
 /// Relative change of the capillary conductance `g_l` between ticks above
 /// which the next tick is graded: about 0.3 C of a mineral oil's viscosity
@@ -172,6 +175,8 @@ pub struct Twin<F, T> {
     model: Model<F>,
     coefficients: Coefficients<T>,
     engine: Engine<T>,
+    /// The scheme of a graded substep's pieces (see [`Twin::substep`]).
+    fine_engine: Engine<T>,
     substeps: u8,
     /// The substep length times `a_x` (model units): `xi' = a_x w`.
     h_a_x: T,
@@ -186,6 +191,8 @@ pub struct Twin<F, T> {
     xi_carry: T,
     /// The coefficients changed abruptly since the last tick.
     abrupt: bool,
+    /// Pieces of a graded substep: the first no longer than [`GRADED_FIRST`].
+    graded_pieces: u8,
     config: TwinConfig,
 }
 
@@ -201,7 +208,12 @@ impl<F: Float, T: Real> Twin<F, T> {
             None => Engine::Generic(Stepper::new(config.scheme, h)),
         };
         let coefficients: Coefficients<T> = model.coefficients(&eq.fluid)?;
+        let fine_engine = match config.scheme.dirk() {
+            Some(_) => Engine::Dirk(Dirk::new(&super::dirk::FINE, h)),
+            None => engine,
+        };
         Ok(Twin {
+            fine_engine,
             h_a_x: T::from_f64(h) * coefficients.a_x,
             held_part: T::from_f64(1.0 / HELD_STEPS as f64),
             abrupt_threshold: T::from_f64(ABRUPT_CHANGE),
@@ -212,6 +224,14 @@ impl<F: Float, T: Real> Twin<F, T> {
             state: model.equilibrium_state(&eq),
             xi_carry: T::ZERO,
             abrupt: false,
+            graded_pieces: {
+                let substep = config.tick / config.substeps as f64;
+                let mut n = 1u8;
+                while n < MAX_GRADED_PIECES && substep / (1u64 << (n - 1)) as f64 > GRADED_FIRST {
+                    n += 1;
+                }
+                n
+            },
             model,
             config,
         })
@@ -307,9 +327,10 @@ impl<F: Float, T: Real> Twin<F, T> {
 
     /// One step of `frac` of a substep from `y`, in `contact`.
     /// `xi_carry`: the compensated summation's carry of `xi` (free motion).
-    fn step(&self, y: &[T; 4], frac: T, contact: Contact, xi_carry: &mut T) -> Result<[T; 4], StepError> {
+    fn step(&self, y: &[T; 4], frac: T, contact: Contact, xi_carry: &mut T, fine: bool) -> Result<[T; 4], StepError> {
         let c = &self.coefficients;
-        match &self.engine {
+        let engine = if fine { &self.fine_engine } else { &self.engine };
+        match engine {
             Engine::Dirk(d) => Ok(d.step(c, y, frac, contact, xi_carry)),
             Engine::Generic(s) => {
                 let sys = Fsi {
@@ -327,30 +348,31 @@ impl<F: Float, T: Real> Twin<F, T> {
     }
 
     /// `frac` of a substep from `y`; `carry` is `xi`'s compensated-summation carry.
-    fn piece(&self, y: &[T; 4], frac: T, carry: &mut T) -> Result<([T; 4], bool), StepError> {
+    /// `fine`: a piece of a graded substep (see [`Twin::substep`]).
+    fn piece(&self, y: &[T; 4], frac: T, carry: &mut T, fine: bool) -> Result<([T; 4], bool), StepError> {
         match self.coefficients.contact(y) {
-            Contact::Free => self.free_piece(y, frac, carry, EVENTS_PER_SUBSTEP),
-            held => self.held_piece(y, frac, held, carry, EVENTS_PER_SUBSTEP),
+            Contact::Free => self.free_piece(y, frac, carry, EVENTS_PER_SUBSTEP, fine),
+            held => self.held_piece(y, frac, held, carry, EVENTS_PER_SUBSTEP, fine),
         }
     }
 
     /// One substep from `y`; after an abrupt change of the coefficients the
-    /// substep is taken in [`GRADED_PIECES`] pieces growing geometrically
-    /// from `2^-(GRADED_PIECES - 1)` of it, so that the transient the
+    /// substep is taken in pieces growing geometrically from
+    /// `2^-(pieces - 1)` of it (at most [`GRADED_FIRST`]), so that the transient the
     /// change starts (the pressures re-equilibrating, the plunger
     /// accelerating into its new motion) is followed rather than stepped
     /// over.
     fn substep(&self, y: &[T; 4], carry: &mut T, graded: bool) -> Result<([T; 4], bool), StepError> {
         if !graded {
-            return self.piece(y, T::ONE, carry);
+            return self.piece(y, T::ONE, carry, false);
         }
         let mut frac = T::ONE;
-        for _ in 1..GRADED_PIECES {
+        for _ in 1..self.graded_pieces {
             frac *= T::HALF;
         }
-        let (mut state, mut impact) = self.piece(y, frac, carry)?;
-        for _ in 1..GRADED_PIECES {
-            let (next, hit) = self.piece(&state, frac, carry)?;
+        let (mut state, mut impact) = self.piece(y, frac, carry, true)?;
+        for _ in 1..self.graded_pieces {
+            let (next, hit) = self.piece(&state, frac, carry, true)?;
             state = next;
             impact |= hit;
             frac = frac + frac;
@@ -365,9 +387,16 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// located: the plunger is put on the stop and the whole piece held from
     /// `y`'s pressures (never with the pressures of a motion the stop
     /// forbids). Returns the state and whether an impact happened.
-    fn free_piece(&self, y: &[T; 4], frac: T, carry: &mut T, events: u8) -> Result<([T; 4], bool), StepError> {
+    fn free_piece(
+        &self,
+        y: &[T; 4],
+        frac: T,
+        carry: &mut T,
+        events: u8,
+        fine: bool,
+    ) -> Result<([T; 4], bool), StepError> {
         let mut tried = *carry;
-        let next = self.step(y, frac, Contact::Free, &mut tried)?;
+        let next = self.step(y, frac, Contact::Free, &mut tried, fine)?;
         let (stop, contact) = if next[0] < T::ZERO {
             (T::ZERO, Contact::Closed)
         } else if next[0] > T::ONE {
@@ -379,13 +408,13 @@ impl<F: Float, T: Real> Twin<F, T> {
         *carry = T::ZERO;
         if events == 0 {
             let at = [stop, T::ZERO, y[2], y[3]];
-            let (end, _) = self.held_piece(&at, frac, contact, carry, 0)?;
+            let (end, _) = self.held_piece(&at, frac, contact, carry, 0, fine)?;
             return Ok((end, true));
         }
         let theta = self.impact_fraction(y, &next, frac, stop);
         let mut at = if theta > T::ZERO {
             let mut c = T::ZERO;
-            self.step(y, frac * theta, Contact::Free, &mut c)?
+            self.step(y, frac * theta, Contact::Free, &mut c, fine)?
         } else {
             *y
         };
@@ -398,9 +427,9 @@ impl<F: Float, T: Real> Twin<F, T> {
         // Held for the rest, unless the plunger travelled before the impact
         // and the force there pulls it off the stop again (a touch).
         let (end, _) = if theta > T::ZERO && away_from(&self.coefficients, contact, &at) > T::ZERO {
-            self.free_piece(&at, rest, carry, events - 1)?
+            self.free_piece(&at, rest, carry, events - 1, fine)?
         } else {
-            self.held_piece(&at, rest, contact, carry, events - 1)?
+            self.held_piece(&at, rest, contact, carry, events - 1, fine)?
         };
         Ok((end, true))
     }
@@ -419,6 +448,7 @@ impl<F: Float, T: Real> Twin<F, T> {
         held: Contact,
         carry: &mut T,
         events: u8,
+        fine: bool,
     ) -> Result<([T; 4], bool), StepError> {
         let c = &self.coefficients;
         // On the stop exactly: nothing is left to carry.
@@ -427,34 +457,40 @@ impl<F: Float, T: Real> Twin<F, T> {
         let y0 = [y[0], T::ZERO, y[2], y[3]];
         // One step first: a quiet hold (the force into the stop and
         // changing by less than half of what is left of it) is done.
-        let whole = self.step(&y0, frac, held, carry)?;
+        let whole = self.step(&y0, frac, held, carry, fine)?;
         let (f0, f1) = (away(&y0), away(&whole));
-        if f1 <= T::ZERO && (f1 - f0).abs() <= T::HALF * f1.abs() {
+        let quiet = f1 <= T::ZERO && (f1 - f0).abs() <= T::HALF * f1.abs();
+        if quiet || (fine && f1 <= T::ZERO) {
             return Ok((whole, false));
         }
         // A transient: followed in HELD_STEPS steps, the release located.
-        let part = if frac == T::ONE {
-            self.held_part
-        } else {
-            frac * self.held_part
+        // (A graded piece is short already: one step.)
+        let (steps, part) = match (fine, frac == T::ONE) {
+            (true, _) => (1, frac),
+            (false, true) => (HELD_STEPS, self.held_part),
+            (false, false) => (HELD_STEPS, frac * self.held_part),
         };
         let mut start = y0;
         let mut t0 = T::ZERO;
-        for _ in 0..HELD_STEPS {
-            let end = self.step(&start, part, held, carry)?;
+        for _ in 0..steps {
+            let end = if steps == 1 {
+                whole
+            } else {
+                self.step(&start, part, held, carry, fine)?
+            };
             let f1 = away(&end);
             if f1 > T::ZERO && events > 0 {
                 let f0 = away(&start);
                 if f0 > T::ZERO {
                     // Held although pulled away at the start (the piece
                     // after an impact at its start): released there.
-                    return self.free_piece(&start, frac - t0, carry, events - 1);
+                    return self.free_piece(&start, frac - t0, carry, events - 1, fine);
                 }
                 // The first bracketed time at which the held force pulls away.
                 let mut at = end;
                 let (_, theta) = illinois(f0, f1, RELEASE_ITERATIONS, |t| {
                     let mut no_carry = T::ZERO;
-                    let s = self.step(&start, part * t, held, &mut no_carry)?;
+                    let s = self.step(&start, part * t, held, &mut no_carry, fine)?;
                     let f = away(&s);
                     if f > T::ZERO {
                         at = s;
@@ -465,7 +501,7 @@ impl<F: Float, T: Real> Twin<F, T> {
                 if !(rest > T::ZERO) {
                     return Ok((at, false));
                 }
-                return self.free_piece(&at, rest, carry, events - 1);
+                return self.free_piece(&at, rest, carry, events - 1, fine);
             }
             start = end;
             t0 += part;
