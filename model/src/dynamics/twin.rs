@@ -79,18 +79,9 @@ pub struct TickReport {
 /// (`host-tests/tests/survey.rs` records the reference's largest excursion).
 pub const PRESSURE_MARGIN: f64 = 4.0;
 
-/// Iterations of the release-time search on a stop (Illinois regula falsi
-/// on the held force; each costs one held step, two closed forms per stage
-/// for the SDIRK schemes).
-pub const RELEASE_ITERATIONS: u8 = 4;
-
 /// Iterations of the impact-time search on the step's cubic Hermite
 /// interpolant (no model evaluation).
 pub const IMPACT_ITERATIONS: u8 = 6;
-
-/// Steps of a held piece whose force changes quickly (a transient that
-/// may release the plunger; see `Twin::tick`).
-pub const HELD_STEPS: u8 = 4;
 
 /// Pieces of a graded substep (see [`Twin::tick`]): the first is
 /// `2^-(pieces - 1)` of the substep, no longer than [`GRADED_FIRST`].
@@ -182,8 +173,6 @@ pub struct Twin<F, T> {
     h_a_x: T,
     /// [`ABRUPT_CHANGE`] in `T`.
     abrupt_threshold: T,
-    /// `1 / HELD_STEPS`: the length of a held step, in substeps.
-    held_part: T,
     /// Pressure bounds `[-PRESSURE_MARGIN, 1 + PRESSURE_MARGIN]`.
     pressure_bounds: (T, T),
     state: [T; 4],
@@ -215,7 +204,6 @@ impl<F: Float, T: Real> Twin<F, T> {
         Ok(Twin {
             fine_engine,
             h_a_x: T::from_f64(h) * coefficients.a_x,
-            held_part: T::from_f64(1.0 / HELD_STEPS as f64),
             abrupt_threshold: T::from_f64(ABRUPT_CHANGE),
             coefficients,
             engine,
@@ -281,18 +269,29 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// actually makes:
     /// * held on a stop (on it, at rest, the static force of the current
     ///   pressures pushing into it), the substep is integrated held (`w = 0`
-    ///   throughout). If the force at its end pulls away, the release time
-    ///   is located (Illinois on the held force, [`RELEASE_ITERATIONS`]
-    ///   held steps): held up to it, free after it;
+    ///   throughout). If the force at its end pulls away, the plunger is
+    ///   released where the force, interpolated over the step, crosses zero:
+    ///   held up to it, free after it;
     /// * moving freely, a substep that ends beyond a stop is redone up to
     ///   the impact (located on the step's cubic Hermite interpolant of
     ///   `xi`), the plunger stops there (inelastic: `w = 0`), and the rest of
-    ///   the substep is integrated held.
+    ///   the substep is held, or free if the force there pulls it off again
+    ///   (a touch).
+    ///
+    /// After an abrupt change of the coefficients ([`ABRUPT_CHANGE`], set
+    /// by [`Twin::set_fluid`]) the tick's first substep is graded: taken in
+    /// pieces growing geometrically from at most [`GRADED_FIRST`], so that
+    /// the transients the change starts (pressures re-equilibrating in
+    /// microseconds, the plunger accelerating into its new motion) are
+    /// followed, not stepped over.
     ///
     /// Whatever the tick's phase, a release and an impact are placed where
     /// the force and the motion put them, not at a substep's boundary. The
-    /// cost is bounded: a quiet substep is one step; one with an event is
-    /// at most two free and `RELEASE_ITERATIONS + 2` held steps.
+    /// cost is bounded: a substep is one step of the scheme; one with
+    /// events at most [`EVENTS_PER_SUBSTEP`] of them, each adding one free
+    /// or one held step; a graded substep at most [`MAX_GRADED_PIECES`]
+    /// such pieces (host simulations of abrupt steps: the estimator never
+    /// changes the coefficients abruptly).
     pub fn tick(&mut self) -> Result<TickReport, StepError> {
         let mut impact = false;
         let mut graded = self.abrupt;
@@ -435,12 +434,12 @@ impl<F: Float, T: Real> Twin<F, T> {
     }
 
     /// Held on a stop from `y` over `frac` of a substep: the plunger at
-    /// rest, the pressures in one step while the hold is quiet, else in
-    /// `HELD_STEPS` equal steps (a pressure transient after a change of
-    /// temperature decides when the plunger lifts off: it is followed, not
-    /// stepped over). When the held force pulls away at a step's end and
-    /// `events` remain, the release is located (Illinois on the held force)
-    /// and the piece goes on free from there.
+    /// rest, the pressures in one step. When the held force pulls away at
+    /// the step's end and `events` remain, the plunger is released where
+    /// the force, interpolated linearly over the step, crosses zero (exact
+    /// for the slow drift of a ramp; after an abrupt change the graded
+    /// tick's short pieces follow the transient) and the piece goes on free
+    /// from there.
     fn held_piece(
         &self,
         y: &[T; 4],
@@ -455,58 +454,30 @@ impl<F: Float, T: Real> Twin<F, T> {
         *carry = T::ZERO;
         let away = |s: &[T; 4]| away_from(c, held, s);
         let y0 = [y[0], T::ZERO, y[2], y[3]];
-        // One step first: a quiet hold (the force into the stop and
-        // changing by less than half of what is left of it) is done.
-        let whole = self.step(&y0, frac, held, carry, fine)?;
-        let (f0, f1) = (away(&y0), away(&whole));
-        let quiet = f1 <= T::ZERO && (f1 - f0).abs() <= T::HALF * f1.abs();
-        if quiet || (fine && f1 <= T::ZERO) {
-            return Ok((whole, false));
+        let end = self.step(&y0, frac, held, carry, fine)?;
+        let (f0, f1) = (away(&y0), away(&end));
+        if f1 <= T::ZERO || events == 0 {
+            return Ok((end, false));
         }
-        // A transient: followed in HELD_STEPS steps, the release located.
-        // (A graded piece is short already: one step.)
-        let (steps, part) = match (fine, frac == T::ONE) {
-            (true, _) => (1, frac),
-            (false, true) => (HELD_STEPS, self.held_part),
-            (false, false) => (HELD_STEPS, frac * self.held_part),
+        if f0 > T::ZERO {
+            // Held although pulled away at the start (the piece after an
+            // impact at its start): released there.
+            return self.free_piece(&y0, frac, carry, events - 1, fine);
+        }
+        // Released where the held force, interpolated linearly over the
+        // step, crosses zero.
+        let theta = f0 / (f0 - f1);
+        let at = if theta > T::ZERO {
+            let mut no_carry = T::ZERO;
+            self.step(&y0, frac * theta, held, &mut no_carry, fine)?
+        } else {
+            y0
         };
-        let mut start = y0;
-        let mut t0 = T::ZERO;
-        for _ in 0..steps {
-            let end = if steps == 1 {
-                whole
-            } else {
-                self.step(&start, part, held, carry, fine)?
-            };
-            let f1 = away(&end);
-            if f1 > T::ZERO && events > 0 {
-                let f0 = away(&start);
-                if f0 > T::ZERO {
-                    // Held although pulled away at the start (the piece
-                    // after an impact at its start): released there.
-                    return self.free_piece(&start, frac - t0, carry, events - 1, fine);
-                }
-                // The first bracketed time at which the held force pulls away.
-                let mut at = end;
-                let (_, theta) = illinois(f0, f1, RELEASE_ITERATIONS, |t| {
-                    let mut no_carry = T::ZERO;
-                    let s = self.step(&start, part * t, held, &mut no_carry, fine)?;
-                    let f = away(&s);
-                    if f > T::ZERO {
-                        at = s;
-                    }
-                    Ok(f)
-                })?;
-                let rest = frac - (t0 + part * theta);
-                if !(rest > T::ZERO) {
-                    return Ok((at, false));
-                }
-                return self.free_piece(&at, rest, carry, events - 1, fine);
-            }
-            start = end;
-            t0 += part;
+        let rest = frac * (T::ONE - theta);
+        if !(rest > T::ZERO) {
+            return Ok((at, false));
         }
-        Ok((start, false))
+        self.free_piece(&at, rest, carry, events - 1, fine)
     }
 
     /// The fraction of a free step `y -> next` of `frac` substeps at which
