@@ -5,6 +5,7 @@ use crate::commands::{CliError, load_params};
 use crate::csv::Table;
 use crate::temps;
 use compensator::ModelError;
+use compensator::dynamics::config::{Choice, TARGET_PCT, choose};
 use compensator::dynamics::linear::linearise;
 use compensator::dynamics::reduced::ReducedTwin;
 use compensator::dynamics::schemes::StepError;
@@ -103,10 +104,11 @@ impl<F: Float, T: Real> Ticking<F> for ReducedTwin<F, T> {
 /// to second order).
 fn run<F: Float>(
     twin: Result<impl Ticking<F>, ModelError>,
-    tick: f64,
+    config: &TwinConfig,
     prof: &Profile,
     n: usize,
 ) -> Result<Response, CliError> {
+    let tick = config.tick;
     let mut twin = twin.map_err(|e| CliError::Input(format!("--from: {e}")))?;
     let mut out = Response {
         time: vec![0.0],
@@ -116,7 +118,13 @@ fn run<F: Float>(
         let t_mid = prof.temperature((k as f64 + 0.5) * tick);
         twin.set_temperature(F::from_f64(t_mid))
             .map_err(|e| CliError::Input(format!("temperature {t_mid} C: {e}")))?;
-        twin.tick().map_err(|e| CliError::Failed(format!("tick {k}: {e:?}")))?;
+        twin.tick().map_err(|e| {
+            CliError::Failed(format!(
+                "tick {k} (t = {} s), {}: {e}",
+                k as f64 * tick,
+                describe(config)
+            ))
+        })?;
         out.time.push((k + 1) as f64 * tick);
         out.state.push(widen(twin.state()));
     }
@@ -130,7 +138,7 @@ fn run_twin<F: Float, T: Real>(
     n: usize,
 ) -> Result<Response, CliError> {
     let twin = Twin::<F, T>::new(params, config, F::from_f64(prof.start()));
-    run(twin, config.tick, prof, n)
+    run(twin, &config, prof, n)
 }
 
 /// Simulates `prof` for `n` ticks of `config.tick` with the chosen precision.
@@ -151,7 +159,7 @@ pub fn simulate(
         Precision::FixedQ24 => run_twin::<f32, compensator::scalar::Q8_24>(&p32()?, config, prof, n),
         Precision::Reduced => {
             let twin = ReducedTwin::<f64, f64>::new(&p64()?, config, prof.start());
-            run(twin, config.tick, prof, n)
+            run(twin, &config, prof, n)
         }
         Precision::Reference => {
             // The profile's temperatures must be evaluable before the solver runs.
@@ -214,7 +222,112 @@ pub fn tick_count(t_end: f64, dt: f64) -> Result<usize, CliError> {
     Ok(n as usize)
 }
 
-/// `step`: response table.
+/// `scheme x substeps per tick`, e.g. `sdirk3, 2 substeps per 0.001 s tick`.
+pub fn describe(config: &TwinConfig) -> String {
+    format!(
+        "{}, {} substep{} per {} s tick",
+        config.scheme.name(),
+        config.substeps,
+        if config.substeps == 1 { "" } else { "s" },
+        config.tick
+    )
+}
+
+/// The chooser's configuration of the twin for a parameter file at `tick`
+/// [s], over the file's validated range (`[estimator] valid_min`,
+/// `valid_max`).
+pub fn chosen(raw: &RawParams, tick: f64) -> Result<Choice, CliError> {
+    let p = Params::<f64>::new(raw).map_err(|e| CliError::Input(e.to_string()))?;
+    let valid = (raw.estimator.valid_min, raw.estimator.valid_max);
+    choose(&p, tick, valid).map_err(|e| {
+        CliError::Failed(format!(
+            "choosing the twin's substeps over {}-{} C at a {tick} s tick: {e}",
+            valid.0, valid.1
+        ))
+    })
+}
+
+/// `--substeps` within `1..=MAX_SUBSTEPS`.
+fn check_substeps(substeps: Option<u8>) -> Result<(), CliError> {
+    match substeps {
+        Some(n) if n == 0 || n > compensator::dynamics::twin::MAX_SUBSTEPS => Err(CliError::Input(format!(
+            "--substeps: {n} is not in 1..={}",
+            compensator::dynamics::twin::MAX_SUBSTEPS
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// The twin configuration of a run: the chooser's for the file at `tick`
+/// [s], with `--scheme` and `--substeps` overriding their fields (an
+/// explicit `--substeps` alone runs SDIRK3, the chooser's scheme, without
+/// running the chooser). Also returns the one line saying so.
+pub fn resolve_config(
+    raw: &RawParams,
+    tick: f64,
+    scheme: Option<Scheme>,
+    substeps: Option<u8>,
+) -> Result<(TwinConfig, String), CliError> {
+    check_substeps(substeps)?;
+    if let Some(substeps) = substeps {
+        let config = TwinConfig {
+            scheme: scheme.unwrap_or(Scheme::Sdirk3),
+            tick,
+            substeps,
+        };
+        let given = if scheme.is_some() {
+            "--scheme and --substeps"
+        } else {
+            "--substeps"
+        };
+        let line = format!("{}; from {given}, accuracy not estimated", describe(&config));
+        return Ok((config, line));
+    }
+    let choice = chosen(raw, tick)?;
+    let estimate = format!(
+        "over the validated {}-{} C: estimated error {:.3} % of a step, target {TARGET_PCT} %: {}",
+        raw.estimator.valid_min,
+        raw.estimator.valid_max,
+        choice.estimated_error_pct,
+        if choice.goal_met {
+            "met"
+        } else {
+            "NOT met (the finest candidate)"
+        }
+    );
+    Ok(match scheme {
+        Some(scheme) if scheme != choice.config.scheme => {
+            let config = TwinConfig {
+                scheme,
+                ..choice.config
+            };
+            let line = format!(
+                "{}; scheme from --scheme, substeps chosen for {} {estimate}",
+                describe(&config),
+                choice.config.scheme.name()
+            );
+            (config, line)
+        }
+        _ => (
+            choice.config,
+            format!("{}; chosen {estimate}", describe(&choice.config)),
+        ),
+    })
+}
+
+/// What `step` writes: the response table (standard output) and the one
+/// line naming what computed it (standard error).
+#[derive(Clone, Debug)]
+pub struct StepOutput {
+    /// CSV `time_s,x_m,v_m_s,p_a_pa,p_b_pa`.
+    pub csv: String,
+    /// The configuration used, in one line.
+    pub note: String,
+}
+
+/// `step`: response table. The twin's configuration is the chooser's for
+/// the file at `dt` unless `scheme` or `substeps` override it
+/// ([`resolve_config`]).
 #[allow(clippy::too_many_arguments)]
 pub fn step(
     path: &Path,
@@ -224,29 +337,73 @@ pub fn step(
     dt: f64,
     t_end: Option<f64>,
     precision: Precision,
-    scheme: Scheme,
-    substeps: u8,
-) -> Result<String, CliError> {
+    scheme: Option<Scheme>,
+    substeps: Option<u8>,
+) -> Result<StepOutput, CliError> {
     let (raw, _) = load_params::<f64>(path)?;
     let prof = profile(from, to, ramp)?;
-    if substeps == 0 || substeps > compensator::dynamics::twin::MAX_SUBSTEPS {
-        return Err(CliError::Input(format!(
-            "--substeps: {substeps} is not in 1..={}",
-            compensator::dynamics::twin::MAX_SUBSTEPS
-        )));
-    }
     let n = tick_count(t_end.unwrap_or_else(|| default_t_end(&prof)), dt)?;
-    let config = TwinConfig {
-        scheme,
-        tick: dt,
-        substeps,
+    check_substeps(substeps)?;
+    let (config, note) = if precision == Precision::Reference {
+        if n > reference::MAX_SAMPLES {
+            return Err(CliError::Input(format!(
+                "--t-end / --dt: {n} output samples exceed the reference solver's limit of {} \
+                 (at least one solver step each); use a larger --dt or a shorter --t-end",
+                reference::MAX_SAMPLES
+            )));
+        }
+        let config = TwinConfig {
+            tick: dt,
+            ..TwinConfig::SHIPPED
+        };
+        (
+            config,
+            format!("reference: Radau5 (rtol 1e-12), sampled every {dt} s; --scheme and --substeps do not apply"),
+        )
+    } else {
+        let (config, line) = resolve_config(&raw, dt, scheme, substeps)?;
+        let model = if precision == Precision::Reduced {
+            format!(
+                "reduced model (runs {} for {})",
+                config.scheme.generic().name(),
+                config.scheme.name()
+            )
+        } else {
+            "twin".to_string()
+        };
+        (config, format!("{model}: {line}"))
     };
     let r = simulate(&raw, precision, config, &prof, n)?;
     let mut table = Table::new(&["time_s", "x_m", "v_m_s", "p_a_pa", "p_b_pa"]);
     for (t, s) in r.time.iter().zip(&r.state) {
         table.row(&[*t, s.x, s.v, s.p_a, s.p_b]);
     }
-    Ok(table.as_str().to_string())
+    Ok(StepOutput {
+        csv: table.as_str().to_string(),
+        note,
+    })
+}
+
+/// `twin-config`: the chooser's configuration for a parameter file at
+/// `dt` [s], one CSV row.
+pub fn twin_config(path: &Path, dt: f64) -> Result<String, CliError> {
+    if !(dt > 0.0 && dt.is_finite()) {
+        return Err(CliError::Input(format!("--dt: {dt} must be positive")));
+    }
+    let (raw, _) = load_params::<f64>(path)?;
+    let c = chosen(&raw, dt)?;
+    Ok(format!(
+        "scheme,substeps,tick_s,valid_min_c,valid_max_c,estimated_error_pct,target_pct,goal_met\n\
+         {},{},{},{},{},{},{},{}\n",
+        c.config.scheme.name(),
+        c.config.substeps,
+        c.config.tick,
+        raw.estimator.valid_min,
+        raw.estimator.valid_max,
+        c.estimated_error_pct,
+        TARGET_PCT,
+        c.goal_met
+    ))
 }
 
 /// `eigen`: eigenvalues of the linearisation per temperature.

@@ -5,7 +5,7 @@
 //! naming the field; nothing is written to stdout then.
 
 use clap::{Parser, Subcommand, ValueEnum};
-use compensator::dynamics::{Scheme, TwinConfig};
+use compensator::dynamics::Scheme;
 use compensator_cli::commands::{self, CliError};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -80,6 +80,9 @@ enum Command {
         temps: String,
     },
     /// Response to a temperature step or ramp (FSI model, Eqs. 33-36).
+    ///
+    /// The twin runs what `twin-config` chooses for the file at --dt unless
+    /// --scheme or --substeps override it; stderr names the configuration.
     Step {
         #[arg(long)]
         params: PathBuf,
@@ -101,12 +104,24 @@ enum Command {
         /// Scalar type, the reduced model, or the adaptive reference solver.
         #[arg(long, value_enum, default_value = "f64")]
         precision: compensator_cli::dynamics::Precision,
-        /// One-step scheme of the twin (default: the shipped one).
-        #[arg(long, default_value = TwinConfig::SHIPPED.scheme.name(), value_parser = scheme_parser())]
-        scheme: Scheme,
-        /// Steps per tick (default: the shipped number).
-        #[arg(long, default_value_t = TwinConfig::SHIPPED.substeps)]
-        substeps: u8,
+        /// One-step scheme of the twin, overriding the chosen one (sdirk3).
+        #[arg(long, value_parser = scheme_parser())]
+        scheme: Option<Scheme>,
+        /// Steps per tick, overriding the chosen number (alone: with sdirk3).
+        #[arg(long)]
+        substeps: Option<u8>,
+    },
+    /// The twin's scheme and substeps per tick chosen for a file (CSV).
+    ///
+    /// Chosen from the design's own dynamics over the file's validated
+    /// range ([estimator] valid_min, valid_max): the cheapest substep count
+    /// whose estimated error stays within the target (% of a step).
+    TwinConfig {
+        #[arg(long)]
+        params: PathBuf,
+        /// Tick [s].
+        #[arg(long, default_value = "0.001", allow_hyphen_values = true)]
+        dt: f64,
     },
     /// Eigenvalues of the linearisation at the equilibrium (Eq. 37).
     Eigen {
@@ -199,7 +214,12 @@ fn run(cli: Cli) -> Result<String, CliError> {
             precision,
             scheme,
             substeps,
-        } => compensator_cli::dynamics::step(&params, from, to, ramp, dt, t_end, precision, scheme, substeps),
+        } => {
+            let out = compensator_cli::dynamics::step(&params, from, to, ramp, dt, t_end, precision, scheme, substeps)?;
+            eprintln!("{}", out.note);
+            Ok(out.csv)
+        }
+        Command::TwinConfig { params, dt } => compensator_cli::dynamics::twin_config(&params, dt),
         Command::Eigen { params, temps } => compensator_cli::dynamics::eigen(&params, &temps),
         Command::Indicators {
             params,

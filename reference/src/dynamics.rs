@@ -270,6 +270,28 @@ pub enum Method {
     Dop853,
 }
 
+/// Most output samples (`t_end / dt`) a run may ask for. The solver's step
+/// is capped at `dt` (so that no sample interval hides a transient), so a
+/// run takes at least one Radau step per sample: about 4 us a sample with
+/// the solver optimised (the paper preset's 500 s ramp at `dt` = 1 ms,
+/// 500,000 samples: 2 s), plus 40 bytes a sample for the trajectory and
+/// about 100 for the CLI's CSV. 5,000,000 samples are then about 20 s and
+/// 0.7 GB; beyond that a run is refused up front instead of failing or
+/// exhausting memory half-way.
+pub const MAX_SAMPLES: usize = 5_000_000;
+
+/// Steps one phase of `span` [s] may take with steps capped at `h_max`:
+/// four times the least number, for rejected steps and the short steps
+/// around transients and events, plus a fixed reserve for the stiff start
+/// of a phase (a step or a release).
+pub fn step_budget(span: f64, h_max: f64) -> usize {
+    4 * (span / h_max).ceil() as usize + 100_000
+}
+
+/// Least step budget of DOP853 per phase: explicit, its steps are bounded
+/// by the pressures' stiffness (eigenvalues up to ~1e8 1/s), not by `dt`.
+const DOP853_FLOOR: usize = 100_000_000;
+
 /// A reference trajectory sampled on a uniform grid.
 #[derive(Clone, Debug)]
 pub struct Trajectory {
@@ -318,7 +340,14 @@ pub fn simulate(
     if !(t_end > 0.0 && dt > 0.0 && rtol > 0.0) {
         return Err("t_end, dt and rtol must be positive".into());
     }
-    let n = (t_end / dt).round() as usize;
+    let samples = (t_end / dt).round();
+    if samples > MAX_SAMPLES as f64 {
+        return Err(format!(
+            "t_end / dt = {t_end} s / {dt} s: {samples} output samples exceed the reference solver's \
+             limit of {MAX_SAMPLES} (at least one step each); use a larger dt"
+        ));
+    }
+    let n = samples as usize;
     if n == 0 {
         return Err(format!("dt = {dt} s is more than twice t_end = {t_end} s"));
     }
@@ -362,6 +391,10 @@ pub fn simulate(
         };
         phase.g_prev = Some(phase.g(&y).0);
         let h_max = dt.min(phase_end - t);
+        // The steps are capped at `dt`: a long run needs at least
+        // `(phase_end - t) / dt` of them, more than the library's default
+        // budget (100,000 for Radau5), so the budget follows the run.
+        let budget = step_budget(phase_end - t, h_max);
         let steps = match method {
             Method::Radau5 => solve(
                 &sys,
@@ -369,7 +402,12 @@ pub fn simulate(
                 phase_end,
                 y,
                 &mut phase,
-                ImplicitRungeKutta::radau5().rtol([rtol; 4]).atol(atol).h_max(h_max),
+                ImplicitRungeKutta::radau5()
+                    .rtol([rtol; 4])
+                    .atol(atol)
+                    .h_max(h_max)
+                    .max_steps(budget),
+                budget,
             )?,
             Method::Dop853 => solve(
                 &sys,
@@ -381,7 +419,8 @@ pub fn simulate(
                     .rtol(rtol)
                     .atol(atol)
                     .h_max(h_max)
-                    .max_steps(100_000_000),
+                    .max_steps(budget.max(DOP853_FLOOR)),
+                budget.max(DOP853_FLOOR),
             )?,
         };
         out.steps += steps;
@@ -421,10 +460,24 @@ pub fn simulate(
     Ok(out)
 }
 
-fn solve<M>(sys: &Fsi, t0: f64, t1: f64, y0: [f64; 4], phase: &mut Phase<'_>, mut method: M) -> Result<usize, String>
+fn solve<M>(
+    sys: &Fsi,
+    t0: f64,
+    t1: f64,
+    y0: [f64; 4],
+    phase: &mut Phase<'_>,
+    mut method: M,
+    budget: usize,
+) -> Result<usize, String>
 where
     M: OrdinaryNumericalMethod<f64, [f64; 4]> + Interpolation<f64, [f64; 4]>,
 {
-    let sol = solve_ode(&mut method, sys, t0, t1, &y0, phase).map_err(|e| format!("{e:?}"))?;
+    let sol = solve_ode(&mut method, sys, t0, t1, &y0, phase).map_err(|e| match e {
+        Error::MaxSteps { t, .. } => format!(
+            "the solver used its budget of {budget} steps between t = {t0} s and t = {t1} s \
+             (stopped at t = {t} s)"
+        ),
+        e => format!("{e:?}"),
+    })?;
     Ok(sol.steps.accepted)
 }
