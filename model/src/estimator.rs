@@ -10,21 +10,26 @@
 //!    the one before: then it is a real step and the filter jumps to it;
 //! 2. a first-order filter (time constant `filter_time_constant`) follows
 //!    the last accepted sample;
-//! 3. one temperature-only job runs, in turn: the oil's properties at the
-//!    filtered temperature (one Walther evaluation, handed to the twin and
-//!    the flow laws); the closed-form equilibrium with `dx/dt` (Eq. 31); the
-//!    Routh-Hurwitz stability of the linearisation at that equilibrium; the
-//!    machine's losses. None runs on a telemetry tick (at most every second
-//!    tick). Each result is thus refreshed every four non-telemetry ticks
+//! 3. the twin advances one tick (its coefficients from the last Fluid
+//!    job);
+//! 4. one temperature-only job runs, in turn: the oil's properties (one
+//!    Walther evaluation, handed to the twin and the flow laws) at the
+//!    filtered temperature, reached at a bounded slew ([`TWIN_SLEW`]: the
+//!    twin never sees an abrupt change, and while it is on its way every
+//!    job is this one); the closed-form equilibrium with `dx/dt` (Eq. 31);
+//!    the Routh-Hurwitz stability of the linearisation at that equilibrium;
+//!    the machine's losses. None runs on a telemetry tick (at most every
+//!    second tick), nor on a tick where the twin had an event (an impact, a
+//!    release: a few steps more), which also moves a due telemetry record
+//!    to the next tick. Each result is thus refreshed every four job ticks
 //!    (4 ms at the default 1 kHz and 2 Hz telemetry: fluid properties five
 //!    times the MAX31865's 50 Hz rate), while the oil's temperature changes
 //!    over seconds. A job the model refuses keeps its previous results and
 //!    flags the estimate `DEGRADED` until it succeeds again;
-//! 4. the twin advances one tick;
 //! 5. flows and the compensation error follow from the twin's state.
 //!
 //! A consistency check catches a twin that settled where the physics does
-//! not: once the filtered temperature has stayed within [`STEADY_BAND`] for
+//! not: once the twin's temperature has stayed within [`STEADY_BAND`] for
 //! [`SETTLE_TIME_CONSTANTS`] of the twin's slowest time constants (the
 //! decay rate of the slowest mode of the linearisation, found by the
 //! Stability job), every Equilibrium job compares the twin's state with the
@@ -369,6 +374,11 @@ pub struct Estimator {
     /// The last check re-seated the twin (raises `TWIN_RESEATED` until a
     /// check finds it in agreement).
     reseated: bool,
+    /// This tick's estimate is to be published ([`Estimator::telemetry_due`]).
+    publish: bool,
+    /// A publication was due on a tick the twin spent on an event: the
+    /// next tick publishes.
+    telemetry_pending: bool,
 }
 
 /// Results that depend on the temperature only. Each tick that is not a
@@ -504,6 +514,8 @@ impl Estimator {
             reseats: 0,
             checks: 0,
             reseated: false,
+            publish: false,
+            telemetry_pending: false,
         })
     }
 
@@ -702,7 +714,26 @@ impl Estimator {
     }
 
     fn update(&mut self, t: f32, flags: &mut Flags) -> Result<StateEstimate, ModelError> {
-        if !self.telemetry_due() {
+        // The twin first: its events (an impact, a release) cost it a few
+        // steps more, and the tick then runs neither a job nor telemetry
+        // (both wait for the next tick), so that the worst tick stays the
+        // twin's plain tick plus the larger of one job or the telemetry.
+        let p = &self.params;
+        let eventful = match self.twin.tick() {
+            Ok(report) => report.eventful(),
+            Err(_) => {
+                // A failed step (never seen with valid parameters): restart
+                // from the equilibrium rather than continue from garbage.
+                self.twin = Twin::new(p, self.twin.config(), self.statics.point.state.temperature)?;
+                flags.insert(Flags::DEGRADED);
+                true
+            }
+        };
+        let due = self.telemetry_pending
+            || (self.config.telemetry_every > 0 && self.tick.is_multiple_of(self.config.telemetry_every));
+        self.publish = due && !eventful;
+        self.telemetry_pending = due && eventful;
+        if !due && !eventful {
             // The steady stretch, counted in ticks that run a job (a
             // telemetry tick only publishes): the window in time is at
             // least as long, and the telemetry tick, the costliest, is
@@ -753,12 +784,6 @@ impl Estimator {
             flags.insert(Flags::TWIN_RESEATED);
         }
         let p = &self.params;
-        if self.twin.tick().is_err() {
-            // A failed step (never seen with valid parameters): restart
-            // from the equilibrium rather than continue from garbage.
-            self.twin = Twin::new(p, self.twin.config(), self.statics.point.state.temperature)?;
-            flags.insert(Flags::DEGRADED);
-        }
         if !self.statics.stable {
             flags.insert(Flags::UNSTABLE);
         }
@@ -835,9 +860,11 @@ impl Estimator {
         self.since_sample = 0;
     }
 
-    /// `true` when this tick's estimate should be published.
+    /// `true` when this tick's estimate should be published: every
+    /// `telemetry_every` ticks, a tick later when the twin had an event on
+    /// the scheduled one.
     pub fn telemetry_due(&self) -> bool {
-        self.config.telemetry_every > 0 && self.tick.is_multiple_of(self.config.telemetry_every)
+        self.publish
     }
 }
 

@@ -231,38 +231,50 @@ fn pieces(params: &Params<f32>) -> Result<(), &'static str> {
     info!("[measure] piece name=estimator-reseat-tick total={=u32}", worst);
 
     // The whole estimator tick, as the firmware runs it: a sample every
-    // 20 ticks, a 30 -> 40 C step; with telemetry packed at its cadence
-    // (every 100 ticks here), then without telemetry.
-    for telemetry in [true, false] {
-        let mut config = config;
-        config.telemetry_every = if telemetry { 100 } else { 0 };
-        let mut est = Estimator::new(params, config, 30.0).map_err(|_| "estimator cannot start")?;
-        let (mut total, mut worst, mut worst_tick) = (0u32, 0u32, 0u32);
-        let n = 1000u32;
-        for k in 0..n {
-            let sample = if k % 20 == 0 { Ok(Some(40.0f32)) } else { Ok(None) };
-            let (_, c) = counts(|| {
-                let e = est.tick(black_box(sample));
-                if est.telemetry_due() {
-                    info!("estimate {}", e);
+    // 20 ticks; a 30 -> 40 C step (taken as real by the spike filter, then
+    // followed by the twin at its slew), and ramps at 4 C/s from 26 C to
+    // 46 C and back (the plunger leaves the closed stop and creeps back
+    // onto it: the releases and impacts); with telemetry packed at its
+    // cadence (every 100 ticks here), then without telemetry.
+    for (workload, n) in [("step", 1000u32), ("ramps", 10_000u32)] {
+        for telemetry in [true, false] {
+            let mut config = config;
+            config.telemetry_every = if telemetry { 100 } else { 0 };
+            let start = if workload == "step" { 30.0 } else { 26.0 };
+            let mut est = Estimator::new(params, config, start).map_err(|_| "estimator cannot start")?;
+            let (mut total, mut worst, mut worst_tick) = (0u32, 0u32, 0u32);
+            for k in 0..n {
+                let temperature = if workload == "step" {
+                    40.0f32
+                } else {
+                    let s = k as f32 * 1e-3;
+                    26.0 + 4.0 * if s < 5.0 { s } else { 10.0 - s }
+                };
+                let sample = if k % 20 == 0 { Ok(Some(temperature)) } else { Ok(None) };
+                let (_, c) = counts(|| {
+                    let e = est.tick(black_box(sample));
+                    if est.telemetry_due() {
+                        info!("estimate {}", e);
+                    }
+                });
+                total += c;
+                if c > worst {
+                    worst = c;
+                    worst_tick = k;
                 }
-            });
-            total += c;
-            if c > worst {
-                worst = c;
-                worst_tick = k;
             }
+            info!(
+                "[measure] estimator workload={=str} scheme={=str} substeps={=u8} telemetry={=bool} ticks={=u32} total={=u32} worst={=u32} worst_tick={=u32}",
+                workload,
+                config.twin.scheme.name(),
+                config.twin.substeps,
+                telemetry,
+                n,
+                total,
+                worst,
+                worst_tick
+            );
         }
-        info!(
-            "[measure] estimator scheme={=str} substeps={=u8} telemetry={=bool} ticks={=u32} total={=u32} worst={=u32} worst_tick={=u32}",
-            config.twin.scheme.name(),
-            config.twin.substeps,
-            telemetry,
-            n,
-            total,
-            worst,
-            worst_tick
-        );
     }
     Ok(())
 }

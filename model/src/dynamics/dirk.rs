@@ -254,52 +254,60 @@ impl<T: Real> Dirk<T> {
         } else {
             self.h_gamma * frac
         };
-        let mut ys = [[T::ZERO; 4]; MAX_STAGES];
-        let mut zs = [[T::ZERO; 4]; MAX_STAGES];
-        let mut w_guess = y[1];
+        if contact != Contact::Free {
+            return self.held(c, y, hg);
+        }
+        // Stage increments `Y_j - Z_j`: `Z_i = y + sum_j alpha_ij (Y_j - Z_j)`.
+        let mut d = [[T::ZERO; 4]; MAX_STAGES];
+        let mut yi = *y;
+        let mut sum_w = T::ZERO;
         for i in 0..self.stages {
             let mut z = *y;
             for j in 0..i {
                 let a = self.alpha[i][j];
-                if a != T::ZERO {
-                    for k in 0..4 {
-                        z[k] += a * (ys[j][k] - zs[j][k]);
-                    }
+                for k in 0..4 {
+                    z[k] += a * d[j][k];
                 }
             }
-            let yi = match contact {
-                Contact::Free => self.free_stage(
-                    c,
-                    &z,
-                    hg,
-                    w_guess,
-                    if i == 0 {
-                        FIRST_STAGE_ITERATIONS
-                    } else {
-                        LATER_STAGE_ITERATIONS
-                    },
-                ),
-                Contact::Closed | Contact::Open => {
-                    let (ta, tb) = time_constants(c, y[0]);
-                    let a = chamber(c, ta, hg, T::ONE - z[2], T::ZERO);
-                    let b = chamber(c, tb, hg, z[3], T::ZERO);
-                    [y[0], T::ZERO, T::ONE - a.u, b.u]
-                }
+            let iterations = if i == 0 {
+                FIRST_STAGE_ITERATIONS
+            } else {
+                LATER_STAGE_ITERATIONS
             };
-            w_guess = yi[1];
-            zs[i] = z;
-            ys[i] = yi;
-        }
-        let mut next = ys[self.stages - 1];
-        if contact == Contact::Free {
-            let mut sum = T::ZERO;
-            for (yj, hb) in ys.iter().zip(&self.h_b).take(self.stages) {
-                sum += *hb * yj[1];
+            // The velocity guess: the previous stage's.
+            yi = self.free_stage(c, &z, hg, yi[1], iterations);
+            for k in 0..4 {
+                d[i][k] = yi[k] - z[k];
             }
-            let h_a_x = if frac == T::ONE { c.a_x } else { c.a_x * frac };
-            next[0] = y[0].mul_add_compensated(h_a_x, sum, xi_carry);
+            sum_w += self.h_b[i] * yi[1];
         }
-        next
+        // xi + h a_x sum_i b_i w_i, compensated (exact for xi' = a_x w).
+        let h_a_x = if frac == T::ONE { c.a_x } else { c.a_x * frac };
+        yi[0] = y[0].mul_add_compensated(h_a_x, sum_w, xi_carry);
+        yi
+    }
+
+    /// A held step: `xi` kept, `w = 0`, each chamber's pressure alone (the
+    /// stages in the chambers' orifice drops).
+    fn held(&self, c: &Coefficients<T>, y: &State<T>, hg: T) -> State<T> {
+        let (ta, tb) = time_constants(c, y[0]);
+        let (ua0, ub0) = (T::ONE - y[2], y[3]);
+        let (mut ua, mut ub) = (ua0, ub0);
+        let mut da = [T::ZERO; MAX_STAGES];
+        let mut db = [T::ZERO; MAX_STAGES];
+        for i in 0..self.stages {
+            let (mut za, mut zb) = (ua0, ub0);
+            for j in 0..i {
+                let a = self.alpha[i][j];
+                za += a * da[j];
+                zb += a * db[j];
+            }
+            ua = chamber(c, ta, hg, za, T::ZERO).u;
+            ub = chamber(c, tb, hg, zb, T::ZERO).u;
+            da[i] = ua - za;
+            db[i] = ub - zb;
+        }
+        [y[0], T::ZERO, T::ONE - ua, ub]
     }
 
     /// The free stage `Y = Z + h gamma f(Y)`: `iterations` Newton
@@ -312,9 +320,12 @@ impl<T: Real> Dirk<T> {
         let base = T::ONE + hg * c.two_zeta + hg * hg;
         let mut w = w0;
         let mut out = [T::ZERO; 4];
+        // The chambers' time constants at the stage's known displacement:
+        // the volumes change by `eps` (a few percent) over a whole stroke,
+        // and by far less over a stage.
+        let (ta, tb) = time_constants(c, z[0]);
         for _ in 0..iterations.max(1) {
             let xi = z[0] + hg_a_x * w;
-            let (ta, tb) = time_constants(c, xi);
             let a = chamber(c, ta, hg, u_za, w);
             let b = chamber(c, tb, hg, z[3], w);
             let force = c.phi_over_a_x * (b.u - (T::ONE - a.u)) - (c.xi0 + xi) * c.inv_a_x;

@@ -67,9 +67,26 @@ impl TwinConfig {
 pub struct TickReport {
     /// Contact state at the end of the tick.
     pub contact: Contact,
-    /// A substep ended beyond a stop and was put on it (an impact).
+    /// The plunger hit a stop during the tick (an inelastic impact).
     pub impact: bool,
+    /// The plunger left a stop during the tick (a release).
+    pub release: bool,
+    /// The tick's first substep was graded (after an abrupt change).
+    pub graded: bool,
 }
+
+impl TickReport {
+    /// The tick did more than its plain substeps (an event or a graded
+    /// substep): what a caller with a budget per tick defers work after.
+    pub fn eventful(&self) -> bool {
+        self.impact || self.release || self.graded
+    }
+}
+
+/// Events of a piece of a substep (bit set).
+const IMPACT: u8 = 1;
+/// See [`IMPACT`].
+const RELEASE: u8 = 2;
 
 /// Bound on the chamber pressures, in units of `dp` beyond `[p_c, p_p]`,
 /// past which a tick is reported as [`StepError::Diverged`]. The physical
@@ -78,10 +95,6 @@ pub struct TickReport {
 /// water-hammer-like transient, well under one `dp` on every surveyed design
 /// (`host-tests/tests/survey.rs` records the reference's largest excursion).
 pub const PRESSURE_MARGIN: f64 = 4.0;
-
-/// Iterations of the impact-time search on the step's cubic Hermite
-/// interpolant (no model evaluation).
-pub const IMPACT_ITERATIONS: u8 = 6;
 
 /// Pieces of a graded substep (see [`Twin::tick`]): the first is
 /// `2^-(pieces - 1)` of the substep, no longer than [`GRADED_FIRST`].
@@ -99,7 +112,7 @@ pub const ABRUPT_CHANGE: f64 = 0.01;
 /// Stop events (releases, impacts) located inside one substep; a further
 /// one waits for the next substep (an impact then ends on the stop at the
 /// substep's end, a release at its start).
-pub const EVENTS_PER_SUBSTEP: u8 = 2;
+pub const EVENTS_PER_SUBSTEP: u8 = 1;
 
 /// The static force on a plunger held at `held`'s stop, positive when it
 /// pulls the plunger off the stop.
@@ -109,46 +122,6 @@ fn away_from<T: Real>(c: &Coefficients<T>, held: Contact, y: &[T; 4]) -> T {
         Contact::Open => -c.static_force(y),
         _ => c.static_force(y),
     }
-}
-
-/// Illinois regula falsi on `[0, 1]` for a function that is `f0 <= 0` at 0
-/// and `f1 > 0` at 1: `iterations` evaluations, returning the final
-/// bracket `(lo, hi)` (`f(lo) <= 0 < f(hi)`). Fixed cost; the bracket
-/// shrinks superlinearly on smooth functions.
-fn illinois<T: Real>(
-    f0: T,
-    f1: T,
-    iterations: u8,
-    mut f: impl FnMut(T) -> Result<T, StepError>,
-) -> Result<(T, T), StepError> {
-    let (mut lo, mut f_lo, mut hi, mut f_hi) = (T::ZERO, f0, T::ONE, f1);
-    let mut side = 0i8;
-    for _ in 0..iterations {
-        let span = f_hi - f_lo;
-        let mut t = if span > T::ZERO {
-            lo - f_lo * (hi - lo) / span
-        } else {
-            (lo + hi) * T::HALF
-        };
-        if !(t > lo && t < hi) {
-            t = (lo + hi) * T::HALF;
-        }
-        let v = f(t)?;
-        if v > T::ZERO {
-            (hi, f_hi) = (t, v);
-            if side == -1 {
-                f_lo *= T::HALF;
-            }
-            side = -1;
-        } else {
-            (lo, f_lo) = (t, v);
-            if side == 1 {
-                f_hi *= T::HALF;
-            }
-            side = 1;
-        }
-    }
-    Ok((lo, hi))
 }
 
 /// The integrator behind a twin.
@@ -293,21 +266,22 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// such pieces (host simulations of abrupt steps: the estimator never
     /// changes the coefficients abruptly).
     pub fn tick(&mut self) -> Result<TickReport, StepError> {
-        let mut impact = false;
-        let mut graded = self.abrupt;
+        let mut events = 0u8;
+        let graded = self.abrupt;
         self.abrupt = false;
-        for _ in 0..self.substeps {
+        for k in 0..self.substeps {
             let mut carry = self.xi_carry;
-            let (next, hit) = self.substep(&self.state, &mut carry, graded)?;
-            graded = false;
+            let (next, e) = self.substep(&self.state, &mut carry, graded && k == 0)?;
             self.check(&next)?;
-            impact |= hit;
+            events |= e;
             self.state = next;
             self.xi_carry = carry;
         }
         Ok(TickReport {
             contact: self.coefficients.contact(&self.state),
-            impact,
+            impact: events & IMPACT != 0,
+            release: events & RELEASE != 0,
+            graded,
         })
     }
 
@@ -348,7 +322,7 @@ impl<F: Float, T: Real> Twin<F, T> {
 
     /// `frac` of a substep from `y`; `carry` is `xi`'s compensated-summation carry.
     /// `fine`: a piece of a graded substep (see [`Twin::substep`]).
-    fn piece(&self, y: &[T; 4], frac: T, carry: &mut T, fine: bool) -> Result<([T; 4], bool), StepError> {
+    fn piece(&self, y: &[T; 4], frac: T, carry: &mut T, fine: bool) -> Result<([T; 4], u8), StepError> {
         match self.coefficients.contact(y) {
             Contact::Free => self.free_piece(y, frac, carry, EVENTS_PER_SUBSTEP, fine),
             held => self.held_piece(y, frac, held, carry, EVENTS_PER_SUBSTEP, fine),
@@ -361,7 +335,7 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// change starts (the pressures re-equilibrating, the plunger
     /// accelerating into its new motion) is followed rather than stepped
     /// over.
-    fn substep(&self, y: &[T; 4], carry: &mut T, graded: bool) -> Result<([T; 4], bool), StepError> {
+    fn substep(&self, y: &[T; 4], carry: &mut T, graded: bool) -> Result<([T; 4], u8), StepError> {
         if !graded {
             return self.piece(y, T::ONE, carry, false);
         }
@@ -369,23 +343,22 @@ impl<F: Float, T: Real> Twin<F, T> {
         for _ in 1..self.graded_pieces {
             frac *= T::HALF;
         }
-        let (mut state, mut impact) = self.piece(y, frac, carry, true)?;
+        let (mut state, mut events) = self.piece(y, frac, carry, true)?;
         for _ in 1..self.graded_pieces {
-            let (next, hit) = self.piece(&state, frac, carry, true)?;
+            let (next, e) = self.piece(&state, frac, carry, true)?;
             state = next;
-            impact |= hit;
+            events |= e;
             frac = frac + frac;
         }
-        Ok((state, impact))
+        Ok((state, events))
     }
 
     /// Free motion from `y` over `frac` of a substep. A step that ends
-    /// beyond a stop is redone up to the impact (on its cubic Hermite
-    /// interpolant), the plunger stops there (inelastic: `w = 0`) and the
-    /// rest of the piece is held. With no `events` left the impact is not
-    /// located: the plunger is put on the stop and the whole piece held from
-    /// `y`'s pressures (never with the pressures of a motion the stop
-    /// forbids). Returns the state and whether an impact happened.
+    /// beyond a stop stops at the impact (located on its cubic Hermite
+    /// interpolant; the pressures there interpolated over the step) at rest
+    /// (inelastic), and the rest of the piece is held (or free again after
+    /// a touch). With no `events` left the rest is held. Returns the state
+    /// and the events.
     fn free_piece(
         &self,
         y: &[T; 4],
@@ -393,7 +366,7 @@ impl<F: Float, T: Real> Twin<F, T> {
         carry: &mut T,
         events: u8,
         fine: bool,
-    ) -> Result<([T; 4], bool), StepError> {
+    ) -> Result<([T; 4], u8), StepError> {
         let mut tried = *carry;
         let next = self.step(y, frac, Contact::Free, &mut tried, fine)?;
         let (stop, contact) = if next[0] < T::ZERO {
@@ -402,35 +375,35 @@ impl<F: Float, T: Real> Twin<F, T> {
             (T::ONE, Contact::Open)
         } else {
             *carry = tried;
-            return Ok((next, false));
+            return Ok((next, 0));
         };
         *carry = T::ZERO;
-        if events == 0 {
-            let at = [stop, T::ZERO, y[2], y[3]];
-            let (end, _) = self.held_piece(&at, frac, contact, carry, 0, fine)?;
-            return Ok((end, true));
-        }
         let theta = self.impact_fraction(y, &next, frac, stop);
-        let mut at = if theta > T::ZERO {
-            let mut c = T::ZERO;
-            self.step(y, frac * theta, Contact::Free, &mut c, fine)?
-        } else {
-            *y
-        };
+        // The pressures at the impact, interpolated over the step.
+        let mut at = *y;
+        at[2] += theta * (next[2] - y[2]);
+        at[3] += theta * (next[3] - y[3]);
         at[0] = stop;
         at[1] = T::ZERO;
         let rest = frac * (T::ONE - theta);
         if !(rest > T::ZERO) {
-            return Ok((at, true));
+            return Ok((at, IMPACT));
+        }
+        if events == 0 {
+            // No event left: held for the rest (its pressures relax with the
+            // plunger at rest, never with the pumping of a motion the stop
+            // forbids); a lift-off waits for the next substep.
+            let (end, _) = self.held_piece(&at, rest, contact, carry, 0, fine)?;
+            return Ok((end, IMPACT));
         }
         // Held for the rest, unless the plunger travelled before the impact
         // and the force there pulls it off the stop again (a touch).
-        let (end, _) = if theta > T::ZERO && away_from(&self.coefficients, contact, &at) > T::ZERO {
+        let (end, e) = if theta > T::ZERO && away_from(&self.coefficients, contact, &at) > T::ZERO {
             self.free_piece(&at, rest, carry, events - 1, fine)?
         } else {
             self.held_piece(&at, rest, contact, carry, events - 1, fine)?
         };
-        Ok((end, true))
+        Ok((end, e | IMPACT))
     }
 
     /// Held on a stop from `y` over `frac` of a substep: the plunger at
@@ -448,7 +421,7 @@ impl<F: Float, T: Real> Twin<F, T> {
         carry: &mut T,
         events: u8,
         fine: bool,
-    ) -> Result<([T; 4], bool), StepError> {
+    ) -> Result<([T; 4], u8), StepError> {
         let c = &self.coefficients;
         // On the stop exactly: nothing is left to carry.
         *carry = T::ZERO;
@@ -457,12 +430,13 @@ impl<F: Float, T: Real> Twin<F, T> {
         let end = self.step(&y0, frac, held, carry, fine)?;
         let (f0, f1) = (away(&y0), away(&end));
         if f1 <= T::ZERO || events == 0 {
-            return Ok((end, false));
+            return Ok((end, 0));
         }
         if f0 > T::ZERO {
             // Held although pulled away at the start (the piece after an
             // impact at its start): released there.
-            return self.free_piece(&y0, frac, carry, events - 1, fine);
+            let (end, e) = self.free_piece(&y0, frac, carry, events - 1, fine)?;
+            return Ok((end, e | RELEASE));
         }
         // Released where the held force, interpolated linearly over the
         // step, crosses zero.
@@ -475,32 +449,37 @@ impl<F: Float, T: Real> Twin<F, T> {
         };
         let rest = frac * (T::ONE - theta);
         if !(rest > T::ZERO) {
-            return Ok((at, false));
+            return Ok((at, RELEASE));
         }
-        self.free_piece(&at, rest, carry, events - 1, fine)
+        let (end, e) = self.free_piece(&at, rest, carry, events - 1, fine)?;
+        Ok((end, e | RELEASE))
     }
 
     /// The fraction of a free step `y -> next` of `frac` substeps at which
-    /// `xi` first reaches `stop`, on the step's cubic Hermite interpolant
-    /// (no model evaluation; the last bracketed point not beyond the stop).
+    /// `xi` reaches `stop`: the chord's crossing, refined by one Newton step
+    /// on the step's cubic Hermite interpolant (no model evaluation).
     fn impact_fraction(&self, y: &[T; 4], next: &[T; 4], frac: T, stop: T) -> T {
         let hx = self.h_a_x * frac;
-        let (x0, x1, d0, d1) = (y[0], next[0], hx * y[1], hx * next[1]);
-        // Positive: beyond the stop.
-        let sign = if stop == T::ZERO { -T::ONE } else { T::ONE };
-        let beyond = |t: T| {
-            let t2 = t * t;
-            let t3 = t2 * t;
-            let h00 = T::TWO * t3 - (t2 + t2 + t2) + T::ONE;
-            let h10 = t3 - T::TWO * t2 + t;
-            let h01 = (t2 + t2 + t2) - T::TWO * t3;
-            let h11 = t3 - t2;
-            sign * (h00 * x0 + h10 * d0 + h01 * x1 + h11 * d1 - stop)
-        };
-        let r: Result<_, StepError> = illinois(sign * (x0 - stop), sign * (x1 - stop), IMPACT_ITERATIONS, |t| {
-            Ok(beyond(t))
-        });
-        r.map(|(lo, _)| lo).unwrap_or(T::ZERO)
+        // The cubic Hermite interpolant of `xi - stop` over the step, as
+        // `((c3 t + c2) t + c1) t + c0`, and one Newton step on it from the
+        // chord's crossing (the chord alone is exact for a creeping plunger).
+        let (e0, e1) = (y[0] - stop, next[0] - stop);
+        let (d0, d1) = (hx * y[1], hx * next[1]);
+        let c2 = (e1 - e0) * T::TWO + (e1 - e0) - (d0 + d0) - d1;
+        let c3 = (e0 - e1) * T::TWO + d0 + d1;
+        let span = e1 - e0;
+        if span == T::ZERO {
+            return T::ZERO;
+        }
+        let t = (-e0 / span).clamp_to(T::ZERO, T::ONE);
+        let p = ((c3 * t + c2) * t + d0) * t + e0;
+        let dp = (c3 * (t + t + t) + (c2 + c2)) * t + d0;
+        let newton = t - p / dp;
+        if dp != T::ZERO && newton >= T::ZERO && newton <= T::ONE {
+            newton
+        } else {
+            t
+        }
     }
 
     /// The state in SI units.
