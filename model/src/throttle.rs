@@ -161,8 +161,10 @@ mod tests {
     fn regularised_root_keeps_its_resolution_in_fixed_point() {
         use crate::scalar::Fixed;
         for &(u, tr) in &[(5e-4, 1e-5), (1e-5, 1e-5), (2e-6, 1e-5), (0.3, 1e-5), (-7e-4, 1e-5)] {
-            let (v, d) = regularised_root(Fixed::from_f64(u), Fixed::from_f64(tr));
-            let (v64, d64) = regularised_root(u, tr);
+            let (uf, tf) = (Fixed::from_f64(u), Fixed::from_f64(tr));
+            let (v, d) = regularised_root(uf, tf);
+            // Against the same law at the inputs as Q12.20 holds them.
+            let (v64, d64) = regularised_root(uf.to_f64(), tf.to_f64());
             // One LSB of Q12.20 on the inputs moves the value by at most
             // 1e-6 / (2 sqrt(u_tr)) ~ 2e-4 near zero.
             assert!(

@@ -6,7 +6,7 @@
 //!                                                build the board image, flash it with probe-rs
 //! cargo xtask test [--bless]                     everything CI checks (the test command)
 //! cargo xtask build [--params F]                 build every firmware image
-//! cargo xtask bench [--write]                    cost, footprint and stack on the emulated MCUs
+//! cargo xtask bench [--params F] [--write]       cost (the twin as built for F), footprint and stack on the emulated MCUs
 //! cargo xtask callgrind [--bless]                host instruction counts against the baseline
 //! cargo xtask msrv                               rust-version against the locked dependencies
 //! cargo xtask toolchain                          find or provision the cross toolchain
@@ -79,7 +79,7 @@ fn usage() -> ExitCode {
          \n                                  build the board image and run it with probe-rs (RTT log, CSV)\
          \n  test [--bless]                  every check CI runs (host tests, clippy, cross builds, QEMU)\
          \n  build [--params F]              build every firmware image\
-         \n  bench [--write]                 instructions per tick, flash, RAM and stack on the emulated MCUs\
+         \n  bench [--params F] [--write]    instructions per tick (the twin as built for F), flash, RAM and stack\
          \n  callgrind [--bless]             host instruction counts (valgrind) against the baseline\
          \n  msrv                            the workspace's rust-version against the locked dependencies\
          \n  target-tests                    the core's tests on the emulated Cortex-M4F (defmt-test)\

@@ -51,13 +51,15 @@ impl TwinConfig {
         self.tick / self.substeps as f64 / time_unit
     }
 
-    /// What the firmware ships: ROS3 (three-stage, L-stable, order 3), two
-    /// steps per 1 ms tick. The accuracy/cost trade-off against the other
-    /// schemes is in the project's `docs/dynamics.md`.
+    /// The default configuration: SDIRK3 ([`super::dirk`]), one step per
+    /// 1 ms tick, what [`super::config::choose`] picks for the paper
+    /// preset. A device's own configuration is chosen for its parameter
+    /// file (the firmware's build script and the CLI do); the trade-off
+    /// against the other schemes is in the project's `docs/dynamics.md`.
     pub const SHIPPED: TwinConfig = TwinConfig {
         scheme: Scheme::Sdirk3,
         tick: 1.0e-3,
-        substeps: 2,
+        substeps: 1,
     };
 }
 
