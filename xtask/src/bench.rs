@@ -13,6 +13,7 @@
 
 use crate::firmware::Image;
 use crate::qemu;
+#[cfg(feature = "host")]
 use compensator::dynamics::TwinConfig;
 use object::{Object, ObjectSection};
 use std::collections::BTreeMap;
