@@ -32,7 +32,7 @@ fn close(actual: f32, expected: f64, rtol: f64, atol: f64) -> bool {
 
 #[defmt_test::tests]
 mod tests {
-    use super::{EXPECTED, RAW_PARAMS, close};
+    use super::{EXPECTED, RAW_PARAMS, TWIN_SCHEME, TWIN_SUBSTEPS, close};
     use compensator::dynamics::fsi::DynamicState;
     use compensator::dynamics::linear::{hurwitz_stable, linearise};
     use compensator::dynamics::{Twin, TwinConfig};

@@ -656,7 +656,9 @@ impl Estimator {
                 } else {
                     f32::INFINITY
                 };
-                let step = (t - now).clamp(-max_step, max_step);
+                // max/min, not `f32::clamp`: its assertion formats f32 with
+                // core::fmt, 17 KiB of flash on the controller.
+                let step = (t - now).max(-max_step).min(max_step);
                 let point = p.oil.point(now + step)?;
                 statics.slewing = step != t - now;
                 twin.set_fluid(&point.state)?;

@@ -141,8 +141,9 @@ pub struct Twin<F, T> {
     model: Model<F>,
     coefficients: Coefficients<T>,
     engine: Engine<T>,
-    /// The scheme of a graded substep's pieces (see [`Twin::substep`]).
-    fine_engine: Engine<T>,
+    /// The scheme of a graded substep's pieces when the engine is a DIRK
+    /// (see [`Twin::substep`]; a generic engine grades with itself).
+    fine_dirk: Dirk<T>,
     substeps: u8,
     /// The substep length times `a_x` (model units): `xi' = a_x w`.
     h_a_x: T,
@@ -172,12 +173,9 @@ impl<F: Float, T: Real> Twin<F, T> {
             None => Engine::Generic(Stepper::new(config.scheme, h)),
         };
         let coefficients: Coefficients<T> = model.coefficients(&eq.fluid)?;
-        let fine_engine = match config.scheme.dirk() {
-            Some(_) => Engine::Dirk(Dirk::new(&super::dirk::FINE, h)),
-            None => engine,
-        };
+        let fine_dirk = Dirk::new(&super::dirk::FINE, h);
         Ok(Twin {
-            fine_engine,
+            fine_dirk,
             h_a_x: T::from_f64(h) * coefficients.a_x,
             abrupt_threshold: T::from_f64(ABRUPT_CHANGE),
             coefficients,
@@ -304,9 +302,8 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// `xi_carry`: the compensated summation's carry of `xi` (free motion).
     fn step(&self, y: &[T; 4], frac: T, contact: Contact, xi_carry: &mut T, fine: bool) -> Result<[T; 4], StepError> {
         let c = &self.coefficients;
-        let engine = if fine { &self.fine_engine } else { &self.engine };
-        match engine {
-            Engine::Dirk(d) => Ok(d.step(c, y, frac, contact, xi_carry)),
+        match &self.engine {
+            Engine::Dirk(d) => Ok(if fine { &self.fine_dirk } else { d }.step(c, y, frac, contact, xi_carry)),
             Engine::Generic(s) => {
                 let sys = Fsi {
                     coefficients: c,
