@@ -162,14 +162,18 @@ mod tests {
         use crate::scalar::Fixed;
         for &(u, tr) in &[(5e-4, 1e-5), (1e-5, 1e-5), (2e-6, 1e-5), (0.3, 1e-5), (-7e-4, 1e-5)] {
             let (v, d) = regularised_root(Fixed::from_f64(u), Fixed::from_f64(tr));
-            let (v64, d64) = regularised_root(u, tr);
+            let (v64, _) = regularised_root(u, tr);
             // One LSB of Q12.20 on the inputs moves the value by at most
             // 1e-6 / (2 sqrt(u_tr)) ~ 2e-4 near zero.
             assert!(
                 (v.to_f64() - v64).abs() <= 3e-4 * (1.0 + v64.abs()),
                 "value at {u}: {v:?} vs {v64}"
             );
-            assert!((d.to_f64() - d64).abs() <= 2e-2 * d64, "slope at {u}: {d:?} vs {d64}");
+            // The slope against the law at the inputs as Q12.20 holds them:
+            // u_tr = 1e-5 is 10 LSB (4.6 % low), which alone moves the slope
+            // near zero by 2.4 %; the computation adds a few LSB.
+            let (_, d64) = regularised_root(Fixed::from_f64(u).to_f64(), Fixed::from_f64(tr).to_f64());
+            assert!((d.to_f64() - d64).abs() <= 2e-3 * d64, "slope at {u}: {d:?} vs {d64}");
         }
     }
 

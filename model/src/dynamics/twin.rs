@@ -134,8 +134,12 @@ fn illinois<T: Real>(
     let mut side = 0i8;
     for _ in 0..iterations {
         let span = f_hi - f_lo;
+        // The ratio first: `f_lo / span` lies in [-1, 0] and keeps its
+        // resolution in fixed point however small the values near the
+        // root are (`f_lo (hi - lo)` first underflowed to zero there and
+        // left a bisection).
         let mut t = if span > T::ZERO {
-            lo - f_lo * (hi - lo) / span
+            lo - f_lo / span * (hi - lo)
         } else {
             (lo + hi) * T::HALF
         };
@@ -261,12 +265,13 @@ impl<F: Float, T: Real> Twin<F, T> {
 
     /// As [`Twin::set_temperature`] from an already evaluated fluid state.
     /// A change of the capillary conductance by more than
-    /// [`ABRUPT_CHANGE`] (relative) makes the next tick start graded.
+    /// [`ABRUPT_CHANGE`] (relative), or of the flow unit
+    /// ([`super::fsi::flow_shift`]), makes the next tick start graded.
     pub fn set_fluid(&mut self, fluid: &FluidState<F>) -> Result<(), ModelError> {
-        let before = self.coefficients.g_l;
+        let (before, unit) = (self.coefficients.g_l, self.coefficients.flow_shift);
         self.coefficients.set_hydraulic(&self.model, fluid)?;
         let change = (self.coefficients.g_l - before).abs();
-        self.abrupt |= change > self.abrupt_threshold * before;
+        self.abrupt |= change > self.abrupt_threshold * before || self.coefficients.flow_shift != unit;
         Ok(())
     }
 
