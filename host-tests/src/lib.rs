@@ -7,6 +7,8 @@
 
 pub mod accuracy;
 pub mod bench;
+pub mod fixed_audit;
+pub mod probe;
 pub mod random;
 pub mod survey;
 pub use compensator_reference::statics as reference;

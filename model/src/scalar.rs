@@ -48,6 +48,11 @@ pub trait Real:
     const TWO: Self;
     /// A short name for reports (`"f32"`, `"I16F16"`...).
     const NAME: &'static str;
+    /// The type saturates beyond a small range (fixed point): the few
+    /// expressions whose value can exceed it on some designs take a
+    /// scaled form instead (never in floating point, where the plain
+    /// form is cheaper and exact enough).
+    const SATURATES: bool = false;
 
     /// Conversion from a double (rounds; saturates for fixed point).
     fn from_f64(v: f64) -> Self;
@@ -100,6 +105,20 @@ pub trait Real:
         let s = self + d;
         *carry = d - (s - self);
         s
+    }
+    /// `self + a (b_0 c_0 + b_1 c_1 + ...)` (pairs of `b`, `c`),
+    /// compensated as [`Real::mul_add_compensated`]: the products of the
+    /// sum round for floating point (what `mul_add_compensated` of the
+    /// rounded sum gives), not at all for fixed point, where a sum of
+    /// products each below the resolution (a plunger creeping over short
+    /// steps) would otherwise round to zero step after step.
+    #[inline]
+    fn dot_add_compensated(self, a: Self, b: &[Self], c: &[Self], carry: &mut Self) -> Self {
+        let mut sum = Self::ZERO;
+        for (bj, cj) in b.iter().zip(c) {
+            sum += *bj * *cj;
+        }
+        self.mul_add_compensated(a, sum, carry)
     }
 }
 
@@ -514,6 +533,7 @@ mod fixed_point {
             Fix(FixedI32::<F>::from_bits(2i32 << F::U32))
         };
         const NAME: &'static str = "fixed-i32";
+        const SATURATES: bool = true;
 
         #[inline]
         fn from_f64(v: f64) -> Self {
@@ -567,6 +587,29 @@ mod fixed_point {
             *carry = Fix(FixedI32::<F>::from_bits((p - (q << F::U32)) as i32));
             saturate(self.0.to_bits() as i64 + q)
         }
+        /// The sum of the exact products (units of `2^-2F`, in 128 bits),
+        /// times `a` exactly (`2^-3F`), plus the carry; rounded to the
+        /// format, the remainder (below half an LSB, kept to `2^-2F`) back
+        /// into `carry`. Saturating throughout (no input panics).
+        #[inline]
+        fn dot_add_compensated(self, a: Self, b: &[Self], c: &[Self], carry: &mut Self) -> Self {
+            let f = F::U32;
+            let mut sum: i128 = 0;
+            for (bj, cj) in b.iter().zip(c) {
+                sum = sum.saturating_add(bj.0.to_bits() as i128 * cj.0.to_bits() as i128);
+            }
+            let p = (a.0.to_bits() as i128)
+                .saturating_mul(sum)
+                .saturating_add((carry.0.to_bits() as i128) << f);
+            let half = if f > 0 { 1i128 << (2 * f - 1) } else { 0 };
+            let q = p.saturating_add(half) >> (2 * f);
+            // |p - q 2^2F| <= 2^(2F-1): rounded to 2^-2F, below 2^(F-1) + 1.
+            let rem = p - (q << (2 * f));
+            let rounding = if f > 0 { 1i128 << (f - 1) } else { 0 };
+            *carry = Fix(FixedI32::<F>::from_bits(((rem + rounding) >> f) as i32));
+            let q = q.clamp(-(1i128 << 33), 1i128 << 33) as i64;
+            saturate(self.0.to_bits() as i64 + q)
+        }
     }
 }
 
@@ -589,6 +632,51 @@ mod tests {
         assert_eq!(Q16_16::ONE.to_f64(), 1.0);
         assert_eq!(Q12_20::ONE.to_f64(), 1.0);
         assert!((Q16_16::from_f64(2.0).sqrt().to_f64() - 2f64.sqrt()).abs() < 2e-5);
+    }
+
+    #[test]
+    fn products_below_the_resolution_still_add_up() {
+        // A plunger creeping at w = 31 LSB over steps of h b = 0.015: each
+        // product is 0.47 LSB, which rounds to zero; summed exactly and
+        // carried, 10,000 steps of a = 0.1 advance by their true total.
+        let (a, hb, w) = (
+            0.1,
+            [0.015, 0.012],
+            [31.0 / (1u64 << 20) as f64, 29.0 / (1u64 << 20) as f64],
+        );
+        let exact = 10_000.0 * a * (hb[0] * w[0] + hb[1] * w[1]);
+        let (qa, qb, qw) = (
+            Q12_20::from_f64(a),
+            [Q12_20::from_f64(hb[0]), Q12_20::from_f64(hb[1])],
+            [Q12_20::from_f64(w[0]), Q12_20::from_f64(w[1])],
+        );
+        let (mut x, mut carry) = (Q12_20::ZERO, Q12_20::ZERO);
+        let (mut rounded, mut c2) = (Q12_20::ZERO, Q12_20::ZERO);
+        for _ in 0..10_000 {
+            x = x.dot_add_compensated(qa, &qb, &qw, &mut carry);
+            rounded = rounded.mul_add_compensated(qa, qb[0] * qw[0] + qb[1] * qw[1], &mut c2);
+        }
+        let lsb = 1.0 / (1u64 << 20) as f64;
+        // The inputs as Q12.20 holds them differ by 1e-4 relative at most.
+        assert!(
+            (x.to_f64() - exact).abs() <= 2.0 * lsb + 2e-4 * exact,
+            "{x:?} vs {exact}"
+        );
+        assert!(
+            rounded.to_f64() < 0.5 * exact,
+            "the rounded products were expected to vanish"
+        );
+        // Floats: the plain sum of products, compensated.
+        let (mut y, mut c) = (0.0f64, 0.0f64);
+        for _ in 0..10_000 {
+            y = y.dot_add_compensated(a, &hb, &w, &mut c);
+        }
+        assert!((y - exact).abs() <= 1e-15);
+        // Saturating, never panicking, on extreme inputs.
+        let big = Q12_20::from_f64(2047.0);
+        let mut k = Q12_20::from_f64(-0.5);
+        let z = Q12_20::ZERO.dot_add_compensated(big, &[big, big, big], &[big, big, big], &mut k);
+        assert_eq!(z.to_f64(), 2048.0 - lsb);
     }
 
     #[test]

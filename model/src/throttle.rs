@@ -171,7 +171,10 @@ mod tests {
                 (v.to_f64() - v64).abs() <= 3e-4 * (1.0 + v64.abs()),
                 "value at {u}: {v:?} vs {v64}"
             );
-            assert!((d.to_f64() - d64).abs() <= 2e-2 * d64, "slope at {u}: {d:?} vs {d64}");
+            // The slope against the law at the inputs as Q12.20 holds them:
+            // u_tr = 1e-5 is 10 LSB (4.6 % low), which alone moves the slope
+            // near zero by 2.4 %; the computation adds a few LSB.
+            assert!((d.to_f64() - d64).abs() <= 2e-3 * d64, "slope at {u}: {d:?} vs {d64}");
         }
     }
 

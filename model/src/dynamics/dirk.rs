@@ -246,7 +246,7 @@ impl<T: Real> Dirk<T> {
     ///
     /// In free motion the new displacement is `xi + h a_x sum_i b_i w_i`
     /// (exact for the linear row `xi' = a_x w`), accumulated with
-    /// [`Real::mul_add_compensated`] and `xi_carry`: a plunger creeping by
+    /// [`Real::dot_add_compensated`] and `xi_carry`: a plunger creeping by
     /// less than the resolution per step still arrives.
     pub fn step(&self, c: &Coefficients<T>, y: &State<T>, frac: T, contact: Contact, xi_carry: &mut T) -> State<T> {
         let hg = if frac == T::ONE {
@@ -260,7 +260,7 @@ impl<T: Real> Dirk<T> {
         // Stage increments `Y_j - Z_j`: `Z_i = y + sum_j alpha_ij (Y_j - Z_j)`.
         let mut d = [[T::ZERO; 4]; MAX_STAGES];
         let mut yi = *y;
-        let mut sum_w = T::ZERO;
+        let mut ws = [T::ZERO; MAX_STAGES];
         for i in 0..self.stages {
             let mut z = *y;
             for j in 0..i {
@@ -279,11 +279,15 @@ impl<T: Real> Dirk<T> {
             for k in 0..4 {
                 d[i][k] = yi[k] - z[k];
             }
-            sum_w += self.h_b[i] * yi[1];
+            ws[i] = yi[1];
         }
         // xi + h a_x sum_i b_i w_i, compensated (exact for xi' = a_x w).
+        // Fixed point sums the products h b_i w_i exactly: rounded one by
+        // one they vanish for a plunger creeping over short steps (0.47 LSB
+        // each at w = 31 LSB, 32 substeps per tick), and it stopped 4e-4 of
+        // the stroke short (`docs/dynamics.md`, "Fixed-point ranges").
         let h_a_x = if frac == T::ONE { c.a_x } else { c.a_x * frac };
-        yi[0] = y[0].mul_add_compensated(h_a_x, sum_w, xi_carry);
+        yi[0] = y[0].dot_add_compensated(h_a_x, &self.h_b[..self.stages], &ws[..self.stages], xi_carry);
         yi
     }
 
@@ -330,9 +334,17 @@ impl<T: Real> Dirk<T> {
             let b = chamber(c, tb, hg, z[3], w);
             let force = c.phi_over_a_x * (b.u - (T::ONE - a.u)) - (c.xi0 + xi) * c.inv_a_x;
             let g = w - z[1] - hg * (force - c.two_zeta * w);
-            // d(pi_b - pi_a)/dw = du_b/dw + du_a/dw < 0 (hydraulic damping).
-            let dg = base - hg * c.phi_over_a_x * (b.du_dw + a.du_dw);
-            let dw = -(g / dg);
+            // d(pi_b - pi_a)/dw = du_b/dw + du_a/dw < 0 (hydraulic damping):
+            // g' = base + hp s. On strongly damped designs hp s (the
+            // hydraulic damping over a step) reaches 1,850 (survey, 10,000
+            // designs): a saturating type divides g and g' by hp first
+            // (`docs/dynamics.md`, "Fixed-point ranges").
+            let (hp, s) = (hg * c.phi_over_a_x, -(b.du_dw + a.du_dw));
+            let dw = if T::SATURATES && hp > T::ONE && s > T::ONE {
+                -((g / hp) / (base / hp + s))
+            } else {
+                -(g / (base + hp * s))
+            };
             w += dw;
             out = [xi + hg_a_x * dw, w, T::ONE - (a.u + a.du_dw * dw), b.u + b.du_dw * dw];
         }

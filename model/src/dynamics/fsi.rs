@@ -32,6 +32,17 @@
 //! `2 zeta = b / sqrt(c m)`, `q_t = sqrt(rho_15 / rho)` and
 //! `g_l = dp / (R_l Q*)` (the only temperature-dependent coefficients).
 //!
+//! Flow unit: `Q*` as long as the capillary conducts at most
+//! [`FLOW_SCALE_LIMIT`] times the orifice (`g_l <= 256`), else `2^n Q*`
+//! with the smallest `n` that brings `g_l` back under it ([`flow_shift`]).
+//! Every flow coefficient (`q_t`, `g_l`, `sigma`) is divided by `2^n`,
+//! every chamber rate (`omega`) multiplied by it: the equations in
+//! `(xi, w, pi_a, pi_b)` are homogeneous in that scale, so the state and
+//! its trajectory are unchanged (exactly: a power of two), and no
+//! coefficient outgrows fixed point when a thin oil runs hot (`g_l` of
+//! the survey's designs reaches 1,944 at 150 C and 1,232 inside 26-78 C,
+//! against Q12.20's 2,048; `docs/dynamics.md`, "Fixed-point ranges").
+//!
 //! End stops are inelastic: on a stop, with the net static force pushing
 //! into it and no velocity away from it, the plunger is held (`xi' = w' = 0`,
 //! [`Contact`]); a step that crosses a stop ends on it with `w = 0`.
@@ -46,6 +57,31 @@ use crate::throttle::{regularised_root, regularised_root_value};
 
 /// Transition pressure of the regularised orifice law, as a fraction of `dp`.
 pub const TRANSITION_FRACTION: f64 = 1.0e-5;
+
+/// Largest capillary conductance `g_l` (in the flow unit) the coefficients
+/// carry: beyond it the flow unit doubles ([`flow_shift`]). 256 keeps
+/// every stage intermediate of the twin below half of Q12.20's range
+/// (`g_l - sigma w`, `k + g_l`, `1 + beta g_l` and `R K` of
+/// [`super::dirk`]), while `q_t` stays above `128 / g_l` in any unit.
+pub const FLOW_SCALE_LIMIT: f64 = 256.0;
+
+/// Largest exponent of the flow unit (`g_l` up to `256 * 2^24`, far beyond
+/// any oil; beyond it the coefficients are refused as not representable).
+pub const MAX_FLOW_SHIFT: u8 = 24;
+
+/// The exponent `n` of the flow unit `2^n Q*` for a capillary conductance
+/// `g_l` in units of `Q*`: the smallest `n <= MAX_FLOW_SHIFT` with
+/// `g_l / 2^n <= FLOW_SCALE_LIMIT` (zero for NaN).
+#[inline]
+pub fn flow_shift<F: Float>(g_l: F) -> u8 {
+    let mut limit = F::from_f64(FLOW_SCALE_LIMIT);
+    let mut n = 0;
+    while g_l > limit && n < MAX_FLOW_SHIFT {
+        limit = limit + limit;
+        n += 1;
+    }
+    n
+}
 
 /// Whether the plunger is held by a stop during a step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -147,6 +183,21 @@ pub struct Coefficients<T> {
     pub q_t: T,
     /// `g_l = dp / (R_l(t) Q*)` (temperature-dependent).
     pub g_l: T,
+    /// The flow unit is `2^flow_shift Q*` ([`flow_shift`]): `q_t`, `g_l`
+    /// and `sigma` above are divided by `2^flow_shift`, `omega_a0`,
+    /// `omega_b0` multiplied by it (`inv_omega_a0`, `inv_omega_b0`
+    /// divided). Zero unless the capillary conducts more than
+    /// [`FLOW_SCALE_LIMIT`] times the orifice.
+    pub flow_shift: u8,
+}
+
+/// The coefficients that carry the flow unit, for one [`flow_shift`].
+struct Flows<T> {
+    omega_a0: T,
+    inv_omega_a0: T,
+    omega_b0: T,
+    inv_omega_b0: T,
+    sigma: T,
 }
 
 /// The temperature-independent part of the model, computed once in the
@@ -158,6 +209,12 @@ pub struct Model<F> {
     pub scales: Scales<F>,
     q_star: F,
     a_x: F,
+    /// `omega_a0`, `omega_b0`, their reciprocals and `sigma` in units of
+    /// `Q*` (computed in `f64`, rounded once to `F`; a flow unit of `2^n Q*`
+    /// scales them exactly).
+    omega: [F; 2],
+    inv_omega: [F; 2],
+    sigma: F,
 }
 
 impl<F: Float> Model<F> {
@@ -186,11 +243,37 @@ impl<F: Float> Model<F> {
             pressure: dp,
             outlet_pressure: p.outlet_pressure,
         };
+        let swept_rate = |v: F| t.to_f64() * q_star.to_f64() * p.oil.bulk_modulus.to_f64() / (dp.to_f64() * v.to_f64());
+        let (oa, ob) = (
+            finite(swept_rate(p.volume_a), "omega_a")?,
+            finite(swept_rate(p.volume_b), "omega_b")?,
+        );
+        let sigma = F::from_f64(finite(
+            area.to_f64() * scales.velocity.to_f64() / q_star.to_f64(),
+            "sigma",
+        )?);
         Ok(Model {
             params: *params,
             scales,
             q_star,
             a_x,
+            omega: [F::from_f64(oa), F::from_f64(ob)],
+            inv_omega: [F::from_f64(1.0 / oa), F::from_f64(1.0 / ob)],
+            sigma,
+        })
+    }
+
+    /// The coefficients that carry the flow unit `2^shift Q*`, in `T`.
+    /// `omega` may saturate fixed point (see [`Coefficients::omega_a0`]).
+    fn flows<T: Real>(&self, shift: u8) -> Result<Flows<T>, ModelError> {
+        let s = F::from_f64((1u32 << shift) as f64);
+        let saturating = |v: F, what: &'static str| finite(finite(v, what)?.to_real::<T>(), what);
+        Ok(Flows {
+            omega_a0: saturating(self.omega[0] * s, "omega_a")?,
+            inv_omega_a0: represent(self.inv_omega[0] / s, "omega_a")?,
+            omega_b0: saturating(self.omega[1] * s, "omega_b")?,
+            inv_omega_b0: represent(self.inv_omega[1] / s, "omega_b")?,
+            sigma: represent(self.sigma / s, "sigma")?,
         })
     }
 
@@ -207,24 +290,20 @@ impl<F: Float> Model<F> {
         Ok((finite(q_t, "q_t")?, finite(g_l, "g_l")?))
     }
 
-    /// All coefficients for a fluid state, converted to `T`.
+    /// All coefficients for a fluid state, converted to `T` (in the flow
+    /// unit [`flow_shift`] picks for the fluid's `g_l`).
     pub fn coefficients<T: Real>(&self, fluid: &FluidState<F>) -> Result<Coefficients<T>, ModelError> {
         let p = &self.params;
         let pl = &p.plunger;
-        let s = &self.scales;
         let (q_t, g_l) = self.hydraulic(fluid)?;
-        let (time, length, pressure, velocity) = (
-            s.time.to_f64(),
-            s.length.to_f64(),
-            s.pressure.to_f64(),
-            s.velocity.to_f64(),
-        );
+        let shift = flow_shift(g_l);
+        let s = F::from_f64((1u32 << shift) as f64);
+        let length = self.scales.length.to_f64();
         let swept = pl.area().to_f64() * length;
-        let omega = |v: f64| time * self.q_star.to_f64() * p.oil.bulk_modulus.to_f64() / (pressure * v);
         let a_x = self.a_x.to_f64();
-        let phi = pl.area().to_f64() * pressure / (pl.spring_rate.to_f64() * length);
+        let phi = pl.area().to_f64() * self.scales.pressure.to_f64() / (pl.spring_rate.to_f64() * length);
         let c = |v: f64, what: &'static str| represent::<f64, T>(v, what);
-        let saturating = |v: f64, what: &'static str| finite(T::from_f64(finite(v, what)?), what);
+        let flows = self.flows::<T>(shift)?;
         Ok(Coefficients {
             a_x: c(a_x, "a_x")?,
             inv_a_x: c(1.0 / a_x, "1/a_x")?,
@@ -234,16 +313,17 @@ impl<F: Float> Model<F> {
                 "zeta",
             )?,
             xi0: c(pl.preload.to_f64() / length, "preload")?,
-            omega_a0: saturating(omega(p.volume_a.to_f64()), "omega_a")?,
-            inv_omega_a0: c(1.0 / omega(p.volume_a.to_f64()), "omega_a")?,
+            omega_a0: flows.omega_a0,
+            inv_omega_a0: flows.inv_omega_a0,
             eps_a: c(swept / p.volume_a.to_f64(), "eps_a")?,
-            omega_b0: saturating(omega(p.volume_b.to_f64()), "omega_b")?,
-            inv_omega_b0: c(1.0 / omega(p.volume_b.to_f64()), "omega_b")?,
+            omega_b0: flows.omega_b0,
+            inv_omega_b0: flows.inv_omega_b0,
             eps_b: c(swept / p.volume_b.to_f64(), "eps_b")?,
-            sigma: c(pl.area().to_f64() * velocity / self.q_star.to_f64(), "sigma")?,
+            sigma: flows.sigma,
             u_tr: c(TRANSITION_FRACTION, "u_tr")?,
-            q_t: c(q_t.to_f64(), "q_t")?,
-            g_l: c(g_l.to_f64(), "g_l")?,
+            q_t: represent(q_t / s, "q_t")?,
+            g_l: represent(g_l / s, "g_l")?,
+            flow_shift: shift,
         })
     }
 
@@ -277,11 +357,24 @@ impl<T: Real> Coefficients<T> {
         self.phi_over_a_x * (two * s0 * s0 - T::ONE) - (self.xi0 + xi) * self.inv_a_x
     }
 
-    /// Sets the temperature-dependent `q_t`, `g_l` for a fluid state; on
-    /// error (not finite, or saturating `T`) nothing changes.
+    /// Sets the temperature-dependent `q_t`, `g_l` for a fluid state, and
+    /// the flow unit with them ([`flow_shift`]: `sigma` and the chamber
+    /// rates change only when the unit does); on error (not finite, or
+    /// not representable in `T`) nothing changes.
     pub fn set_hydraulic<F: Float>(&mut self, model: &Model<F>, fluid: &FluidState<F>) -> Result<(), ModelError> {
         let (q_t, g_l) = model.hydraulic(fluid)?;
-        let (q_t, g_l) = (represent(q_t, "q_t")?, represent(g_l, "g_l")?);
+        let shift = flow_shift(g_l);
+        let s = F::from_f64((1u32 << shift) as f64);
+        let (q_t, g_l) = (represent(q_t / s, "q_t")?, represent(g_l / s, "g_l")?);
+        if shift != self.flow_shift {
+            let f = model.flows::<T>(shift)?;
+            self.omega_a0 = f.omega_a0;
+            self.inv_omega_a0 = f.inv_omega_a0;
+            self.omega_b0 = f.omega_b0;
+            self.inv_omega_b0 = f.inv_omega_b0;
+            self.sigma = f.sigma;
+            self.flow_shift = shift;
+        }
         self.q_t = q_t;
         self.g_l = g_l;
         Ok(())
@@ -599,6 +692,7 @@ mod tests {
             u_tr: 1e-5,
             q_t: 1.02,
             g_l: 1.4,
+            flow_shift: 0,
         }
     }
 

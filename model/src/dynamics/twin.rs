@@ -222,12 +222,13 @@ impl<F: Float, T: Real> Twin<F, T> {
 
     /// As [`Twin::set_temperature`] from an already evaluated fluid state.
     /// A change of the capillary conductance by more than
-    /// [`ABRUPT_CHANGE`] (relative) makes the next tick start graded.
+    /// [`ABRUPT_CHANGE`] (relative), or of the flow unit
+    /// ([`super::fsi::flow_shift`]), makes the next tick start graded.
     pub fn set_fluid(&mut self, fluid: &FluidState<F>) -> Result<(), ModelError> {
-        let before = self.coefficients.g_l;
+        let (before, unit) = (self.coefficients.g_l, self.coefficients.flow_shift);
         self.coefficients.set_hydraulic(&self.model, fluid)?;
         let change = (self.coefficients.g_l - before).abs();
-        self.abrupt |= change > self.abrupt_threshold * before;
+        self.abrupt |= change > self.abrupt_threshold * before || self.coefficients.flow_shift != unit;
         Ok(())
     }
 
@@ -473,12 +474,16 @@ impl<F: Float, T: Real> Twin<F, T> {
         let t = (-e0 / span).clamp_to(T::ZERO, T::ONE);
         let p = ((c3 * t + c2) * t + d0) * t + e0;
         let dp = (c3 * (t + t + t) + (c2 + c2)) * t + d0;
-        let newton = t - p / dp;
-        if dp != T::ZERO && newton >= T::ZERO && newton <= T::ONE {
-            newton
-        } else {
-            t
+        // Newton only where it moves by at most the whole step (the
+        // quotient then stays within [-1, 1], in range for fixed point,
+        // and a flat interpolant never divides by zero).
+        if dp != T::ZERO && p.abs() <= dp.abs() {
+            let newton = t - p / dp;
+            if newton >= T::ZERO && newton <= T::ONE {
+                return newton;
+            }
         }
+        t
     }
 
     /// The state in SI units.
