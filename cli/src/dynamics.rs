@@ -8,8 +8,7 @@ use compensator::ModelError;
 use compensator::dynamics::config::{Choice, TARGET_PCT, choose};
 use compensator::dynamics::linear::linearise;
 use compensator::dynamics::reduced::ReducedTwin;
-use compensator::dynamics::schemes::StepError;
-use compensator::dynamics::{DynamicState, Scheme, Twin, TwinConfig};
+use compensator::dynamics::{Dynamic, DynamicState, Scheme, Twin, TwinConfig};
 use compensator::equilibrium::equilibrium;
 use compensator::scalar::Fixed;
 use compensator::{Float, Params, RawParams, Real};
@@ -68,42 +67,11 @@ fn widen<F: Float>(s: DynamicState<F>) -> DynamicState<f64> {
     }
 }
 
-/// What [`run`] drives: the full twin or the reduced one.
-trait Ticking<F> {
-    fn set_temperature(&mut self, temperature: F) -> Result<(), ModelError>;
-    fn tick(&mut self) -> Result<(), StepError>;
-    fn state(&self) -> DynamicState<F>;
-}
-
-impl<F: Float, T: Real> Ticking<F> for Twin<F, T> {
-    fn set_temperature(&mut self, temperature: F) -> Result<(), ModelError> {
-        Twin::set_temperature(self, temperature)
-    }
-    fn tick(&mut self) -> Result<(), StepError> {
-        Twin::tick(self).map(|_| ())
-    }
-    fn state(&self) -> DynamicState<F> {
-        Twin::state(self)
-    }
-}
-
-impl<F: Float, T: Real> Ticking<F> for ReducedTwin<F, T> {
-    fn set_temperature(&mut self, temperature: F) -> Result<(), ModelError> {
-        ReducedTwin::set_temperature(self, temperature)
-    }
-    fn tick(&mut self) -> Result<(), StepError> {
-        ReducedTwin::tick(self)
-    }
-    fn state(&self) -> DynamicState<F> {
-        ReducedTwin::state(self)
-    }
-}
-
 /// `n` ticks of `config.tick` along `prof`, from a twin at rest at its
 /// start, with the coefficients at each tick's midpoint (a ramp followed
 /// to second order).
 fn run<F: Float>(
-    twin: Result<impl Ticking<F>, ModelError>,
+    twin: Result<impl Dynamic<F>, ModelError>,
     config: &TwinConfig,
     prof: &Profile,
     n: usize,

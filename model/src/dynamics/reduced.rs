@@ -155,3 +155,27 @@ impl<F: Float, T: Real> ReducedTwin<F, T> {
             .to_si(&[self.state[0], self.state[1], T::ONE - pb, pb])
     }
 }
+
+impl<F: Float, T: Real> super::Dynamic<F> for ReducedTwin<F, T> {
+    fn set_temperature(&mut self, temperature: F) -> Result<(), ModelError> {
+        ReducedTwin::set_temperature(self, temperature)
+    }
+    /// The report's contact is the state's at the tick's end; the reduced
+    /// twin locates no events (`impact`, `release`, `graded` are false).
+    fn tick(&mut self) -> Result<super::TickReport, StepError> {
+        ReducedTwin::tick(self)?;
+        let probe = ReducedFsi {
+            coefficients: &self.coefficients,
+            contact: Contact::Free,
+        };
+        Ok(super::TickReport {
+            contact: contact_for(self.state[0], self.state[1], probe.static_force(self.state[0])),
+            impact: false,
+            release: false,
+            graded: false,
+        })
+    }
+    fn state(&self) -> DynamicState<F> {
+        ReducedTwin::state(self)
+    }
+}

@@ -503,3 +503,15 @@ impl<F: Float, T: Real> Twin<F, T> {
         self.xi_carry = T::ZERO;
     }
 }
+
+impl<F: Float, T: Real> super::Dynamic<F> for Twin<F, T> {
+    fn set_temperature(&mut self, temperature: F) -> Result<(), ModelError> {
+        Twin::set_temperature(self, temperature)
+    }
+    fn tick(&mut self) -> Result<TickReport, StepError> {
+        Twin::tick(self)
+    }
+    fn state(&self) -> DynamicState<F> {
+        Twin::state(self)
+    }
+}
