@@ -8,7 +8,7 @@ use compensator::dynamics::linear::linearise;
 use compensator::dynamics::{Twin, TwinConfig};
 use compensator::equilibrium::{balance_temperature, equilibrium};
 use compensator::estimator::{Estimator, EstimatorConfig};
-use compensator::params::{RawCore, RawParams};
+use compensator::params::{CORE_FIELDS, RawParams};
 use compensator::scalar::{Fixed, Q16_16};
 use compensator::sensor::SensorFault;
 use compensator::{Float, Params, Real};
@@ -62,10 +62,10 @@ fn corrupted_parameter_sets_give_errors_not_panics() {
     let mut rng = Rng::new(1);
     for _ in 0..3000 {
         let mut raw = physical_params(&mut rng);
-        let mut core = raw.core.to_array();
-        let k = (rng.unit() * core.len() as f64) as usize % core.len();
-        core[k] = pick(&mut rng);
-        raw.core = RawCore::from_array(core);
+        let fields = &CORE_FIELDS;
+        let target = fields[(rng.unit() * fields.len() as f64) as usize % fields.len()].path;
+        let bad = pick(&mut rng);
+        raw.core = raw.core.map(|n| if n.path == target { bad } else { n.value });
         if raw.validate().is_err() {
             assert!(Params::<f64>::new(&raw).is_err());
             continue;

@@ -54,18 +54,11 @@ fn committed_preset_is_what_calibrate_produces() {
     let base = params_file::load(&root.join("presets/model-example.toml")).unwrap();
     let cal = paper::calibrate(&base, &t1, &t2).unwrap();
     let committed = params_file::load(&root.join("presets/paper.toml")).unwrap();
-    for (i, (a, b)) in cal
-        .params
-        .core
-        .to_array()
-        .iter()
-        .zip(committed.core.to_array())
-        .enumerate()
-    {
+    for (a, b) in cal.params.core.named().zip(committed.core.named()).into_array() {
+        let (field, a, b) = (a.path, a.value, b.value);
         assert!(
             (a - b).abs() <= 1e-6 * b.abs(),
-            "{}: calibrate gives {a}, presets/paper.toml has {b}; rerun `compensator calibrate`",
-            compensator::params::CORE_FIELDS[i].path
+            "{field}: calibrate gives {a}, presets/paper.toml has {b}; rerun `compensator calibrate`",
         );
     }
 }

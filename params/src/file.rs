@@ -6,7 +6,7 @@
 //! `nan` and `inf` are read and then rejected by validation with the field's
 //! name.
 
-use crate::{CORE_FIELDS, ESTIMATOR_FIELDS, MACHINE_FIELDS, ParamError, RawParams};
+use crate::{CORE_FIELDS, ESTIMATOR_FIELDS, Field, MACHINE_FIELDS, ParamError, RawParams};
 use std::fmt;
 use std::path::Path;
 
@@ -102,10 +102,10 @@ pub fn load(path: &Path) -> Result<RawParams, LoadError> {
 /// Writes a parameter set back as TOML (core sections, then `[machine]` if
 /// present, then the `[estimator]` keys that differ from their defaults).
 pub fn to_toml(raw: &RawParams) -> String {
-    use crate::RawEstimator;
+    use crate::{RawCore, RawEstimator, RawMachine};
     let mut out = String::new();
     let mut section = "";
-    let mut emit = |out: &mut String, field: &crate::Field, v: f64| {
+    let mut emit = |out: &mut String, field: &Field, v: f64| {
         if field.section != section {
             if !out.is_empty() {
                 out.push('\n');
@@ -115,18 +115,18 @@ pub fn to_toml(raw: &RawParams) -> String {
         }
         out.push_str(&format!("{} = {}    # {}\n", field.key, fmt_float(v), field.unit));
     };
-    for (f, v) in CORE_FIELDS.iter().zip(raw.core.to_array()) {
-        emit(&mut out, f, v);
+    // Each field's description paired with its value by name, in file order.
+    for (f, n) in RawCore::FIELD.zip(raw.core.named()).into_array() {
+        emit(&mut out, &f, n.value);
     }
     if let Some(m) = &raw.machine {
-        for (f, v) in MACHINE_FIELDS.iter().zip(m.to_array()) {
-            emit(&mut out, f, v);
+        for (f, n) in RawMachine::FIELD.zip(m.named()).into_array() {
+            emit(&mut out, &f, n.value);
         }
     }
-    let defaults = RawEstimator::DEFAULT.to_array();
-    for ((f, v), d) in ESTIMATOR_FIELDS.iter().zip(raw.estimator.to_array()).zip(defaults) {
-        if v != d {
-            emit(&mut out, f, v);
+    for (f, n) in RawEstimator::FIELD.zip(raw.estimator.named()).into_array() {
+        if Some(n.value) != f.default {
+            emit(&mut out, &f, n.value);
         }
     }
     out

@@ -7,7 +7,7 @@
 //! tools read files with [`file::parse`]; the firmware's build script turns a
 //! file into checked constants with the same reader, so a device is flashed
 //! only with a parameter set that passed the same validation.
-#![cfg_attr(not(feature = "toml"), no_std)]
+#![cfg_attr(not(any(feature = "toml", test)), no_std)]
 #![deny(missing_docs)]
 
 mod schema;
@@ -16,3 +16,6 @@ mod schema;
 pub mod file;
 
 pub use schema::*;
+
+#[cfg(test)]
+mod tests;

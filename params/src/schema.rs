@@ -1,6 +1,12 @@
 //! The parameter file's schema and its validation, in plain `f64`.
 //!
 //! Units are SI, temperatures in degrees Celsius (MODEL.md section 8).
+//!
+//! Each section group is declared once, by the `schema!` list below; code
+//! reaches a field by its name, never by its place in the list: its
+//! description is `RawCore::FIELD.spring_rate` (`plunger.spring_rate`), its
+//! value with that name `raw.named().spring_rate`. The tables
+//! (`CORE_FIELDS`, ...) are for going over every field in file order.
 
 use core::fmt;
 
@@ -13,6 +19,9 @@ pub struct Field {
     pub key: &'static str,
     /// `section.key`, the name used in error messages.
     pub path: &'static str,
+    /// The Rust field it fills (`"spring_rate"` of [`RawCore`]), for
+    /// generated code that writes a parameter set as a struct literal.
+    pub name: &'static str,
     /// Unit, for documentation and generated tables.
     pub unit: &'static str,
     /// Value used when the key is absent; `None` means the key is required.
@@ -21,15 +30,38 @@ pub struct Field {
     pub doc: &'static str,
 }
 
+/// A field's value together with its name: what a rule needs to check the
+/// value and to name the field when it rejects it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Named {
+    /// `section.key` of the field.
+    pub path: &'static str,
+    /// Its value.
+    pub value: f64,
+}
+
 macro_rules! count {
     () => { 0usize };
     ($head:tt $($tail:tt)*) => { 1usize + count!($($tail)*) };
 }
 
+/// Declares one section group of the file from a single list of fields:
+///
+/// * the struct of values (`RawCore`, one `f64` per field);
+/// * a struct with the same field names over any `T` (`CoreFields<T>`):
+///   `RawCore::FIELD` (a `CoreFields<Field>`) is the named handle of every
+///   field, `RawCore::named()` (a `CoreFields<Named>`) every value with its
+///   field's `section.key`;
+/// * the table of the fields in file order (`CORE_FIELDS`), for code that
+///   goes over all of them (reading, writing, listing).
+///
+/// Code that needs one particular field names it (`FIELD.spring_rate`,
+/// `named().spring_rate`); nothing outside this macro depends on the
+/// position of a field in the list, so inserting a field shifts nothing.
 macro_rules! schema {
     (
         $(#[$meta:meta])*
-        struct $name:ident, const $fields:ident;
+        struct $name:ident, fields $fields_ty:ident, const $fields:ident;
         $( $field:ident : $section:literal . $key:literal [$unit:literal] = $default:expr, $doc:literal; )*
     ) => {
         $(#[$meta])*
@@ -38,35 +70,87 @@ macro_rules! schema {
             $( #[doc = $doc] #[doc = concat!("Unit: ", $unit, ".")] pub $field: f64, )*
         }
 
-        #[doc = concat!("The fields of [`", stringify!($name), "`], in declaration order.")]
-        pub const $fields: [Field; count!($($field)*)] = [
-            $( Field {
-                section: $section,
-                key: $key,
-                path: concat!($section, ".", $key),
-                unit: $unit,
-                default: $default,
-                doc: $doc,
-            }, )*
-        ];
+        #[doc = concat!("One `T` per field of [`", stringify!($name), "`], under the same names: [`",
+            stringify!($name), "::FIELD`] holds each field's description, [`", stringify!($name),
+            "::named`] each value with its field's name.")]
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct $fields_ty<T> {
+            $( #[doc = concat!("`", $section, ".", $key, "`: ", $doc)] pub $field: T, )*
+        }
 
-        impl $name {
-            /// Builds the struct from values in the order of the field table.
-            pub const fn from_array(values: [f64; count!($($field)*)]) -> Self {
-                let [$($field),*] = values;
-                Self { $($field),* }
-            }
-            /// The values in the order of the field table.
-            pub const fn to_array(&self) -> [f64; count!($($field)*)] {
+        impl<T> $fields_ty<T> {
+            /// The entries in file order (the order of the field table).
+            pub fn into_array(self) -> [T; count!($($field)*)] {
                 [$(self.$field),*]
             }
+
+            /// Pairs the entries of `self` and `other` by field name.
+            pub fn zip<U>(self, other: $fields_ty<U>) -> $fields_ty<(T, U)> {
+                $fields_ty { $( $field: (self.$field, other.$field), )* }
+            }
+        }
+
+        #[doc = concat!("The fields of [`", stringify!($name), "`], in file order (the entries of [`",
+            stringify!($name), "::FIELD`]).")]
+        pub const $fields: [Field; count!($($field)*)] = [$($name::FIELD.$field),*];
+
+        impl $name {
+            /// Each field's description (section, key, unit, default), by name.
+            pub const FIELD: $fields_ty<Field> = $fields_ty {
+                $( $field: Field {
+                    section: $section,
+                    key: $key,
+                    path: concat!($section, ".", $key),
+                    name: stringify!($field),
+                    unit: $unit,
+                    default: $default,
+                    doc: $doc,
+                }, )*
+            };
+
+            /// Every value together with its field's `section.key`.
+            pub const fn named(&self) -> $fields_ty<Named> {
+                $fields_ty {
+                    $( $field: Named { path: Self::FIELD.$field.path, value: self.$field }, )*
+                }
+            }
+
+            /// Builds the struct from one value per field, asked for by
+            /// field in file order; the first error is returned.
+            pub fn try_from_fields<E>(
+                mut value: impl FnMut(&'static Field) -> Result<f64, E>,
+            ) -> Result<Self, E> {
+                Ok(Self { $( $field: value(&Self::FIELD.$field)?, )* })
+            }
+
+            /// Builds the struct from one value per field, asked for by
+            /// field in file order.
+            pub fn from_fields(mut value: impl FnMut(&'static Field) -> f64) -> Self {
+                Self { $( $field: value(&Self::FIELD.$field), )* }
+            }
+
+            /// The same set with every value passed through `f`, which
+            /// sees it with its field's name.
+            pub fn map(&self, mut f: impl FnMut(Named) -> f64) -> Self {
+                let named = self.named();
+                Self { $( $field: f(named.$field), )* }
+            }
+
+            /// Every field at its default, NaN where the key is required.
+            #[allow(dead_code, reason = "only a section whose every key has a default uses it")]
+            const WITH_DEFAULTS: Self = Self {
+                $( $field: match Self::FIELD.$field.default {
+                    Some(v) => v,
+                    None => f64::NAN,
+                }, )*
+            };
         }
     };
 }
 
 schema! {
     /// The compensator's physical parameters (all required).
-    struct RawCore, const CORE_FIELDS;
+    struct RawCore, fields CoreFields, const CORE_FIELDS;
     walther_a: "fluid"."walther_a" ["-"] = None, "Walther constant a in log10(log10(nu_cSt + 0.7)) = a - b log10(T_K).";
     walther_b: "fluid"."walther_b" ["-"] = None, "Walther slope b.";
     density_15: "fluid"."density_15" ["kg/m^3"] = None, "Density at 15 C.";
@@ -95,7 +179,7 @@ schema! {
     ///
     /// Its volumetric losses are laminar leakage, proportional to `1/mu`:
     /// `dQ_lost(t) = leakage_reference * mu(t_ref) / mu(t)`.
-    struct RawMachine, const MACHINE_FIELDS;
+    struct RawMachine, fields MachineFields, const MACHINE_FIELDS;
     working_flow: "machine"."working_flow" ["m^3/s"] = None, "Flow Q_work the driven motor needs.";
     leakage_reference: "machine"."leakage_reference" ["m^3/s"] = None, "Volumetric loss at the reference temperature.";
     leakage_temperature: "machine"."leakage_temperature" ["C"] = None, "Reference temperature of the loss.";
@@ -104,7 +188,7 @@ schema! {
 schema! {
     /// Estimator and sensor settings (optional section `[estimator]`; every
     /// key has a default).
-    struct RawEstimator, const ESTIMATOR_FIELDS;
+    struct RawEstimator, fields EstimatorFields, const ESTIMATOR_FIELDS;
     tick_hz: "estimator"."tick_hz" ["Hz"] = Some(1000.0), "Estimator tick rate.";
     filter_time_constant: "estimator"."filter_time_constant" ["s"] = Some(0.2), "First-order temperature filter time constant.";
     spike_threshold: "estimator"."spike_threshold" ["C"] = Some(5.0), "A sample further than this from the filtered value is a spike.";
@@ -206,66 +290,71 @@ impl fmt::Display for ParamError {
     }
 }
 
-fn err(field: &'static str, value: f64, problem: Problem) -> ParamError {
-    ParamError { field, value, problem }
+/// The error naming the field `n` and its value.
+fn err(n: Named, problem: Problem) -> ParamError {
+    ParamError {
+        field: n.path,
+        value: n.value,
+        problem,
+    }
 }
 
 /// Finite, else the matching error.
-fn finite(field: &'static str, v: f64) -> Result<f64, ParamError> {
-    if v.is_nan() {
-        Err(err(field, v, Problem::NotANumber))
-    } else if v.is_infinite() {
-        Err(err(field, v, Problem::Infinite))
+fn finite(n: Named) -> Result<f64, ParamError> {
+    if n.value.is_nan() {
+        Err(err(n, Problem::NotANumber))
+    } else if n.value.is_infinite() {
+        Err(err(n, Problem::Infinite))
     } else {
-        Ok(v)
+        Ok(n.value)
     }
 }
 
-fn positive(field: &'static str, v: f64) -> Result<f64, ParamError> {
-    let v = finite(field, v)?;
+fn positive(n: Named) -> Result<f64, ParamError> {
+    let v = finite(n)?;
     if v > 0.0 {
         Ok(v)
     } else {
-        Err(err(field, v, Problem::NotPositive))
+        Err(err(n, Problem::NotPositive))
     }
 }
 
-fn non_negative(field: &'static str, v: f64) -> Result<f64, ParamError> {
-    let v = finite(field, v)?;
+fn non_negative(n: Named) -> Result<f64, ParamError> {
+    let v = finite(n)?;
     if v >= 0.0 {
         Ok(v)
     } else {
-        Err(err(field, v, Problem::Negative))
+        Err(err(n, Problem::Negative))
     }
 }
 
-fn within(field: &'static str, v: f64, min: f64, max: f64) -> Result<f64, ParamError> {
-    let v = finite(field, v)?;
+fn within(n: Named, min: f64, max: f64) -> Result<f64, ParamError> {
+    let v = finite(n)?;
     if v >= min && v <= max {
         Ok(v)
     } else {
-        Err(err(field, v, Problem::OutOfRange { min, max }))
+        Err(err(n, Problem::OutOfRange { min, max }))
     }
 }
 
 /// A whole number (counts).
-fn whole(field: &'static str, v: f64) -> Result<f64, ParamError> {
-    let v = finite(field, v)?;
+fn whole(n: Named) -> Result<f64, ParamError> {
+    let v = finite(n)?;
     // Exact for |v| < 2^63 (the saturating cast changes any fraction).
     if v as i64 as f64 == v {
         Ok(v)
     } else {
-        Err(err(field, v, Problem::NotWhole))
+        Err(err(n, Problem::NotWhole))
     }
 }
 
 /// Discharge coefficients live in (0, 1].
-fn discharge(field: &'static str, v: f64) -> Result<f64, ParamError> {
-    let v = positive(field, v)?;
+fn discharge(n: Named) -> Result<f64, ParamError> {
+    let v = positive(n)?;
     if v <= 1.0 {
         Ok(v)
     } else {
-        Err(err(field, v, Problem::OutOfRange { min: 0.0, max: 1.0 }))
+        Err(err(n, Problem::OutOfRange { min: 0.0, max: 1.0 }))
     }
 }
 
@@ -275,44 +364,38 @@ impl RawCore {
     /// Checks every field against its physical rule, in file order, and the
     /// rules that tie fields together. The first violation is returned.
     pub fn validate(&self) -> Result<(), ParamError> {
-        let f = &CORE_FIELDS;
-        let p = |i: usize| f[i].path;
-        positive(p(0), self.walther_a)?;
-        positive(p(1), self.walther_b)?;
-        positive(p(2), self.density_15)?;
+        let n = self.named();
+        positive(n.walther_a)?;
+        positive(n.walther_b)?;
+        positive(n.density_15)?;
         // rho = rho_15 / (1 + e (t - 15)) must stay positive and finite over
         // any oil temperature; 1e-2/K is ten times any hydraulic oil's.
-        within(p(3), self.expansion, 0.0, 1.0e-2)?;
-        positive(p(4), self.bulk_modulus)?;
-        positive(p(5), self.laminar_diameter)?;
-        positive(p(6), self.laminar_length)?;
-        positive(p(7), self.turbulent_diameter)?;
-        discharge(p(8), self.turbulent_discharge)?;
-        positive(p(9), self.plunger_diameter)?;
-        positive(p(10), self.mass)?;
-        non_negative(p(11), self.damping)?;
-        positive(p(12), self.spring_rate)?;
-        non_negative(p(13), self.preload)?;
-        positive(p(14), self.stroke)?;
-        positive(p(15), self.slot_diameter)?;
-        discharge(p(16), self.slot_discharge)?;
-        positive(p(17), self.volume_a)?;
-        positive(p(18), self.volume_b)?;
-        positive(p(19), self.pressure_drop)?;
-        non_negative(p(20), self.outlet_pressure)?;
+        within(n.expansion, 0.0, 1.0e-2)?;
+        positive(n.bulk_modulus)?;
+        positive(n.laminar_diameter)?;
+        positive(n.laminar_length)?;
+        positive(n.turbulent_diameter)?;
+        discharge(n.turbulent_discharge)?;
+        positive(n.plunger_diameter)?;
+        positive(n.mass)?;
+        non_negative(n.damping)?;
+        positive(n.spring_rate)?;
+        non_negative(n.preload)?;
+        positive(n.stroke)?;
+        positive(n.slot_diameter)?;
+        discharge(n.slot_discharge)?;
+        positive(n.volume_a)?;
+        positive(n.volume_b)?;
+        positive(n.pressure_drop)?;
+        non_negative(n.outlet_pressure)?;
 
         if self.preload > self.stroke {
-            return Err(err(
-                p(13),
-                self.preload,
-                Problem::Inconsistent("preload beyond the stroke"),
-            ));
+            return Err(err(n.preload, Problem::Inconsistent("preload beyond the stroke")));
         }
         let swept = PI * self.plunger_diameter * self.plunger_diameter / 4.0 * self.stroke;
         if !(swept.is_finite() && swept > 0.0) {
             return Err(err(
-                p(14),
-                self.stroke,
+                n.stroke,
                 Problem::Inconsistent("swept volume A_p * stroke is not finite"),
             ));
         }
@@ -321,15 +404,13 @@ impl RawCore {
         // that a mirrored design (and the file format) stays symmetric.
         if self.volume_a <= swept {
             return Err(err(
-                p(17),
-                self.volume_a,
+                n.volume_a,
                 Problem::Inconsistent("not larger than the swept volume A_p * stroke"),
             ));
         }
         if self.volume_b <= swept {
             return Err(err(
-                p(18),
-                self.volume_b,
+                n.volume_b,
                 Problem::Inconsistent("not larger than the swept volume A_p * stroke"),
             ));
         }
@@ -340,79 +421,59 @@ impl RawCore {
 impl RawMachine {
     /// Checks the machine section.
     pub fn validate(&self) -> Result<(), ParamError> {
-        let p = |i: usize| MACHINE_FIELDS[i].path;
-        non_negative(p(0), self.working_flow)?;
-        non_negative(p(1), self.leakage_reference)?;
-        within(p(2), self.leakage_temperature, -50.0, 200.0)?;
+        let n = self.named();
+        non_negative(n.working_flow)?;
+        non_negative(n.leakage_reference)?;
+        within(n.leakage_temperature, -50.0, 200.0)?;
         Ok(())
     }
 }
 
 impl RawEstimator {
     /// The defaults of the `[estimator]` section.
-    pub const DEFAULT: RawEstimator = {
-        let mut values = [0.0; ESTIMATOR_FIELDS.len()];
-        let mut i = 0;
-        while i < values.len() {
-            values[i] = match ESTIMATOR_FIELDS[i].default {
-                Some(v) => v,
-                None => f64::NAN,
-            };
-            i += 1;
-        }
-        RawEstimator::from_array(values)
-    };
+    pub const DEFAULT: RawEstimator = RawEstimator::WITH_DEFAULTS;
 
     /// Checks the estimator section.
     pub fn validate(&self) -> Result<(), ParamError> {
-        let p = |i: usize| ESTIMATOR_FIELDS[i].path;
-        within(p(0), self.tick_hz, 1.0, 100_000.0)?;
-        positive(p(1), self.filter_time_constant)?;
-        positive(p(2), self.spike_threshold)?;
-        within(p(3), self.spike_limit, 0.0, 65_534.0)?;
-        whole(p(3), self.spike_limit)?;
-        within(p(6), self.oil_min, -60.0, 300.0)?;
-        within(p(7), self.oil_max, -60.0, 300.0)?;
+        let n = self.named();
+        within(n.tick_hz, 1.0, 100_000.0)?;
+        positive(n.filter_time_constant)?;
+        positive(n.spike_threshold)?;
+        within(n.spike_limit, 0.0, 65_534.0)?;
+        whole(n.spike_limit)?;
+        within(n.oil_min, -60.0, 300.0)?;
+        within(n.oil_max, -60.0, 300.0)?;
         if self.oil_max <= self.oil_min {
-            return Err(err(
-                p(7),
-                self.oil_max,
-                Problem::Inconsistent("not above estimator.oil_min"),
-            ));
+            return Err(err(n.oil_max, Problem::Inconsistent("not above estimator.oil_min")));
         }
-        within(p(4), self.valid_min, self.oil_min, self.oil_max)?;
-        within(p(5), self.valid_max, self.oil_min, self.oil_max)?;
+        within(n.valid_min, self.oil_min, self.oil_max)?;
+        within(n.valid_max, self.oil_min, self.oil_max)?;
         if self.valid_max <= self.valid_min {
-            return Err(err(
-                p(5),
-                self.valid_max,
-                Problem::Inconsistent("not above estimator.valid_min"),
-            ));
+            return Err(err(n.valid_max, Problem::Inconsistent("not above estimator.valid_min")));
         }
         // A telemetry tick runs none of the estimator's rotating jobs: at
         // most every second tick, so that they keep being refreshed.
-        within(p(8), self.telemetry_hz, 0.0, self.tick_hz / 2.0)?;
-        positive(p(9), self.rtd_r0)?;
-        positive(p(10), self.rtd_reference)?;
-        let wires = within(p(11), self.rtd_wires, 2.0, 4.0)?;
-        whole(p(11), wires)?;
-        let mains = finite(p(12), self.mains_hz)?;
+        within(n.telemetry_hz, 0.0, self.tick_hz / 2.0)?;
+        positive(n.rtd_r0)?;
+        positive(n.rtd_reference)?;
+        within(n.rtd_wires, 2.0, 4.0)?;
+        whole(n.rtd_wires)?;
+        let mains = finite(n.mains_hz)?;
         if mains != 50.0 && mains != 60.0 {
-            return Err(err(p(12), mains, Problem::NotOneOf("50 or 60")));
+            return Err(err(n.mains_hz, Problem::NotOneOf("50 or 60")));
         }
         // Around IEC 60751's 3.9083e-3, -5.775e-7, -4.183e-12: a calibrated
         // probe's coefficients differ in the third or fourth digit.
-        within(p(13), self.rtd_a, 1.0e-3, 1.0e-2)?;
-        within(p(14), self.rtd_b, -1.0e-5, 1.0e-5)?;
-        within(p(15), self.rtd_c, -1.0e-9, 1.0e-9)?;
+        within(n.rtd_a, 1.0e-3, 1.0e-2)?;
+        within(n.rtd_b, -1.0e-5, 1.0e-5)?;
+        within(n.rtd_c, -1.0e-9, 1.0e-9)?;
         // The converter inverts R(t): it must rise over the oil's range.
         let mut t = self.oil_min;
         for i in 0..=64 {
             let slope = self.rtd_slope(t);
             if !(slope > 0.0) {
                 return Err(err(
-                    p(14),
-                    self.rtd_b,
+                    n.rtd_b,
                     Problem::Inconsistent(
                         "the RTD's resistance must rise with temperature over estimator.oil_min..oil_max",
                     ),
@@ -426,8 +487,7 @@ impl RawEstimator {
         let bound = self.rtd_resistance(self.oil_max) * 32768.0 / 32766.0;
         if !(self.rtd_reference > bound) {
             return Err(err(
-                p(10),
-                self.rtd_reference,
+                n.rtd_reference,
                 Problem::NotAbove {
                     bound,
                     why: "the RTD's resistance at estimator.oil_max: the converter would saturate",
@@ -471,51 +531,39 @@ impl RawParams {
     /// Assembles a parameter set from a lookup `get(section, key)`, applying
     /// defaults and the all-or-none rule of optional sections; then validates.
     pub fn from_lookup(mut get: impl FnMut(&str, &str) -> Option<f64>) -> Result<Self, ParamError> {
-        let mut core = [0.0; CORE_FIELDS.len()];
-        for (slot, field) in core.iter_mut().zip(CORE_FIELDS.iter()) {
-            *slot = get(field.section, field.key).or(field.default).ok_or(ParamError {
-                field: field.path,
-                value: f64::NAN,
-                problem: Problem::Missing,
-            })?;
-        }
-        let mut machine = [0.0; MACHINE_FIELDS.len()];
+        let missing = |field: &Field| ParamError {
+            field: field.path,
+            value: f64::NAN,
+            problem: Problem::Missing,
+        };
+        let core = RawCore::try_from_fields(|field| {
+            get(field.section, field.key)
+                .or(field.default)
+                .ok_or_else(|| missing(field))
+        })?;
         let mut present = 0;
         let mut first_missing = None;
-        for (slot, field) in machine.iter_mut().zip(MACHINE_FIELDS.iter()) {
-            match get(field.section, field.key) {
-                Some(v) => {
-                    *slot = v;
-                    present += 1;
-                }
-                None => {
-                    if first_missing.is_none() {
-                        first_missing = Some(field.path);
-                    }
-                }
+        let machine = RawMachine::from_fields(|field| match get(field.section, field.key) {
+            Some(v) => {
+                present += 1;
+                v
             }
-        }
+            None => {
+                first_missing.get_or_insert(field);
+                f64::NAN
+            }
+        });
         let machine = match (present, first_missing) {
             (0, _) => None,
-            (_, None) => Some(RawMachine::from_array(machine)),
-            (_, Some(path)) => {
-                return Err(ParamError {
-                    field: path,
-                    value: f64::NAN,
-                    problem: Problem::Missing,
-                });
-            }
+            (_, None) => Some(machine),
+            (_, Some(field)) => return Err(missing(field)),
         };
-        let mut estimator = RawEstimator::DEFAULT.to_array();
-        for (slot, field) in estimator.iter_mut().zip(ESTIMATOR_FIELDS.iter()) {
-            if let Some(v) = get(field.section, field.key) {
-                *slot = v;
-            }
-        }
+        let estimator =
+            RawEstimator::from_fields(|field| get(field.section, field.key).or(field.default).unwrap_or(f64::NAN));
         let raw = RawParams {
-            core: RawCore::from_array(core),
+            core,
             machine,
-            estimator: RawEstimator::from_array(estimator),
+            estimator,
         };
         raw.validate()?;
         Ok(raw)

@@ -10,8 +10,8 @@
 //! function of the core may divide by its positive fields.
 
 pub use compensator_params::{
-    CORE_FIELDS, ESTIMATOR_FIELDS, Field, MACHINE_FIELDS, ParamError, Problem, RawCore, RawEstimator, RawMachine,
-    RawParams,
+    CORE_FIELDS, CoreFields, ESTIMATOR_FIELDS, EstimatorFields, Field, MACHINE_FIELDS, MachineFields, Named,
+    ParamError, Problem, RawCore, RawEstimator, RawMachine, RawParams,
 };
 
 use crate::fluid::Oil;
@@ -86,15 +86,16 @@ pub struct Params<T> {
     pub machine: Option<Machine<T>>,
 }
 
-/// Converts a validated `f64` to `T`, rejecting values that overflow or
+/// Converts a validated field to `T`, rejecting values that overflow or
 /// underflow to zero there (a positive value must stay positive; a zero the
 /// schema allows stays zero).
-fn conv<T: Float>(field: &'static str, v: f64) -> Result<T, ParamError> {
+fn conv<T: Float>(n: Named) -> Result<T, ParamError> {
+    let v = n.value;
     let t = T::from_f64(v);
     let lost = !t.is_finite() || (v > 0.0 && !(t > T::ZERO));
     if lost {
         Err(ParamError {
-            field,
+            field: n.path,
             value: v,
             problem: Problem::NotRepresentable(T::NAME),
         })
@@ -117,59 +118,64 @@ impl<T: Float> Params<T> {
     /// As [`Params::new`], from the sections separately.
     pub fn from_core(core: &RawCore, machine: Option<&RawMachine>) -> Result<Self, ParamError> {
         core.validate()?;
-        let f = &CORE_FIELDS;
-        let v = core.to_array();
-        let c = |i: usize| conv::<T>(f[i].path, v[i]);
-        let params = Params {
+        let n = core.named();
+        let params: Self = Params {
             oil: {
-                for i in 0..5 {
-                    c(i)?;
+                for field in [n.walther_a, n.walther_b, n.density_15, n.expansion, n.bulk_modulus] {
+                    conv::<T>(field)?;
                 }
-                Oil::new(v[0], v[1], v[2], v[3], v[4])
+                Oil::new(
+                    core.walther_a,
+                    core.walther_b,
+                    core.density_15,
+                    core.expansion,
+                    core.bulk_modulus,
+                )
             },
             capillary: Capillary {
-                diameter: c(5)?,
-                length: c(6)?,
+                diameter: conv(n.laminar_diameter)?,
+                length: conv(n.laminar_length)?,
             },
             orifice: Orifice {
-                diameter: c(7)?,
-                discharge_coefficient: c(8)?,
+                diameter: conv(n.turbulent_diameter)?,
+                discharge_coefficient: conv(n.turbulent_discharge)?,
             },
             plunger: Plunger {
-                diameter: c(9)?,
-                mass: c(10)?,
-                damping: c(11)?,
-                spring_rate: c(12)?,
-                preload: c(13)?,
-                stroke: c(14)?,
+                diameter: conv(n.plunger_diameter)?,
+                mass: conv(n.mass)?,
+                damping: conv(n.damping)?,
+                spring_rate: conv(n.spring_rate)?,
+                preload: conv(n.preload)?,
+                stroke: conv(n.stroke)?,
             },
             slot: Slot {
-                diameter: c(15)?,
-                discharge_coefficient: c(16)?,
+                diameter: conv(n.slot_diameter)?,
+                discharge_coefficient: conv(n.slot_discharge)?,
             },
-            volume_a: c(17)?,
-            volume_b: c(18)?,
-            pressure_drop: c(19)?,
-            outlet_pressure: c(20)?,
+            volume_a: conv(n.volume_a)?,
+            volume_b: conv(n.volume_b)?,
+            pressure_drop: conv(n.pressure_drop)?,
+            outlet_pressure: conv(n.outlet_pressure)?,
             machine: match machine {
                 None => None,
                 Some(m) => {
                     m.validate()?;
-                    let mf = &MACHINE_FIELDS;
+                    let n = m.named();
                     Some(Machine {
-                        working_flow: conv(mf[0].path, m.working_flow)?,
-                        leakage_reference: conv(mf[1].path, m.leakage_reference)?,
-                        leakage_temperature: conv(mf[2].path, m.leakage_temperature)?,
+                        working_flow: conv(n.working_flow)?,
+                        leakage_reference: conv(n.leakage_reference)?,
+                        leakage_temperature: conv(n.leakage_temperature)?,
                     })
                 }
             },
         };
         // Derived quantities the model divides by must be representable too.
+        let f = &RawCore::FIELD;
         let derived = [
-            (f[9].path, params.plunger.area()),
-            (f[7].path, params.orifice.area()),
-            (f[5].path, params.capillary.bore_term()),
-            (f[14].path, params.plunger.area() * params.plunger.stroke),
+            (f.plunger_diameter.path, params.plunger.area()),
+            (f.turbulent_diameter.path, params.orifice.area()),
+            (f.laminar_diameter.path, params.capillary.bore_term()),
+            (f.stroke.path, params.plunger.area() * params.plunger.stroke),
         ];
         for (field, value) in derived {
             if !(value.is_finite() && value > T::ZERO) {
@@ -194,7 +200,7 @@ impl<T: Float> Params<T> {
     pub fn with_pressure_drop(&self, dp: T) -> Result<Self, ParamError> {
         if !(dp.is_finite() && dp > T::ZERO) {
             return Err(ParamError {
-                field: CORE_FIELDS[19].path,
+                field: RawCore::FIELD.pressure_drop.path,
                 value: dp.to_f64(),
                 problem: Problem::NotPositive,
             });
@@ -203,5 +209,152 @@ impl<T: Float> Params<T> {
             pressure_drop: dp,
             ..*self
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A valid design whose values all differ, so that a field converted
+    /// into another's place shows. No preload: the stroke may then shrink
+    /// to nothing without breaking a rule.
+    const CORE: RawCore = RawCore {
+        walther_a: 9.5,
+        walther_b: 3.75,
+        density_15: 871.0,
+        expansion: 6.5e-4,
+        bulk_modulus: 1.6e9,
+        laminar_diameter: 8.1e-4,
+        laminar_length: 0.0242,
+        turbulent_diameter: 7.2e-4,
+        turbulent_discharge: 0.61,
+        plunger_diameter: 0.0101,
+        mass: 0.021,
+        damping: 2.2,
+        spring_rate: 25600.0,
+        preload: 0.0,
+        stroke: 0.0015,
+        slot_diameter: 0.0021,
+        slot_discharge: 0.63,
+        volume_a: 2.1e-6,
+        volume_b: 2.3e-6,
+        pressure_drop: 410_000.0,
+        outlet_pressure: 1500.0,
+    };
+
+    const MACHINE: RawMachine = RawMachine {
+        working_flow: 3.6e-7,
+        leakage_reference: 3.5e-5,
+        leakage_temperature: 41.0,
+    };
+
+    type Get = fn(&Params<f64>) -> f64;
+
+    fn machine(p: &Params<f64>) -> Machine<f64> {
+        p.machine.expect("a machine was given")
+    }
+
+    /// Where each field of the file must land in `Params`, written by hand
+    /// (the oil's Walther constants are private: the oil is compared whole).
+    const LANDS: &[(&str, Get)] = &[
+        ("fluid.density_15", |p| p.oil.density_15),
+        ("fluid.expansion", |p| p.oil.expansion),
+        ("fluid.bulk_modulus", |p| p.oil.bulk_modulus),
+        ("laminar_throttle.diameter", |p| p.capillary.diameter),
+        ("laminar_throttle.length", |p| p.capillary.length),
+        ("turbulent_throttle.diameter", |p| p.orifice.diameter),
+        ("turbulent_throttle.discharge_coefficient", |p| {
+            p.orifice.discharge_coefficient
+        }),
+        ("plunger.diameter", |p| p.plunger.diameter),
+        ("plunger.mass", |p| p.plunger.mass),
+        ("plunger.damping", |p| p.plunger.damping),
+        ("plunger.spring_rate", |p| p.plunger.spring_rate),
+        ("plunger.preload", |p| p.plunger.preload),
+        ("plunger.stroke", |p| p.plunger.stroke),
+        ("slot.diameter", |p| p.slot.diameter),
+        ("slot.discharge_coefficient", |p| p.slot.discharge_coefficient),
+        ("chambers.volume_a", |p| p.volume_a),
+        ("chambers.volume_b", |p| p.volume_b),
+        ("operating.pressure_drop", |p| p.pressure_drop),
+        ("operating.outlet_pressure", |p| p.outlet_pressure),
+        ("machine.working_flow", |p| machine(p).working_flow),
+        ("machine.leakage_reference", |p| machine(p).leakage_reference),
+        ("machine.leakage_temperature", |p| machine(p).leakage_temperature),
+    ];
+
+    fn every_value() -> impl Iterator<Item = Named> {
+        CORE.named()
+            .into_array()
+            .into_iter()
+            .chain(MACHINE.named().into_array())
+    }
+
+    #[test]
+    fn every_field_lands_in_the_params_field_of_its_name() {
+        let values: Vec<Named> = every_value().collect();
+        for (i, a) in values.iter().enumerate() {
+            for b in &values[i + 1..] {
+                assert_ne!(
+                    a.value, b.value,
+                    "{} and {} are alike: a swap would go unseen",
+                    a.path, b.path
+                );
+            }
+        }
+        let p = Params::<f64>::from_core(&CORE, Some(&MACHINE)).unwrap();
+        let walther = ["fluid.walther_a", "fluid.walther_b"];
+        for n in &values {
+            match LANDS.iter().find(|(path, _)| *path == n.path) {
+                Some((_, get)) => assert_eq!(get(&p), n.value, "{} is not in its own field", n.path),
+                None => assert!(walther.contains(&n.path), "{}: where does it land?", n.path),
+            }
+        }
+        assert_eq!(LANDS.len() + walther.len(), values.len());
+        let oil = Oil::new(
+            CORE.walther_a,
+            CORE.walther_b,
+            CORE.density_15,
+            CORE.expansion,
+            CORE.bulk_modulus,
+        );
+        assert_eq!(p.oil, oil);
+        assert_ne!(
+            p.oil,
+            Oil::new(
+                CORE.walther_b,
+                CORE.walther_a,
+                CORE.density_15,
+                CORE.expansion,
+                CORE.bulk_modulus
+            ),
+            "the comparison sees swapped Walther constants"
+        );
+    }
+
+    /// A value `f32` loses (to zero or infinity) is reported under the name
+    /// of the field it was in.
+    #[test]
+    fn a_value_f32_cannot_hold_names_its_own_field() {
+        for field in CORE_FIELDS.iter().chain(MACHINE_FIELDS.iter()) {
+            let mut checked = false;
+            for lost in [1e-60, 1e60] {
+                let with = |n: Named| if n.path == field.path { lost } else { n.value };
+                let (core, machine) = (CORE.map(with), MACHINE.map(with));
+                if core.validate().and(machine.validate()).is_err() {
+                    continue;
+                }
+                let e = Params::<f32>::from_core(&core, Some(&machine)).unwrap_err();
+                assert_eq!(
+                    (e.field, e.value, e.problem),
+                    (field.path, lost, Problem::NotRepresentable("f32"))
+                );
+                checked = true;
+            }
+            assert!(checked, "{}: no valid value that f32 loses", field.path);
+        }
+        // The same values in `f64` are fine.
+        assert!(Params::<f64>::from_core(&CORE, Some(&MACHINE)).is_ok());
     }
 }
