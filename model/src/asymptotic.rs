@@ -1,5 +1,5 @@
 //! Asymptotic expansion of the equilibrium (paper section 3, Eqs. 11-32;
-//! MODEL.md section 5).
+//! `docs/model.md` section 5).
 //!
 //! `Phi(A) = (dp + A^2 - A sqrt(4 dp + A^2)) A_p / c` (Eq. 16, with the
 //! plunger area) and `x = Phi(A(t)) - x0` (Eq. 17). About a reference
@@ -35,7 +35,7 @@ use crate::fluid::{Derivatives, FluidPoint};
 use crate::params::Params;
 use crate::scalar::Float;
 
-/// Which quantity the small parameter expands (MODEL.md section 5).
+/// Which quantity the small parameter expands (`docs/model.md` section 5).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Reading {

@@ -1,4 +1,4 @@
-//! Quasi-static equilibrium (paper Eqs. 2-10, MODEL.md section 4).
+//! Quasi-static equilibrium (paper Eqs. 2-10, `docs/model.md` section 4).
 //!
 //! Each chamber is a series pair of an orifice and a capillary carrying the
 //! same flow `Q_a = Q_b`. With `A(t) = R_l / sqrt(R_t)` and `q = sqrt(R_t) Q_a`:

@@ -1,4 +1,4 @@
-//! Oil properties as functions of temperature (MODEL.md section 2).
+//! Oil properties as functions of temperature (`docs/model.md` section 2).
 //!
 //! * Kinematic viscosity by Walther / ASTM D341:
 //!   `log10(log10(nu_cSt + 0.7)) = a - b log10(T_K)`.

@@ -3,7 +3,10 @@
 //! A `no_std`, allocation-free digital twin of the passive throttle-based
 //! temperature flow compensator of "Asymptotic analysis and reduced-order
 //! modeling of a passive throttle-based temperature flow compensator", with
-//! the physics fixed in `MODEL.md` of the project's shared notes.
+//! the physics fixed in the project's `docs/model.md` (what the paper
+//! leaves open or gets wrong, and where the code departs from the plain
+//! equations: the regularised orifice law, the stops as inelastic events,
+//! the twin's units).
 //!
 //! The paper's three levels:
 //!

@@ -1,5 +1,5 @@
 //! The reduced-order fluid-structure model (paper section 4, Eqs. 33-36,
-//! signs of MODEL.md section 6), nondimensionalised for fixed point.
+//! signs of `docs/model.md` section 6), nondimensionalised for fixed point.
 //!
 //! Dimensional form:
 //!
