@@ -2,7 +2,8 @@
 //! step, generic over the scalar type and the state dimension.
 //!
 //! Rosenbrock (linearly implicit Runge-Kutta) methods in the transformed
-//! form of Hairer & Wanner (IV.7), one LU factorisation per step:
+//! form of Hairer & Wanner (IV.7), one factorisation of the stage matrix
+//! per step (a dense LU, or the system's own: [`OdeSystem::linearise`]):
 //!
 //! ```text
 //! (I / (h gamma) - J) U_i = f(y + sum_j a_ij U_j) + sum_j (c_ij / h) U_j
@@ -323,11 +324,6 @@ impl<T: Real> Stepper<T> {
             reuse_f,
             rk4_sixth_h: T::from_f64(h / 6.0),
         }
-    }
-
-    /// The scheme.
-    pub fn scheme(&self) -> Scheme {
-        self.scheme
     }
 
     /// Advances `y` by one step of `sys`.

@@ -3,9 +3,17 @@
 //!
 //! A tick of length `dt` is `substeps` steps of one [`Scheme`]; the
 //! temperature-dependent coefficients are frozen over a tick (set them for
-//! the tick's midpoint to follow a ramp to second order). The cost of a
-//! tick depends on the configuration only: one Jacobian, one 4x4 LU and
-//! `stages` right-hand sides per substep, whatever the state.
+//! the tick's midpoint to follow a ramp to second order).
+//!
+//! The cost of a tick is bounded by the configuration. A substep is one
+//! step of the scheme: for the shipped SDIRK ([`super::dirk`]) `stages`
+//! stage solutions, each a fixed number of Newton iterations on the
+//! plunger velocity with both chamber pressures in closed form; for a
+//! Rosenbrock scheme one factorisation of the stage matrix with the
+//! pressures eliminated ([`super::fsi::FsiFactor`], a 2x2 system) and
+//! `stages` right-hand sides. A stop event adds at most one step per
+//! substep ([`EVENTS_PER_SUBSTEP`]), and the first substep after an abrupt
+//! change is at most [`MAX_GRADED_PIECES`] pieces ([`Twin::tick`]).
 //!
 //! The twin is generic over the parameters' float type `F` (used for the
 //! fluid properties at the sensor rate) and the integration scalar `T`
