@@ -25,7 +25,11 @@
 //!
 //! Nothing in this crate allocates or panics: bad parameters give a
 //! [`params::ParamError`] naming the field, a model evaluation outside its
-//! range gives a [`ModelError`].
+//! range gives a [`ModelError`] naming the quantity, a twin tick that fails
+//! gives a [`dynamics::StepError`], a temperature sensor a
+//! [`sensor::SensorFault`]. Each fallible function's documentation says
+//! what makes it fail; [`ModelError`], [`dynamics::StepError`] and the
+//! sensor's errors implement `Display` and `core::error::Error`.
 #![cfg_attr(not(test), no_std)]
 #![deny(missing_docs)]
 #![forbid(unsafe_op_in_unsafe_fn)]
