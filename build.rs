@@ -29,7 +29,7 @@
 //!    (`$OUT_DIR/expectations.rs`). Both are computed here, on the host, in
 //!    `f64` by the independent reference (`compensator-reference`:
 //!    bisection on each chamber's flow balance, Walther and density written
-//!    from MODEL.md), never by the core. The board image needs none of it,
+//!    from `docs/model.md`), never by the core. The board image needs none of it,
 //!    and does not build the reference.
 
 // The replay's template is only used for the QEMU images (feature `qemu`).
