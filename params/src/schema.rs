@@ -290,6 +290,8 @@ impl fmt::Display for ParamError {
     }
 }
 
+impl core::error::Error for ParamError {}
+
 /// The error naming the field `n` and its value.
 fn err(n: Named, problem: Problem) -> ParamError {
     ParamError {
