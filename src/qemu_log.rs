@@ -49,8 +49,8 @@ fn flush_buffer(out: &mut Buffer) {
     if out.stdout.is_none() {
         out.stdout = cortex_m_semihosting::hio::hstdout().ok();
     }
-    if let Some(h) = out.stdout.as_mut() {
-        let _ = h.write_all(&out.bytes[..out.len]);
+    if let (Some(h), Some(frame)) = (out.stdout.as_mut(), out.bytes.get(..out.len)) {
+        let _ = h.write_all(frame);
     }
     out.len = 0;
 }
@@ -70,11 +70,15 @@ fn push(bytes: &[u8]) {
         return;
     }
     for &b in bytes {
-        if out.len == BUFFER {
+        if out.len >= BUFFER {
             flush_buffer(out);
         }
-        out.bytes[out.len] = b;
-        out.len += 1;
+        // Always `Some` (`len < BUFFER` here); `get_mut` keeps the logger,
+        // which the tick's telemetry runs through, free of panic paths.
+        if let Some(slot) = out.bytes.get_mut(out.len) {
+            *slot = b;
+            out.len += 1;
+        }
     }
 }
 
@@ -83,7 +87,9 @@ unsafe impl defmt::Logger for Logger {
         // SAFETY: paired with the `release` below.
         let restore = unsafe { critical_section::acquire() };
         if TAKEN.swap(true, Ordering::Relaxed) {
-            panic!("defmt logger taken reentrantly");
+            // Re-entered (a fault or panic while logging): the frame in
+            // progress is lost; end the run rather than interleave frames.
+            crate::qemu::exit(false);
         }
         // SAFETY: we hold the critical section and `TAKEN`.
         unsafe {

@@ -215,16 +215,26 @@ fn main() -> ! {
             warn!("{=u32} ticks overran", now.wrapping_sub(done) - 1);
         }
         done = now;
-        let sample = if now % sensor_every == 0 {
-            sensor.read()
-        } else {
-            Ok(None)
-        };
-        let estimate = estimator.tick(sample);
-        if estimator.telemetry_due() {
-            // The same line as the QEMU twin's: `cargo xtask` decodes it.
-            let ms = clock().map_or(0, |c| c.millis(now));
-            info!("{=u32} ms {}", ms, estimate);
-        }
+        tick_path(&mut sensor, &mut estimator, now, now % sensor_every == 0);
+    }
+}
+
+/// One tick: the sensor read when due (`read`), the estimator, the
+/// telemetry record when due. Not inlined, so that `cargo xtask test` can
+/// check that nothing reachable from it panics (the HAL's SPI and the
+/// RTT logger included).
+#[inline(never)]
+fn tick_path<S: embedded_hal::spi::SpiDevice>(
+    sensor: &mut Max31865<S>,
+    estimator: &mut Estimator,
+    now: u32,
+    read: bool,
+) {
+    let sample = if read { sensor.read() } else { Ok(None) };
+    let estimate = estimator.tick(sample);
+    if estimator.telemetry_due() {
+        // The same line as the QEMU twin's: `cargo xtask` decodes it.
+        let ms = clock().map_or(0, |c| c.millis(now));
+        info!("{=u32} ms {}", ms, estimate);
     }
 }

@@ -20,7 +20,7 @@
 
 use compensator::dynamics::linear::linearise;
 use compensator::equilibrium::{balance_temperature, equilibrium};
-use compensator::estimator::{Estimator, EstimatorConfig, Flags};
+use compensator::estimator::{Estimator, EstimatorConfig, Flags, StateEstimate};
 use compensator::sensor::TemperatureSource;
 use compensator::sensor::max31865::{Max31865, Settings, fault};
 use compensator::sensor::simulated::SimulatedMax31865;
@@ -238,8 +238,7 @@ fn replay(params: &Params<f32>, config: EstimatorConfig) -> bool {
                 }
             }
         }
-        let sample = if k % sensor_every == 0 { sensor.read() } else { Ok(None) };
-        let e = estimator.tick(sample);
+        let e = tick_path(&mut sensor, &mut estimator, k % sensor_every == 0);
         if let Some(i) = fault_now {
             seen[i].insert(e.flags);
         }
@@ -303,7 +302,7 @@ fn replay(params: &Params<f32>, config: EstimatorConfig) -> bool {
             next_checkpoint += 1;
         }
         if estimator.telemetry_due() {
-            info!("{=u32} ms {}", (k as f32 * tick * 1e3 + 0.5) as u32, e);
+            telemetry_path((k as f32 * tick * 1e3 + 0.5) as u32, &e);
         }
     }
     checks.check(next_checkpoint == CHECKPOINTS.len(), "every checkpoint reached", end);
@@ -331,6 +330,22 @@ fn replay(params: &Params<f32>, config: EstimatorConfig) -> bool {
 }
 
 /// The simulated converter behind the driver (the driver owns it).
+/// One controller tick as the board runs it: the sensor read when due
+/// (`read`), then the estimator (filter, twin, job). Not inlined, so that
+/// `cargo xtask test` can check that nothing reachable from it panics.
+#[inline(never)]
+fn tick_path(sensor: &mut Max31865<SimulatedMax31865>, estimator: &mut Estimator, read: bool) -> StateEstimate {
+    let sample = if read { sensor.read() } else { Ok(None) };
+    estimator.tick(sample)
+}
+
+/// The telemetry record of `e` at `ms`, packed by defmt (checked as
+/// [`tick_path`] is).
+#[inline(never)]
+fn telemetry_path(ms: u32, e: &StateEstimate) {
+    info!("{=u32} ms {}", ms, e);
+}
+
 fn sensor_device(sensor: &mut Max31865<SimulatedMax31865>) -> &mut SimulatedMax31865 {
     sensor.device_mut()
 }

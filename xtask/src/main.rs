@@ -34,6 +34,7 @@ mod callgrind;
 mod firmware;
 mod flash;
 mod msrv;
+mod panic_free;
 mod params;
 mod process;
 mod qemu;
@@ -437,6 +438,20 @@ fn cmd_test(bless: bool) -> Outcome {
     for (img, elf) in &elfs {
         flash::check_no_debug_logs(elf).map_err(|e| format!("{} ({}): {e}", img.bin, img.target))?;
     }
+    step(
+        "the tick links no panic: nothing reachable from the images' tick_path (and the twin's telemetry_path) panics",
+    );
+    eprintln!(
+        "xtask: twin: {}",
+        panic_free::check(&twin.elf, &["tick_path", "telemetry_path"], &[])?
+    );
+    let board = &elfs.iter().find(|(i, _)| i.bin == "board").ok_or("no board image")?.1;
+    // defmt-rtt's acquire/release panic if the logger is taken re-entrantly;
+    // the board logs from `main` only (never from an interrupt).
+    eprintln!(
+        "xtask: board: {}",
+        panic_free::check(board, &["tick_path"], &["_defmt_acquire", "_defmt_release"])?
+    );
     step("QEMU: the core's tests on the emulated Cortex-M4F");
     firmware::on_target_tests(&tc, &root)?;
     step("QEMU: cost, footprint and stack budgets");

@@ -213,17 +213,19 @@ impl<T: Real> Dirk<T> {
                 alpha[i][j] = T::from_f64(tableau.a[i][j] / tableau.gamma);
             }
         }
+        // Stiffly accurate: `b` is the last row of `A` (`gamma` on the
+        // diagonal). `stages` clamped to `1..=MAX_STAGES`, which the cited
+        // tableaus satisfy, so that no index can fail (the estimator may
+        // rebuild a twin on its tick).
+        let stages = tableau.stages.clamp(1, MAX_STAGES);
+        let last = tableau.a.get(stages - 1).copied().unwrap_or([0.0; MAX_STAGES]);
         let mut h_b = [T::ZERO; MAX_STAGES];
-        for (j, hb) in h_b.iter_mut().enumerate().take(tableau.stages) {
-            let b = if j + 1 == tableau.stages {
-                tableau.gamma
-            } else {
-                tableau.a[tableau.stages - 1][j]
-            };
+        for (j, (hb, a)) in h_b.iter_mut().zip(last).enumerate().take(stages) {
+            let b = if j + 1 == stages { tableau.gamma } else { a };
             *hb = T::from_f64(h * b);
         }
         Dirk {
-            stages: tableau.stages,
+            stages,
             alpha,
             h_b,
             h_gamma: T::from_f64(h * tableau.gamma),
@@ -252,7 +254,10 @@ impl<T: Real> Dirk<T> {
         let mut d = [[T::ZERO; 4]; MAX_STAGES];
         let mut yi = *y;
         let mut ws = [T::ZERO; MAX_STAGES];
-        for i in 0..self.stages {
+        // `stages <= MAX_STAGES` by construction; the `min` lets the
+        // compiler see it, so the tick indexes without bounds checks.
+        let stages = self.stages.min(MAX_STAGES);
+        for i in 0..stages {
             let mut z = *y;
             for j in 0..i {
                 let a = self.alpha[i][j];
@@ -278,7 +283,7 @@ impl<T: Real> Dirk<T> {
         // each at w = 31 LSB, 32 substeps per tick), and it stopped 4e-4 of
         // the stroke short (`docs/dynamics.md`, "Fixed-point ranges").
         let h_a_x = if frac == T::ONE { c.a_x } else { c.a_x * frac };
-        yi[0] = y[0].dot_add_compensated(h_a_x, &self.h_b[..self.stages], &ws[..self.stages], xi_carry);
+        yi[0] = y[0].dot_add_compensated(h_a_x, &self.h_b[..stages], &ws[..stages], xi_carry);
         yi
     }
 
@@ -290,7 +295,7 @@ impl<T: Real> Dirk<T> {
         let (mut ua, mut ub) = (ua0, ub0);
         let mut da = [T::ZERO; MAX_STAGES];
         let mut db = [T::ZERO; MAX_STAGES];
-        for i in 0..self.stages {
+        for i in 0..self.stages.min(MAX_STAGES) {
             let (mut za, mut zb) = (ua0, ub0);
             for j in 0..i {
                 let a = self.alpha[i][j];

@@ -384,7 +384,9 @@ impl<T: Real> Stepper<T> {
             .ok_or(StepError::Singular)?;
         let mut u = [[T::ZERO; N]; MAX_STAGES];
         let mut f = f0;
-        for i in 0..self.stages {
+        // `stages <= MAX_STAGES` by construction; the `min` lets the
+        // compiler see it (no bounds check on the tick).
+        for i in 0..self.stages.min(MAX_STAGES) {
             if i > 0 && !self.reuse_f[i] {
                 let mut yi = *y;
                 for (j, uj) in u.iter().enumerate().take(i) {
