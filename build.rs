@@ -29,12 +29,17 @@
 //!    (`$OUT_DIR/expectations.rs`). Both are computed here, on the host, in
 //!    `f64` by the independent reference (`compensator-reference`:
 //!    bisection on each chamber's flow balance, Walther and density written
-//!    from MODEL.md), never by the core. The board image needs none of it,
+//!    from `docs/model.md`), never by the core. The board image needs none of it,
 //!    and does not build the reference.
 
 // The replay's template is only used for the QEMU images (feature `qemu`).
 #![cfg_attr(not(feature = "qemu"), allow(dead_code))]
 
+/// The injected faults, shared with the twin image and xtask's replica.
+#[cfg(feature = "qemu")]
+#[allow(dead_code)]
+#[path = "src/replay_faults.rs"]
+mod replay_faults;
 use compensator_params::{Field, Named, RawCore, RawEstimator, RawMachine};
 use std::path::PathBuf;
 use std::{env, fs};
@@ -85,6 +90,7 @@ fn main() {
     // reported by the reader below).
     let params = fs::canonicalize(&params).unwrap_or(params);
     println!("cargo:rerun-if-changed={}", params.display());
+    println!("cargo:rerun-if-changed=src/replay_faults.rs");
     let raw = match compensator_params::file::load(&params) {
         Ok(raw) => raw,
         Err(e) => {
@@ -201,17 +207,6 @@ const PIECES: [(f64, f64, f64, f64); 10] = [
     (79.0, 82.0, 30.0, 30.0),
 ];
 
-/// Injected sensor faults: (start [s], end [s], `Injected` variant of the
-/// twin firmware, the `Flags` constant expected).
-const FAULTS: [(f64, f64, &str, &str); 5] = [
-    (10.0, 10.02, "Spike", "SPIKE"),
-    (20.0, 20.3, "BusError", "SENSOR_FAULT"),
-    (30.0, 30.1, "OpenRtd", "SENSOR_FAULT"),
-    (40.0, 40.05, "SaturatedCode", "SENSOR_FAULT"),
-    // Half a second without samples.
-    (69.0, 70.0, "BusError", "DEGRADED"),
-];
-
 /// Time the filter needs to leave the validated range after a step out of
 /// it [s] (a few of its 0.2 s time constants would do; half a second is
 /// ample for the 60 -> 90 C step).
@@ -234,8 +229,6 @@ const OUT_OF_RANGE_DEPTH: f64 = 12.0;
 struct Replay {
     /// (start s, end s, from C, to C).
     pieces: Vec<(f64, f64, f64, f64)>,
-    /// (start s, end s, `Injected` variant, `Flags` constant).
-    faults: Vec<(f64, f64, &'static str, &'static str)>,
     /// When OUT_OF_RANGE must be raised (from s, to s); `None` when the
     /// oil range leaves no room outside the validated one.
     out_of_range: Option<(f64, f64)>,
@@ -264,15 +257,12 @@ impl Replay {
         for (a, b, c, d) in &self.pieces {
             s += &format!("piece {a:?} {b:?} {c:?} {d:?}\n");
         }
-        for (a, b, k, _) in &self.faults {
-            s += &format!("fault {a:?} {b:?} {k}\n");
-        }
         s += &format!("spike_delta {:?}\n", self.spike);
         s
     }
 }
 
-/// The template replay (`PIECES`, `FAULTS`, written for the paper's 26-78 C
+/// The template replay (`PIECES`, and the faults of `src/replay_faults.rs`, written for the paper's 26-78 C
 /// and -20..150 C) adapted to a device's ranges, so that any parameter file
 /// the CLI accepts builds the QEMU twin: every temperature inside the oil
 /// range; an out-of-range hold outside the validated range (the template's
@@ -324,14 +314,16 @@ fn adapt(est: &compensator_params::RawEstimator) -> Replay {
         .map(|p| (p.0 + OUT_OF_RANGE_DELAY, p.1));
     let mut replay = Replay {
         pieces,
-        faults: FAULTS.to_vec(),
         out_of_range,
         spike: 0.0,
         notes,
     };
     // The spike: out of the filter's band (more than spike_threshold away),
     // inside the oil range (else it is a sensor fault, not a spike).
-    let at = FAULTS.iter().find(|f| f.2 == "Spike").map_or(0.0, |f| f.0);
+    let at = replay_faults::FAULTS
+        .iter()
+        .find(|f| f.injected == replay_faults::Injected::Spike)
+        .map_or(0.0, |f| f64::from(f.start));
     let t = replay.temperature_at(at);
     let want = (2.0 * est.spike_threshold).max(40.0);
     let (up, down) = (oil_hi - t, t - oil_lo);
@@ -366,14 +358,6 @@ fn replay_rs(core: &compensator_params::RawCore, est: &compensator_params::RawEs
     );
     for (a, b, c, d) in &replay.pieces {
         s += &format!("    ({a:?}, {b:?}, {c:?}, {d:?}),\n");
-    }
-    s += "];\n/// Injected faults: (start s, end s, what, flag expected).\n";
-    s += &format!(
-        "const REPLAY_FAULTS: [(f32, f32, Injected, Flags); {}] = [\n",
-        replay.faults.len()
-    );
-    for (a, b, k, f) in &replay.faults {
-        s += &format!("    ({a:?}, {b:?}, Injected::{k}, Flags::{f}),\n");
     }
     s += "];\n";
     s += "/// What the injected spike adds to the temperature [C] (beyond the\n";

@@ -5,6 +5,7 @@
 //! for the fault handler's test), and the hardware glue they share.
 //!
 //! * [`clock`]: real time from the tick counter (defmt timestamps).
+//! * [`replay_faults`]: the sensor faults the QEMU twin's replay injects.
 //! * `qemu` (QEMU images): semihosting exit, the shared panic and
 //!   HardFault handling, the defmt logger over semihosting.
 //!
@@ -15,6 +16,7 @@
 #![forbid(unsafe_op_in_unsafe_fn)]
 
 pub mod clock;
+pub mod replay_faults;
 
 #[cfg(all(feature = "qemu", target_os = "none"))]
 pub mod qemu;

@@ -1,5 +1,9 @@
 //! What the QEMU images share besides their logger (`qemu_log`): the
-//! semihosting exit and the `HardFault` report.
+//! semihosting exit, the panic handler and the `HardFault` report.
+//!
+//! A panic on QEMU logs where it happened and ends the run with exit code 1
+//! (the handler lives here, in the library, so every QEMU image and the
+//! on-target tests link this one; the board image links `panic-probe`).
 //!
 //! A fault on QEMU (a bad access, an undefined instruction, a stack
 //! overflow into unmapped memory) ends the run at once with the fault's
@@ -22,6 +26,16 @@ pub fn exit(ok: bool) -> ! {
     debug::exit(if ok { debug::EXIT_SUCCESS } else { debug::EXIT_FAILURE });
     #[allow(clippy::empty_loop)]
     loop {}
+}
+
+/// The QEMU images' panic handler: the location (the message would link
+/// `core::fmt`'s float printing, 17 KiB) and exit code 1.
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    if let Some(loc) = info.location() {
+        defmt::error!("panic at {=str}:{=u32}", loc.file(), loc.line());
+    }
+    exit(false)
 }
 
 /// Reports a HardFault (the stacked `pc`, `lr`, `xpsr` and the fault status

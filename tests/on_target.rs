@@ -14,14 +14,6 @@ include!(concat!(env!("OUT_DIR"), "/expectations.rs"));
 
 compensator_firmware::qemu_hard_fault_handler!();
 
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
-    defmt::error!("{}", defmt::Display2Format(info));
-    cortex_m_semihosting::debug::exit(cortex_m_semihosting::debug::EXIT_FAILURE);
-    #[allow(clippy::empty_loop)]
-    loop {}
-}
-
 /// `|actual - expected| <= atol + rtol |expected|`, in f64.
 fn close(actual: f32, expected: f64, rtol: f64, atol: f64) -> bool {
     let a = actual as f64;

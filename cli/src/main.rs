@@ -1,6 +1,6 @@
 //! `compensator`: the host command-line tool.
 //!
-//! Reads the parameter file of MODEL.md section 8, writes CSV with a header
+//! Reads the parameter file of `docs/model.md` section 8, writes CSV with a header
 //! row in SI units. Bad input exits with status 2 and one line on stderr
 //! naming the field; nothing is written to stdout then.
 
@@ -47,7 +47,7 @@ enum ReadingArg {
 enum Command {
     /// Quasi-static equilibrium (Eqs. 2-10) per temperature.
     Equilibrium {
-        /// Parameter file (TOML, MODEL.md section 8).
+        /// Parameter file (TOML, docs/model.md section 8).
         #[arg(long)]
         params: PathBuf,
         /// Temperatures [C]: start:end:step or a comma list.

@@ -2,7 +2,7 @@
 //! deterministic generator of physical parameter sets, tolerance helpers.
 //!
 //! Nothing here calls the core's closed forms: the references are written
-//! from MODEL.md directly, so that an error in the core cannot hide in the
+//! from `docs/model.md` directly, so that an error in the core cannot hide in the
 //! reference.
 
 pub mod accuracy;

@@ -1,5 +1,5 @@
 //! Asymptotic expansion of the equilibrium (paper section 3, Eqs. 11-32;
-//! MODEL.md section 5).
+//! `docs/model.md` section 5).
 //!
 //! `Phi(A) = (dp + A^2 - A sqrt(4 dp + A^2)) A_p / c` (Eq. 16, with the
 //! plunger area) and `x = Phi(A(t)) - x0` (Eq. 17). About a reference
@@ -35,7 +35,7 @@ use crate::fluid::{Derivatives, FluidPoint};
 use crate::params::Params;
 use crate::scalar::Float;
 
-/// Which quantity the small parameter expands (MODEL.md section 5).
+/// Which quantity the small parameter expands (`docs/model.md` section 5).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Reading {
@@ -141,6 +141,11 @@ pub struct Expansion<T> {
 
 impl<T: Float> Expansion<T> {
     /// Prepares the expansion about `t0` [C].
+    ///
+    /// # Errors
+    ///
+    /// The oil model refuses `t0`, or `A` or its derivatives there are not
+    /// finite ([`a_derivatives`], [`crate::fluid::Oil::density_derivatives`]).
     pub fn new(params: &Params<T>, t0: T, reading: Reading) -> Result<Self, ModelError> {
         let a0 = a_derivatives(params, t0)?;
         let rho0 = params.oil.density_derivatives(t0)?;
@@ -155,6 +160,13 @@ impl<T: Float> Expansion<T> {
     }
 
     /// The series terms at temperature `t` [C].
+    ///
+    /// # Errors
+    ///
+    /// `NonFinite("temperature")` for a `t` that is not finite; with
+    /// [`Reading::Property`], the oil model refuses `t`
+    /// ([`crate::fluid::Oil::state`]); `NonFinite("asymptotic term")` when a
+    /// displacement or total-flow term is not finite.
     pub fn at(&self, t: T) -> Result<Terms<T>, ModelError> {
         let p = &self.params;
         let t = finite(t, "temperature")?;
@@ -242,12 +254,22 @@ pub struct Sensitivity<T> {
 }
 
 /// Sensitivities of the equilibrium to temperature at `t` [C] (Eqs. 30-31).
+///
+/// # Errors
+///
+/// The oil model refuses `t` ([`crate::fluid::Oil::point`]), or as
+/// [`sensitivity_at`].
 pub fn sensitivity<T: Float>(params: &Params<T>, t: T) -> Result<Sensitivity<T>, ModelError> {
     sensitivity_at(params, &params.oil.point(t)?)
 }
 
 /// As [`sensitivity`] from an evaluated [`FluidPoint`] (what the estimator
 /// uses, sharing one Walther evaluation with the fluid state).
+///
+/// # Errors
+///
+/// As [`a_derivatives_at`], and `NonFinite` naming `dx/dt` or
+/// `dQ_throt/dt` when one of them is not finite.
 pub fn sensitivity_at<T: Float>(params: &Params<T>, point: &FluidPoint<T>) -> Result<Sensitivity<T>, ModelError> {
     let a = a_derivatives_at(params, point)?;
     let rho = &point.density;
@@ -290,6 +312,13 @@ pub const MAX_MONOTONICITY_SAMPLES: u32 = 100_000;
 /// Checks Eq. (32), `Phi'(A(t)) dA/dt != 0` with one sign, on `samples`
 /// evenly spaced temperatures of `[lo, hi]` [C] (clamped to
 /// `2..=MAX_MONOTONICITY_SAMPLES`).
+///
+/// # Errors
+///
+/// `NonFinite("temperature")` for a bound that is not finite,
+/// `OutOfRange("temperature interval")` unless `lo < hi`, and any sample's
+/// error from [`sensitivity`] (the oil model refusing a temperature of the
+/// range): the verdict needs every sample.
 pub fn monotonicity<T: Float>(params: &Params<T>, lo: T, hi: T, samples: u32) -> Result<Monotonicity<T>, ModelError> {
     let (lo, hi) = (finite(lo, "temperature")?, finite(hi, "temperature")?);
     if !(hi > lo) {

@@ -36,6 +36,11 @@ pub struct Compensation<T> {
 }
 
 /// Laminar leakage of the machine at `t` [C]: `dQ_ref mu(t_ref) / mu(t)` [m^3/s].
+///
+/// # Errors
+///
+/// The oil model refuses `t` or the machine's reference temperature
+/// ([`crate::fluid::Oil::state`]), or as [`losses_for`].
 pub fn losses<T: Float>(params: &Params<T>, machine: &Machine<T>, t: T) -> Result<T, ModelError> {
     let mu_ref = params.oil.state(machine.leakage_temperature)?.dynamic_viscosity;
     let mu = params.oil.state(t)?.dynamic_viscosity;
@@ -44,13 +49,23 @@ pub fn losses<T: Float>(params: &Params<T>, machine: &Machine<T>, t: T) -> Resul
 
 /// Laminar leakage for the oil's dynamic viscosity `mu` [Pa s], given the
 /// viscosity `mu_ref` at the machine's reference temperature [m^3/s].
+///
+/// # Errors
+///
+/// `NonFinite("losses")` when the quotient is not finite (a zero `mu`).
 pub fn losses_for<T: Float>(machine: &Machine<T>, mu_ref: T, mu: T) -> Result<T, ModelError> {
     finite(machine.leakage_reference * mu_ref / mu, "losses")
 }
 
 /// Demand, supply, error and the Eq. (9) window at `t` [C].
 ///
-/// Returns `OutOfRange("machine")` when the parameter set has no `[machine]`.
+/// # Errors
+///
+/// * `OutOfRange("machine (no [machine] section)")` when the parameter set
+///   describes no machine;
+/// * as [`equilibrium`] and [`losses`] at `t`;
+/// * `NonFinite` naming the compensation error, the required area or the
+///   required displacement when one of them is not finite.
 pub fn compensation<T: Float>(params: &Params<T>, t: T) -> Result<Compensation<T>, ModelError> {
     let machine = params
         .machine

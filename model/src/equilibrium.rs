@@ -1,4 +1,4 @@
-//! Quasi-static equilibrium (paper Eqs. 2-10, MODEL.md section 4).
+//! Quasi-static equilibrium (paper Eqs. 2-10, `docs/model.md` section 4).
 //!
 //! Each chamber is a series pair of an orifice and a capillary carrying the
 //! same flow `Q_a = Q_b`. With `A(t) = R_l / sqrt(R_t)` and `q = sqrt(R_t) Q_a`:
@@ -99,11 +99,21 @@ pub fn a_parameter<T: Float>(params: &Params<T>, fluid: &FluidState<T>) -> T {
 /// derivatives: with `L1 = nu'/nu + rho'/(2 rho)` and
 /// `L2 = nu''/nu - (nu'/nu)^2 + rho''/(2 rho) - (rho'/rho)^2 / 2`,
 /// `A' = A L1` and `A'' = A (L1^2 + L2)`.
+///
+/// # Errors
+///
+/// The oil model refuses `t` ([`crate::fluid::Oil::point`]), or as
+/// [`a_derivatives_at`].
 pub fn a_derivatives<T: Float>(params: &Params<T>, t: T) -> Result<Derivatives<T>, ModelError> {
     a_derivatives_at(params, &params.oil.point(t)?)
 }
 
 /// As [`a_derivatives`] from an evaluated [`FluidPoint`].
+///
+/// # Errors
+///
+/// [`ModelError::NonFinite`] naming `A(t)`, `dA/dt` or `d2A/dt2` when one
+/// of them is not finite.
 pub fn a_derivatives_at<T: Float>(params: &Params<T>, point: &FluidPoint<T>) -> Result<Derivatives<T>, ModelError> {
     let (nu, rho) = (&point.viscosity, &point.density);
     let a = geometry_factor(params) * nu.value * rho.value.sqrt();
@@ -132,6 +142,11 @@ pub fn clamp_to_stops<T: Float>(x_free: T, stroke: T) -> (T, Stop) {
 }
 
 /// The equilibrium for a given `A` [sqrt(Pa)] and fluid state.
+///
+/// # Errors
+///
+/// [`ModelError::NonFinite`] when `a`, the free displacement or the total
+/// flow is not finite.
 pub fn equilibrium_for<T: Float>(params: &Params<T>, fluid: FluidState<T>, a: T) -> Result<Equilibrium<T>, ModelError> {
     let dp = params.pressure_drop;
     let sqrt_dp = dp.sqrt();
@@ -162,6 +177,11 @@ pub fn equilibrium_for<T: Float>(params: &Params<T>, fluid: FluidState<T>, a: T)
 }
 
 /// The quasi-static equilibrium at temperature `t` [C].
+///
+/// # Errors
+///
+/// The oil model refuses `t` ([`crate::fluid::Oil::state`]: `NonFinite`
+/// or `OutOfRange`), or as [`equilibrium_for`].
 pub fn equilibrium<T: Float>(params: &Params<T>, t: T) -> Result<Equilibrium<T>, ModelError> {
     let fluid = params.oil.state(t)?;
     let a = a_parameter(params, &fluid);
@@ -174,6 +194,16 @@ pub fn equilibrium<T: Float>(params: &Params<T>, t: T) -> Result<Equilibrium<T>,
 /// `A` falls monotonically with temperature for every valid parameter set
 /// (viscosity and density both fall), so the root is unique when bracketed.
 /// Fixed cost: 64 halvings at most (stops early at the type's resolution).
+///
+/// # Errors
+///
+/// * [`ModelError::NonFinite`]`("temperature")`: `lo` or `hi` is not finite;
+/// * `OutOfRange("temperature interval")`: `lo < hi` does not hold;
+/// * `OutOfRange("balance temperature (not bracketed)")`: `A(t) -
+///   sqrt(dp / 2)` has the same sign at both ends (no balance point in the
+///   interval);
+/// * the oil model refuses a temperature it evaluates
+///   ([`crate::fluid::Oil::state`]).
 pub fn balance_temperature<T: Float>(params: &Params<T>, lo: T, hi: T) -> Result<T, ModelError> {
     let target = (params.pressure_drop * T::from_f64(0.5)).sqrt();
     let g = |t: T| -> Result<T, ModelError> {

@@ -30,6 +30,10 @@ impl core::fmt::Display for ModelError {
     }
 }
 
+/// A model error is a plain value (no source): `?` turns it into any
+/// `Box<dyn Error>` or error-reporting type on the host.
+impl core::error::Error for ModelError {}
+
 /// `Ok(v)` if `v` is finite, else `NonFinite(what)`.
 #[inline]
 pub(crate) fn finite<T: crate::Real>(v: T, what: &'static str) -> Result<T, ModelError> {

@@ -120,6 +120,11 @@ pub struct EstimatorConfig {
 
 impl EstimatorConfig {
     /// From the parameter file's `[estimator]` section (validated).
+    ///
+    /// # Errors
+    ///
+    /// A [`ParamError`] naming the first field of `raw` that breaks its
+    /// rule (`RawEstimator::validate`).
     pub fn new(raw: &RawEstimator) -> Result<Self, ParamError> {
         raw.validate()?;
         let tick = 1.0 / raw.tick_hz;
@@ -461,7 +466,17 @@ impl Job {
 impl Estimator {
     /// An estimator at rest in the equilibrium of `initial` [C], which must
     /// be a temperature the oil model accepts. Eq. (32) is checked once here
-    /// over the validated range (201 samples).
+    /// over the validated range (201 samples; a range the oil model refuses
+    /// in part is not an error, it raises `NOT_UNIQUE`).
+    ///
+    /// # Errors
+    ///
+    /// * the twin cannot be built at `initial` ([`Twin::new`]: the oil
+    ///   model refuses the temperature, or the parameters' model);
+    /// * the oil model refuses `initial` or the machine's reference
+    ///   temperature ([`crate::fluid::Oil::state`]);
+    /// * a temperature-only job fails at `initial` (the equilibrium, its
+    ///   sensitivity or the machine's losses not finite).
     pub fn new(params: &Params<f32>, config: EstimatorConfig, initial: f32) -> Result<Self, ModelError> {
         let (lo, hi) = config.valid;
         let monotonic = asymptotic::monotonicity(params, lo, hi, 201)

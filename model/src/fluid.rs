@@ -1,4 +1,4 @@
-//! Oil properties as functions of temperature (MODEL.md section 2).
+//! Oil properties as functions of temperature (`docs/model.md` section 2).
 //!
 //! * Kinematic viscosity by Walther / ASTM D341:
 //!   `log10(log10(nu_cSt + 0.7)) = a - b log10(T_K)`.
@@ -126,6 +126,13 @@ impl<T: Float> Oil<T> {
     }
 
     /// Kinematic viscosity `nu(t)` [m^2/s].
+    ///
+    /// # Errors
+    ///
+    /// [`ModelError::NonFinite`] for a temperature that is not finite;
+    /// [`ModelError::OutOfRange`] at or below absolute zero, and where the
+    /// viscosity leaves Walther's range: below [`WALTHER_MIN_CST`] (oil too
+    /// hot or too thin) or above [`WALTHER_MAX_CST`] (too cold).
     pub fn kinematic_viscosity(&self, t: T) -> Result<T, ModelError> {
         let (z, _, _) = self.walther(t)?;
         Ok((z - T::from_f64(0.7)) * T::from_f64(1e-6))
@@ -134,6 +141,10 @@ impl<T: Float> Oil<T> {
     /// `nu`, `dnu/dt`, `d2nu/dt2` [m^2/s, m^2/(s K), m^2/(s K^2)], closed form:
     /// with `Z = nu_cSt + 0.7`, `w = log10 Z`,
     /// `nu' = -b ln10 Z w / T_K`, `nu'' = -b ln10 w (nu'/T_K - Z (b + 1) / T_K^2)`.
+    ///
+    /// # Errors
+    ///
+    /// As [`Oil::kinematic_viscosity`].
     pub fn kinematic_viscosity_derivatives(&self, t: T) -> Result<Derivatives<T>, ModelError> {
         let (z, w, tk) = self.walther(t)?;
         let ln10 = T::from_f64(core::f64::consts::LN_10);
@@ -160,6 +171,12 @@ impl<T: Float> Oil<T> {
     }
 
     /// Density `rho(t)` [kg/m^3].
+    ///
+    /// # Errors
+    ///
+    /// [`ModelError::NonFinite`] for a temperature that is not finite;
+    /// [`ModelError::OutOfRange`] where `1 + e (t - 15)` is not positive
+    /// (only at -85 C or colder, for any validated parameter set).
     pub fn density(&self, t: T) -> Result<T, ModelError> {
         let t = finite(t, "temperature")?;
         Ok(self.density_15 / self.expansion_factor(t)?)
@@ -167,6 +184,10 @@ impl<T: Float> Oil<T> {
 
     /// `rho`, `drho/dt`, `d2rho/dt2`: `rho' = -e rho / f`, `rho'' = 2 e^2 rho / f^2`
     /// with `f = 1 + e (t - 15)`.
+    ///
+    /// # Errors
+    ///
+    /// As [`Oil::density`].
     pub fn density_derivatives(&self, t: T) -> Result<Derivatives<T>, ModelError> {
         let t = finite(t, "temperature")?;
         let f = self.expansion_factor(t)?;
@@ -180,6 +201,11 @@ impl<T: Float> Oil<T> {
     }
 
     /// State and derivatives at `t` [C] (one Walther evaluation).
+    ///
+    /// # Errors
+    ///
+    /// As [`Oil::kinematic_viscosity`] and [`Oil::density`], and
+    /// `NonFinite("dynamic viscosity")` if `nu rho` overflows.
     pub fn point(&self, t: T) -> Result<FluidPoint<T>, ModelError> {
         let nu = self.kinematic_viscosity_derivatives(t)?;
         let rho = self.density_derivatives(t)?;
@@ -196,6 +222,10 @@ impl<T: Float> Oil<T> {
     }
 
     /// Viscosity, density and dynamic viscosity at `t` [C].
+    ///
+    /// # Errors
+    ///
+    /// As [`Oil::point`].
     pub fn state(&self, t: T) -> Result<FluidState<T>, ModelError> {
         let nu = self.kinematic_viscosity(t)?;
         let rho = self.density(t)?;

@@ -3,7 +3,10 @@
 //! A `no_std`, allocation-free digital twin of the passive throttle-based
 //! temperature flow compensator of "Asymptotic analysis and reduced-order
 //! modeling of a passive throttle-based temperature flow compensator", with
-//! the physics fixed in `MODEL.md` of the project's shared notes.
+//! the physics fixed in the project's `docs/model.md` (what the paper
+//! leaves open or gets wrong, and where the code departs from the plain
+//! equations: the regularised orifice law, the stops as inelastic events,
+//! the twin's units).
 //!
 //! The paper's three levels:
 //!
@@ -22,7 +25,11 @@
 //!
 //! Nothing in this crate allocates or panics: bad parameters give a
 //! [`params::ParamError`] naming the field, a model evaluation outside its
-//! range gives a [`ModelError`].
+//! range gives a [`ModelError`] naming the quantity, a twin tick that fails
+//! gives a [`dynamics::StepError`], a temperature sensor a
+//! [`sensor::SensorFault`]. Each fallible function's documentation says
+//! what makes it fail; [`ModelError`], [`dynamics::StepError`] and the
+//! sensor's errors implement `Display` and `core::error::Error`.
 #![cfg_attr(not(test), no_std)]
 #![deny(missing_docs)]
 #![forbid(unsafe_op_in_unsafe_fn)]

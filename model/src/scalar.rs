@@ -46,7 +46,8 @@ pub trait Real:
     const HALF: Self;
     /// Two.
     const TWO: Self;
-    /// A short name for reports (`"f32"`, `"I16F16"`...).
+    /// A short name for reports and errors, one per type: `"f32"`, `"f64"`,
+    /// and `"Q<integer bits>.<fraction bits>"` for fixed point (`"Q12.20"`).
     const NAME: &'static str;
     /// The type saturates beyond a small range (fixed point): the few
     /// expressions whose value can exceed it on some designs take a
@@ -515,6 +516,14 @@ mod fixed_point {
         }
     }
 
+    /// `Q<integer bits>.<fraction bits>` of the 32-bit format with `f`
+    /// fraction bits, at index `f` (what [`Fix`]'s [`Real::NAME`] reads).
+    pub(super) const FIXED_NAMES: [&str; 33] = [
+        "Q32.0", "Q31.1", "Q30.2", "Q29.3", "Q28.4", "Q27.5", "Q26.6", "Q25.7", "Q24.8", "Q23.9", "Q22.10", "Q21.11",
+        "Q20.12", "Q19.13", "Q18.14", "Q17.15", "Q16.16", "Q15.17", "Q14.18", "Q13.19", "Q12.20", "Q11.21", "Q10.22",
+        "Q9.23", "Q8.24", "Q7.25", "Q6.26", "Q5.27", "Q4.28", "Q3.29", "Q2.30", "Q1.31", "Q0.32",
+    ];
+
     impl<F: LeEqU32> Real for Fix<F> {
         const ZERO: Self = Fix(FixedI32::<F>::ZERO);
         const ONE: Self = {
@@ -532,7 +541,7 @@ mod fixed_point {
             assert!(F::U32 <= 29, "fixed-point formats need three integer bits to hold 2");
             Fix(FixedI32::<F>::from_bits(2i32 << F::U32))
         };
-        const NAME: &'static str = "fixed-i32";
+        const NAME: &'static str = FIXED_NAMES[F::USIZE];
         const SATURATES: bool = true;
 
         #[inline]
@@ -677,6 +686,18 @@ mod tests {
         let mut k = Q12_20::from_f64(-0.5);
         let z = Q12_20::ZERO.dot_add_compensated(big, &[big, big, big], &[big, big, big], &mut k);
         assert_eq!(z.to_f64(), 2048.0 - lsb);
+    }
+
+    #[test]
+    fn fixed_point_formats_are_named_by_their_bits() {
+        assert_eq!(Q12_20::NAME, "Q12.20");
+        assert_eq!(Q16_16::NAME, "Q16.16");
+        assert_eq!(Q8_24::NAME, "Q8.24");
+        assert_eq!(Fixed::NAME, "Q12.20");
+        for (f, name) in fixed_point::FIXED_NAMES.iter().enumerate() {
+            assert_eq!(*name, format!("Q{}.{f}", 32 - f));
+        }
+        assert_eq!((f32::NAME, f64::NAME), ("f32", "f64"));
     }
 
     #[test]

@@ -1,4 +1,4 @@
-//! Throttle laws (MODEL.md section 3).
+//! Throttle laws (`docs/model.md` section 3).
 //!
 //! * Laminar capillary, Hagen-Poiseuille: `Q = dp / R_l`,
 //!   `R_l = 128 mu L / (pi d^4)`.

@@ -1,4 +1,4 @@
-//! Reading the parameter file (MODEL.md section 8) into a validated
+//! Reading the parameter file (`docs/model.md` section 8) into a validated
 //! [`RawParams`], and writing one back.
 //!
 //! Every key of the file must be known (a typo is an error, not a silently

@@ -1,4 +1,4 @@
-//! The parameter file of the compensator twin (MODEL.md section 8): its
+//! The parameter file of the compensator twin (`docs/model.md` section 8): its
 //! fields, units and physical rules, in plain `f64`, and (feature `toml`)
 //! the reader of the TOML file.
 //!

@@ -1,6 +1,6 @@
 //! The parameter file's schema and its validation, in plain `f64`.
 //!
-//! Units are SI, temperatures in degrees Celsius (MODEL.md section 8).
+//! Units are SI, temperatures in degrees Celsius (`docs/model.md` section 8).
 //!
 //! Each section group is declared once, by the `schema!` list below; code
 //! reaches a field by its name, never by its place in the list: its
@@ -210,7 +210,7 @@ schema! {
 /// A complete, unvalidated parameter set as read from a file.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RawParams {
-    /// The compensator (MODEL.md section 8).
+    /// The compensator (`docs/model.md` section 8).
     pub core: RawCore,
     /// The driven machine, if the file has a `[machine]` section.
     pub machine: Option<RawMachine>,

@@ -1,4 +1,4 @@
-//! Reference solution of the FSI model (MODEL.md section 6) in SI units.
+//! Reference solution of the FSI model (`docs/model.md` section 6) in SI units.
 //!
 //! ```text
 //! C_a dp_a/dt = Q_t(p_p - p_a) - (p_a - p_c) / R_l + A_p v,  C_a = (V_a0 - A_p x) / beta

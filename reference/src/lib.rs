@@ -1,6 +1,6 @@
 //! Independent `f64` references for the compensator twin.
 //!
-//! Written from MODEL.md in SI units, sharing no code with the core (only
+//! Written from `docs/model.md` in SI units, sharing no code with the core (only
 //! the parameter values, read through `compensator_params::RawCore`):
 //!
 //! * [`statics`]: the quasi-static equilibrium by bisection on each

@@ -21,9 +21,9 @@
 use compensator::dynamics::{Scheme, Twin, TwinConfig};
 use compensator::scalar::Fixed;
 use compensator::{Params, Real};
+use compensator_firmware::qemu::exit;
 use cortex_m::peripheral::{SYST, syst::SystClkSource};
 use cortex_m_rt::entry;
-use cortex_m_semihosting::debug;
 use defmt::{error, info};
 
 include!(concat!(env!("OUT_DIR"), "/params.rs"));
@@ -345,15 +345,4 @@ fn main() -> ! {
     }
 }
 
-fn exit(ok: bool) -> ! {
-    debug::exit(if ok { debug::EXIT_SUCCESS } else { debug::EXIT_FAILURE });
-    #[allow(clippy::empty_loop)]
-    loop {}
-}
-
 compensator_firmware::qemu_hard_fault_handler!();
-
-#[panic_handler]
-fn panic(_: &core::panic::PanicInfo) -> ! {
-    exit(false)
-}

@@ -16,8 +16,3 @@ fn main() -> ! {
     defmt::info!("executing an undefined instruction");
     cortex_m::asm::udf()
 }
-
-#[panic_handler]
-fn panic(_: &core::panic::PanicInfo) -> ! {
-    compensator_firmware::qemu::exit(false)
-}

@@ -25,9 +25,10 @@ use compensator::sensor::TemperatureSource;
 use compensator::sensor::max31865::{Max31865, Settings, fault};
 use compensator::sensor::simulated::SimulatedMax31865;
 use compensator::{Params, asymptotic};
+use compensator_firmware::qemu::exit;
+use compensator_firmware::replay_faults::{Expected, FAULTS, Injected, fault_at};
 use cortex_m as _; // links the critical-section implementation defmt needs
 use cortex_m_rt::entry;
-use cortex_m_semihosting::debug;
 use defmt::{error, info};
 
 include!(concat!(env!("OUT_DIR"), "/params.rs"));
@@ -52,22 +53,13 @@ fn temperature_at(time: f32) -> f32 {
     REPLAY_PIECES[REPLAY_PIECES.len() - 1].3
 }
 
-/// What the replay does to the simulated converter.
-#[derive(Clone, Copy, PartialEq, Eq, defmt::Format)]
-enum Injected {
-    /// `SPIKE_DELTA` (40 C by default) on one sample.
-    Spike,
-    /// The SPI transaction fails.
-    BusError,
-    /// The converter's RTD-high fault (an open RTD).
-    OpenRtd,
-    /// A full-scale code.
-    SaturatedCode,
-}
-
-/// The fault injected at `time` [s], if any (index into `REPLAY_FAULTS`).
-fn fault_at(time: f32) -> Option<usize> {
-    REPLAY_FAULTS.iter().position(|&(t0, t1, _, _)| time >= t0 && time < t1)
+/// The flag an injected fault must raise.
+fn flag(expected: Expected) -> Flags {
+    match expected {
+        Expected::Spike => Flags::SPIKE,
+        Expected::SensorFault => Flags::SENSOR_FAULT,
+        Expected::Degraded => Flags::DEGRADED,
+    }
 }
 
 /// Counts passed checks and keeps the failed ones (a bounded list: the
@@ -208,7 +200,7 @@ fn replay(params: &Params<f32>, config: EstimatorConfig) -> bool {
     let end = REPLAY_PIECES[REPLAY_PIECES.len() - 1].1;
     let ticks = (end / tick) as u32;
     let sensor_every = config.ticks_per(settings.mains.conversion_period());
-    let mut seen = [Flags::empty(); REPLAY_FAULTS.len()];
+    let mut seen = [Flags::empty(); FAULTS.len()];
     let mut next_checkpoint = 0;
     let mut out_of_range_seen = false;
     let mut nan_ticks = 0u32;
@@ -238,7 +230,7 @@ fn replay(params: &Params<f32>, config: EstimatorConfig) -> bool {
             sim.fault = 0;
             sim.forced_code = None;
             if let Some(i) = fault_now {
-                match REPLAY_FAULTS[i].2 {
+                match FAULTS[i].injected {
                     Injected::Spike => sim.temperature += SPIKE_DELTA,
                     Injected::BusError => sim.bus_error = true,
                     Injected::OpenRtd => sim.fault = fault::RTD_HIGH,
@@ -320,10 +312,10 @@ fn replay(params: &Params<f32>, config: EstimatorConfig) -> bool {
     // consistency check never has to re-seat it.
     info!("twin re-seated {=u32} times by the consistency check", reseats);
     checks.check(reseats == 0, "the twin never needed re-seating", end);
-    for (i, &(t0, _, kind, flag)) in REPLAY_FAULTS.iter().enumerate() {
-        let ok = seen[i].contains(flag);
-        info!("injected {} at {=f32} s raised [{}]", kind, t0, seen[i]);
-        checks.check(ok, "the injected fault raised its flag", t0);
+    for (i, f) in FAULTS.iter().enumerate() {
+        let ok = seen[i].contains(flag(f.expected));
+        info!("injected {} at {=f32} s raised [{}]", f.injected, f.start, seen[i]);
+        checks.check(ok, "the injected fault raised its flag", f.start);
     }
     checks.check(
         out_of_range_seen || !OUT_OF_RANGE_REACHABLE,
@@ -358,18 +350,4 @@ fn stack_peak() -> usize {
         p += 4;
     }
     hi - p
-}
-
-fn exit(ok: bool) -> ! {
-    debug::exit(if ok { debug::EXIT_SUCCESS } else { debug::EXIT_FAILURE });
-    #[allow(clippy::empty_loop)]
-    loop {}
-}
-
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
-    if let Some(loc) = info.location() {
-        error!("panic at {=str}:{=u32}", loc.file(), loc.line());
-    }
-    exit(false)
 }

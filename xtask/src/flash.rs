@@ -11,7 +11,7 @@
 //! report.
 
 use crate::firmware::{self, Image, Options};
-use crate::{Failure, Outcome, flag_value, params_arg, process, qemu, telemetry, toolchain};
+use crate::{Failure, Outcome, process, qemu, telemetry, toolchain};
 use object::{Object, ObjectSection, ObjectSymbol};
 use std::io::{BufRead, BufReader, Write};
 use std::path::Path;
@@ -37,33 +37,18 @@ fn probe_rs_version() -> Option<String> {
         .then(|| out.stdout.lines().next().unwrap_or("probe-rs").trim().to_string())
 }
 
-/// `cargo xtask flash`.
-pub fn cmd(root: &Path, args: &[String]) -> Outcome {
-    let params = params_arg(args)?;
-    let debug = args.iter().any(|a| a == "--debug");
-    let seconds = match flag_value(args, "--seconds")? {
-        Some(s) => Some(
-            s.parse::<u64>()
-                .map_err(|_| Failure::Input(format!("--seconds {s}: expected a whole number of seconds")))?,
-        ),
-        None => None,
-    };
-    let csv_path = flag_value(args, "--csv")?;
-    let mut csv = match &csv_path {
-        Some(p) => Some(telemetry::CsvFile::create(Path::new(p)).map_err(Failure::Input)?),
+/// `cargo xtask flash`: `params` resolved and checked by the caller
+/// (`None`: the default preset), `csv` the file for the telemetry as CSV,
+/// `debug` the debug-level logs compiled in, `seconds` a deadline (exit
+/// status 0 when it passes).
+pub fn cmd(root: &Path, params: Option<&Path>, csv_path: Option<&Path>, debug: bool, seconds: Option<u64>) -> Outcome {
+    let mut csv = match csv_path {
+        Some(p) => Some(telemetry::CsvFile::create(p).map_err(Failure::Input)?),
         None => None,
     };
     let tc = toolchain::get(root, &[firmware::M4])?;
     eprintln!("xtask: toolchain: {}", tc.description);
-    let built = firmware::build_with(
-        &tc,
-        root,
-        &Image::BOARD,
-        Options {
-            params: params.as_deref(),
-            debug,
-        },
-    )?;
+    let built = firmware::build_with(&tc, root, &Image::BOARD, Options { params, debug })?;
     eprintln!("xtask: board image {}", built.elf.display());
     let Some(version) = probe_rs_version() else {
         eprintln!("xtask: {}", install_advice(&built.elf));
@@ -109,8 +94,8 @@ pub fn cmd(root: &Path, args: &[String]) -> Outcome {
         }
     }
     let status = child.wait().map_err(|e| e.to_string())?;
-    if let (Some(csv), Some(p)) = (&csv, &csv_path) {
-        eprintln!("xtask: wrote {} telemetry records to {p}", csv.rows);
+    if let (Some(csv), Some(p)) = (&csv, csv_path) {
+        eprintln!("xtask: wrote {} telemetry records to {}", csv.rows, p.display());
     }
     Ok(if seconds.is_some() {
         0

@@ -9,9 +9,14 @@
 //! cargo xtask bench [--params F] [--write]       cost (the twin as built for F), footprint and stack on the emulated MCUs
 //! cargo xtask callgrind [--bless]                host instruction counts against the baseline
 //! cargo xtask msrv                               rust-version against the locked dependencies
+//! cargo xtask target-tests                       the core's tests on the emulated Cortex-M4F
 //! cargo xtask toolchain                          find or provision the cross toolchain
-//! cargo xtask qemu-runner ELF                    run an ELF on QEMU (cargo runner for on-target tests)
+//! cargo xtask qemu-runner ELF [ARGS...]          run an ELF on QEMU (cargo runner for on-target tests)
 //! ```
+//!
+//! Arguments are parsed by clap ([`Cli`]): an unknown command or flag (a
+//! misspelt `--bles`) is an error with exit status 2, never ignored;
+//! `cargo xtask help [COMMAND]` and `--help` describe each command.
 //!
 //! A parameter file (`--params`, or `COMPENSATOR_PARAMS`) is taken relative
 //! to the directory the command is run in and checked before any build: a
@@ -36,6 +41,8 @@ mod replica;
 mod telemetry;
 mod toolchain;
 
+use clap::{Args, Parser, Subcommand};
+use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
@@ -71,49 +78,125 @@ impl From<&str> for Failure {
 
 type Outcome = Result<i32, Failure>;
 
-fn usage() -> ExitCode {
-    eprintln!(
-        "usage: cargo xtask <command>\n\
-         \n  run [--params F] [--csv FILE]   build the QEMU twin firmware and run it (the main job)\
-         \n  flash [--params F] [--csv FILE] [--debug] [--seconds S]\
-         \n                                  build the board image and run it with probe-rs (RTT log, CSV)\
-         \n  test [--bless]                  every check CI runs (host tests, clippy, cross builds, QEMU)\
-         \n  build [--params F]              build every firmware image\
-         \n  bench [--params F] [--write]    instructions per tick (the twin as built for F), flash, RAM and stack\
-         \n  callgrind [--bless]             host instruction counts (valgrind) against the baseline\
-         \n  msrv                            the workspace's rust-version against the locked dependencies\
-         \n  target-tests                    the core's tests on the emulated Cortex-M4F (defmt-test)\
-         \n  toolchain                       find or provision the thumbv7em/thumbv7m toolchain\
-         \n  qemu-runner ELF                 run an ELF on QEMU (netduinoplus2, or netduino2 for thumbv7m)\
-         \n\
-         \nA parameter file (--params or COMPENSATOR_PARAMS) is relative to the current directory."
-    );
-    ExitCode::from(2)
+/// The command line of `cargo xtask`.
+#[derive(Parser, Debug)]
+#[command(
+    name = "cargo xtask",
+    bin_name = "cargo xtask",
+    about = "The project's automation: firmware builds, QEMU runs, benchmarks, CI",
+    arg_required_else_help = true,
+    after_help = "A parameter file (--params or COMPENSATOR_PARAMS) is relative to the current directory."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// The parameter file of a firmware build.
+#[derive(Args, Debug, Clone, PartialEq, Eq)]
+struct ParamsArg {
+    /// Parameter file (TOML, docs/model.md section 8), relative to the
+    /// current directory [default: $COMPENSATOR_PARAMS, else the paper preset]
+    #[arg(long, value_name = "F")]
+    params: Option<String>,
+}
+
+#[derive(Subcommand, Debug, PartialEq, Eq)]
+enum Command {
+    /// Build the QEMU twin firmware and run it (the main job)
+    Run {
+        #[command(flatten)]
+        params: ParamsArg,
+        /// Also write the telemetry to FILE as CSV (every digit, SI units)
+        #[arg(long, value_name = "FILE")]
+        csv: Option<PathBuf>,
+    },
+    /// Build the board image and run it with probe-rs (RTT log, CSV)
+    Flash {
+        #[command(flatten)]
+        params: ParamsArg,
+        /// Also write the telemetry to FILE as CSV (every digit, SI units)
+        #[arg(long, value_name = "FILE")]
+        csv: Option<PathBuf>,
+        /// Build the dev profile (debug assertions; the board keeps its
+        /// debug port clocked in sleep) instead of release
+        #[arg(long)]
+        debug: bool,
+        /// Stop after S seconds (exit status 0) instead of running until Ctrl-C
+        #[arg(long, value_name = "S")]
+        seconds: Option<u64>,
+    },
+    /// Every check CI runs (host tests, clippy, cross builds, QEMU)
+    Test {
+        /// Rewrite the twin firmware's QEMU snapshot instead of checking it
+        #[arg(long)]
+        bless: bool,
+    },
+    /// Build every firmware image
+    Build {
+        #[command(flatten)]
+        params: ParamsArg,
+    },
+    /// Instructions per tick (the twin as built for F), flash, RAM and stack
+    Bench {
+        #[command(flatten)]
+        params: ParamsArg,
+        /// Also write the report to docs/bench.md
+        #[arg(long)]
+        write: bool,
+    },
+    /// Host instruction counts (valgrind) against the baseline
+    Callgrind {
+        /// Rewrite the baseline instead of checking against it
+        #[arg(long)]
+        bless: bool,
+    },
+    /// The workspace's rust-version against the locked dependencies
+    Msrv,
+    /// The core's tests on the emulated Cortex-M4F (defmt-test)
+    TargetTests,
+    /// Find or provision the thumbv7em/thumbv7m toolchain
+    Toolchain,
+    /// Run an ELF on QEMU (netduinoplus2, or netduino2 for thumbv7m)
+    QemuRunner {
+        /// The ELF to run
+        elf: PathBuf,
+        /// What cargo passes after the ELF as a runner (the test binary's
+        /// arguments): accepted and not used
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true, hide = true)]
+        args: Vec<OsString>,
+    },
 }
 
 fn main() -> ExitCode {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let rest = args.get(1..).unwrap_or_default();
-    let result: Outcome = match args.first().map(String::as_str) {
-        Some("run") => cmd_run(rest),
-        Some("flash") => flash::cmd(&root(), rest),
-        Some("test") => cmd_test(rest),
-        Some("bench") => cmd_bench(&args),
-        Some("build") => cmd_build(rest),
-        Some("msrv") => msrv::check(&root()).map(|_| 0).map_err(Failure::from),
-        Some("toolchain") => toolchain::get(&root(), &firmware::TARGETS)
+    // Usage errors (an unknown command or flag, a missing value) exit 2
+    // with clap's message; `--help` exits 0.
+    let cli = Cli::try_parse().unwrap_or_else(|e| e.exit());
+    let result: Outcome = match cli.command {
+        Command::Run { params, csv } => cmd_run(&params, csv.as_deref()),
+        Command::Flash {
+            params,
+            csv,
+            debug,
+            seconds,
+        } => params_file(&params)
+            .and_then(|params| flash::cmd(&root(), params.as_deref(), csv.as_deref(), debug, seconds)),
+        Command::Test { bless } => cmd_test(bless),
+        Command::Bench { params, write } => cmd_bench(&params, write),
+        Command::Build { params } => cmd_build(&params),
+        Command::Msrv => msrv::check(&root()).map(|_| 0).map_err(Failure::from),
+        Command::Toolchain => toolchain::get(&root(), &firmware::TARGETS)
             .map(|t| {
                 println!("{}", t.description);
                 0
             })
             .map_err(Failure::from),
-        Some("qemu-runner") => cmd_qemu_runner(rest),
-        Some("callgrind") => cmd_callgrind(&args),
-        Some("target-tests") => toolchain::get(&root(), &[firmware::M4])
+        Command::QemuRunner { elf, args: _ } => cmd_qemu_runner(&elf),
+        Command::Callgrind { bless } => callgrind::check(&root(), bless).map(|_| 0).map_err(Failure::from),
+        Command::TargetTests => toolchain::get(&root(), &[firmware::M4])
             .and_then(|tc| qemu::ensure().and_then(|_| firmware::on_target_tests(&tc, &root())))
             .map(|_| 0)
             .map_err(Failure::from),
-        _ => return usage(),
     };
     match result {
         Ok(code) => ExitCode::from(code.clamp(0, 255) as u8),
@@ -128,34 +211,21 @@ fn main() -> ExitCode {
     }
 }
 
-fn flag_value(args: &[String], flag: &str) -> Result<Option<String>, Failure> {
-    match args.iter().position(|a| a == flag) {
-        None => Ok(None),
-        Some(i) => args
-            .get(i + 1)
-            .filter(|v| !v.starts_with("--"))
-            .cloned()
-            .map(Some)
-            .ok_or_else(|| Failure::Input(format!("{flag} needs a value"))),
-    }
-}
-
 /// The parameter file of a build (`--params`, else `COMPENSATOR_PARAMS`),
-/// resolved against the current directory and checked.
-fn params_arg(args: &[String]) -> Result<Option<PathBuf>, Failure> {
-    let flag = flag_value(args, "--params")?;
-    params::from_args(flag.as_deref()).map_err(Failure::Input)
+/// resolved against the current directory and checked: an absolute path,
+/// or `None` for the default preset.
+fn params_file(arg: &ParamsArg) -> Result<Option<PathBuf>, Failure> {
+    params::from_args(arg.params.as_deref()).map_err(Failure::Input)
 }
 
 /// The main job: the twin firmware on QEMU's STM32F405, log decoded live
 /// (telemetry rounded for reading; `--csv FILE`: every digit, SI units).
-fn cmd_run(args: &[String]) -> Outcome {
+fn cmd_run(params: &ParamsArg, csv_path: Option<&Path>) -> Outcome {
     let root = root();
-    let params = params_arg(args)?;
-    let csv_path = flag_value(args, "--csv")?;
+    let params = params_file(params)?;
     // Created before the build: a path that cannot be written fails fast.
-    let mut csv = match &csv_path {
-        Some(p) => Some(telemetry::CsvFile::create(Path::new(p)).map_err(Failure::Input)?),
+    let mut csv = match csv_path {
+        Some(p) => Some(telemetry::CsvFile::create(p).map_err(Failure::Input)?),
         None => None,
     };
     let tc = toolchain::get(&root, &[firmware::M4])?;
@@ -164,68 +234,72 @@ fn cmd_run(args: &[String]) -> Outcome {
     let elf = firmware::build(&tc, &root, &firmware::Image::TWIN, params.as_deref())?;
     eprintln!("xtask: running {} on QEMU {}", elf.display(), qemu::NETDUINO.name);
     let run = qemu::run(&elf, qemu::NETDUINO, true, Duration::from_secs(300), qemu::Show::Stream)?;
-    if let (Some(csv), Some(p)) = (csv.as_mut(), &csv_path) {
+    if let (Some(csv), Some(p)) = (csv.as_mut(), csv_path) {
         for line in &run.lines {
             csv.line(line)?;
         }
-        eprintln!("xtask: wrote {} telemetry records to {p}", csv.rows);
+        eprintln!("xtask: wrote {} telemetry records to {}", csv.rows, p.display());
     }
     eprintln!("xtask: firmware exit code {}", run.code);
     Ok(run.code)
 }
 
 /// `cargo xtask build [--params F]`.
-fn cmd_build(args: &[String]) -> Outcome {
-    let params = params_arg(args)?;
+fn cmd_build(params: &ParamsArg) -> Outcome {
+    let params = params_file(params)?;
     firmware::build_all(&root(), params.as_deref())?;
     Ok(0)
 }
 
-/// cargo runner: `xtask qemu-runner ELF [args...]`.
-fn cmd_qemu_runner(args: &[String]) -> Outcome {
-    let elf = args.first().ok_or("qemu-runner needs an ELF")?;
-    let machine = if elf.contains("thumbv7m-none-eabi") {
+/// cargo runner: `xtask qemu-runner ELF [args...]` (the arguments after the
+/// ELF are the test binary's; QEMU runs the image as it is).
+fn cmd_qemu_runner(elf: &Path) -> Outcome {
+    let machine = if elf.to_string_lossy().contains("thumbv7m-none-eabi") {
         qemu::NETDUINO2
     } else {
         qemu::NETDUINO
     };
-    let run = qemu::run(
-        Path::new(elf),
-        machine,
-        true,
-        Duration::from_secs(300),
-        qemu::Show::Stream,
-    )?;
+    let run = qemu::run(elf, machine, true, Duration::from_secs(300), qemu::Show::Stream)?;
     Ok(run.code)
 }
 
 /// Runs this xtask again with the `host` feature (the commands that need
-/// the host-side crates), with the same arguments.
+/// the host-side crates), with `args`.
 #[cfg_attr(feature = "host", allow(dead_code))]
-fn with_host_feature(args: &[String], timeout: Duration) -> Outcome {
+fn with_host_feature(args: &[OsString], timeout: Duration) -> Outcome {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let mut cmd = std::process::Command::new(cargo);
     cmd.args(["run", "--quiet", "--package", "xtask", "--features", "host", "--"])
         .args(args)
         .current_dir(root());
-    process::run(&mut cmd, timeout)
-        .ok_or_else(|| Failure::Other(format!("xtask --features host {} failed", args.join(" "))))
+    process::run(&mut cmd, timeout).ok_or_else(|| {
+        let shown: Vec<_> = args.iter().map(|a| a.to_string_lossy()).collect();
+        Failure::Other(format!("xtask --features host {} failed", shown.join(" ")))
+    })
 }
 
-fn cmd_bench(args: &[String]) -> Outcome {
+/// `cargo xtask bench [--params F] [--write]`. The parameter file is
+/// resolved and checked here, against the user's directory: without the
+/// `host` feature the bench runs in a second xtask whose directory is the
+/// workspace root, and gets the absolute path.
+fn cmd_bench(params: &ParamsArg, write: bool) -> Outcome {
+    let params = params_file(params)?;
     #[cfg(feature = "host")]
     {
-        Ok(bench::cmd(&root(), &args[1..])?)
+        Ok(bench::cmd(&root(), params.as_deref(), write)?)
     }
     #[cfg(not(feature = "host"))]
     {
-        with_host_feature(args, Duration::from_secs(3600))
+        let mut args: Vec<OsString> = vec!["bench".into()];
+        if let Some(p) = params {
+            args.push("--params".into());
+            args.push(p.into_os_string());
+        }
+        if write {
+            args.push("--write".into());
+        }
+        with_host_feature(&args, Duration::from_secs(3600))
     }
-}
-
-fn cmd_callgrind(args: &[String]) -> Outcome {
-    callgrind::check(&root(), args.iter().any(|a| a == "--bless"))?;
-    Ok(0)
 }
 
 fn step(name: &str) {
@@ -257,9 +331,8 @@ fn wide_device_file(root: &Path) -> Result<PathBuf, String> {
     Ok(path)
 }
 
-/// Everything CI checks.
-fn cmd_test(args: &[String]) -> Outcome {
-    let bless = args.iter().any(|a| a == "--bless");
+/// Everything CI checks; `bless` rewrites the twin's QEMU snapshot.
+fn cmd_test(bless: bool) -> Outcome {
     let root = root();
     let minutes = |m: u64| Duration::from_secs(60 * m);
     step("format");
@@ -370,4 +443,83 @@ fn cmd_test(args: &[String]) -> Outcome {
     bench::check(&elfs, &run.lines)?;
     eprintln!("\nxtask: all checks passed");
     Ok(0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+    use clap::error::ErrorKind;
+
+    fn parse(args: &[&str]) -> Result<Command, ErrorKind> {
+        Cli::try_parse_from(std::iter::once("xtask").chain(args.iter().copied()))
+            .map(|c| c.command)
+            .map_err(|e| e.kind())
+    }
+
+    #[test]
+    fn the_parser_is_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn every_command_and_flag_parses() {
+        let params = |p: Option<&str>| ParamsArg {
+            params: p.map(String::from),
+        };
+        assert_eq!(parse(&["test"]), Ok(Command::Test { bless: false }));
+        assert_eq!(parse(&["test", "--bless"]), Ok(Command::Test { bless: true }));
+        assert_eq!(
+            parse(&["run", "--params", "presets/paper.toml", "--csv", "out.csv"]),
+            Ok(Command::Run {
+                params: params(Some("presets/paper.toml")),
+                csv: Some("out.csv".into()),
+            })
+        );
+        assert_eq!(
+            parse(&["flash", "--debug", "--seconds", "60", "--params=f.toml"]),
+            Ok(Command::Flash {
+                params: params(Some("f.toml")),
+                csv: None,
+                debug: true,
+                seconds: Some(60),
+            })
+        );
+        assert_eq!(parse(&["build"]), Ok(Command::Build { params: params(None) }));
+        assert_eq!(
+            parse(&["bench", "--write", "--params", "f.toml"]),
+            Ok(Command::Bench {
+                params: params(Some("f.toml")),
+                write: true,
+            })
+        );
+        assert_eq!(parse(&["callgrind", "--bless"]), Ok(Command::Callgrind { bless: true }));
+        assert_eq!(parse(&["msrv"]), Ok(Command::Msrv));
+        assert_eq!(parse(&["toolchain"]), Ok(Command::Toolchain));
+        assert_eq!(parse(&["target-tests"]), Ok(Command::TargetTests));
+        // As a cargo runner: whatever follows the ELF is the test binary's.
+        assert_eq!(
+            parse(&["qemu-runner", "target/x.elf", "--quiet", "-x"]),
+            Ok(Command::QemuRunner {
+                elf: "target/x.elf".into(),
+                args: vec!["--quiet".into(), "-x".into()],
+            })
+        );
+    }
+
+    #[test]
+    fn misspelt_or_unknown_arguments_are_errors() {
+        // The issue's case: `test --bles` used to run the tests without blessing.
+        assert_eq!(parse(&["test", "--bles"]), Err(ErrorKind::UnknownArgument));
+        assert_eq!(parse(&["bench", "--wrte"]), Err(ErrorKind::UnknownArgument));
+        assert_eq!(parse(&["run", "extra"]), Err(ErrorKind::UnknownArgument));
+        assert_eq!(parse(&["msrv", "--bless"]), Err(ErrorKind::UnknownArgument));
+        assert_eq!(parse(&["tset"]), Err(ErrorKind::InvalidSubcommand));
+        // A flag where a value belongs, a value that is not one.
+        assert_eq!(parse(&["run", "--params", "--csv", "x"]), Err(ErrorKind::InvalidValue));
+        assert_eq!(parse(&["flash", "--seconds", "soon"]), Err(ErrorKind::ValueValidation));
+        assert_eq!(parse(&["qemu-runner"]), Err(ErrorKind::MissingRequiredArgument));
+        // No command: the help, as an error (exit status 2).
+        assert_eq!(parse(&[]), Err(ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand));
+    }
 }

@@ -15,27 +15,19 @@ use compensator::sensor::max31865::{Max31865, Settings, fault};
 use compensator::sensor::simulated::SimulatedMax31865;
 use std::path::Path;
 
-/// A fault the replay injects (`Injected` in the twin).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Injected {
-    /// The spike delta on one sample.
-    Spike,
-    /// The SPI transaction fails.
-    BusError,
-    /// The converter's RTD-high fault.
-    OpenRtd,
-    /// A full-scale code.
-    SaturatedCode,
-}
+/// The faults the replay injects: the twin image's own table, compiled
+/// here too (a rename fails to compile in both).
+#[path = "../../src/replay_faults.rs"]
+mod replay_faults;
+pub use replay_faults::Injected;
+use replay_faults::{FAULTS, fault_at};
 
-/// The replay schedule (the twin's `REPLAY_PIECES`, `REPLAY_FAULTS`,
-/// `SPIKE_DELTA`, in `f32` as the firmware has them).
+/// The replay schedule (the twin's `REPLAY_PIECES` and `SPIKE_DELTA`, in
+/// `f32` as the firmware has them; the faults are [`FAULTS`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Schedule {
     /// (start s, end s, from C, to C).
     pub pieces: Vec<(f32, f32, f32, f32)>,
-    /// (start s, end s, what).
-    pub faults: Vec<(f32, f32, Injected)>,
     /// What the spike adds [C].
     pub spike: f32,
 }
@@ -45,7 +37,6 @@ impl Schedule {
     pub fn parse(text: &str) -> Result<Schedule, String> {
         let mut s = Schedule {
             pieces: vec![],
-            faults: vec![],
             spike: 0.0,
         };
         for line in text.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty()) {
@@ -57,16 +48,6 @@ impl Schedule {
             };
             match w.first().copied() {
                 Some("piece") => s.pieces.push((num(1)?, num(2)?, num(3)?, num(4)?)),
-                Some("fault") => {
-                    let kind = match w.get(3).copied() {
-                        Some("Spike") => Injected::Spike,
-                        Some("BusError") => Injected::BusError,
-                        Some("OpenRtd") => Injected::OpenRtd,
-                        Some("SaturatedCode") => Injected::SaturatedCode,
-                        _ => return Err(format!("replay schedule: unknown fault in {line}")),
-                    };
-                    s.faults.push((num(1)?, num(2)?, kind));
-                }
                 Some("spike_delta") => s.spike = num(1)?,
                 _ => return Err(format!("replay schedule: {line}")),
             }
@@ -92,14 +73,6 @@ impl Schedule {
             }
         }
         self.pieces[self.pieces.len() - 1].3
-    }
-
-    /// The fault injected at `time` [s] (the twin's `fault_at`).
-    fn fault_at(&self, time: f32) -> Option<Injected> {
-        self.faults
-            .iter()
-            .find(|&&(t0, t1, _)| time >= t0 && time < t1)
-            .map(|f| f.2)
     }
 }
 
@@ -156,7 +129,7 @@ pub fn run(raw: &RawParams, schedule: &Schedule) -> Result<Vec<Record>, String> 
         sim.bus_error = false;
         sim.fault = 0;
         sim.forced_code = None;
-        match schedule.fault_at(time) {
+        match fault_at(time).map(|i| FAULTS[i].injected) {
             Some(Injected::Spike) => sim.temperature += schedule.spike,
             Some(Injected::BusError) => sim.bus_error = true,
             Some(Injected::OpenRtd) => sim.fault = fault::RTD_HIGH,
@@ -250,25 +223,26 @@ mod tests {
 
     #[test]
     fn the_schedule_reads_back_and_drives_the_same_profile() {
-        let text = "# comment\npiece 0.0 3.0 26.0 26.0\npiece 3.0 55.0 26.0 78.0\nfault 10.0 10.02 Spike\nfault 20.0 20.3 BusError\nspike_delta -40.0\n";
+        let text = "# comment\npiece 0.0 3.0 26.0 26.0\npiece 3.0 55.0 26.0 78.0\nspike_delta -40.0\n";
         let s = Schedule::parse(text).unwrap();
         assert_eq!(s.pieces.len(), 2);
-        assert_eq!(s.faults[1], (20.0, 20.3, Injected::BusError));
         assert_eq!(s.spike, -40.0);
         assert_eq!(s.temperature_at(29.0), 52.0);
         assert_eq!(s.temperature_at(100.0), 78.0);
-        assert_eq!(s.fault_at(10.01), Some(Injected::Spike));
-        assert_eq!(s.fault_at(10.02), None);
-        assert!(Schedule::parse("fault 1 2 Meteor\npiece 0 1 2 3\n").is_err());
+        assert!(Schedule::parse("fault 1 2 Spike\npiece 0 1 2 3\n").is_err());
         assert!(Schedule::parse("").is_err());
+        // The faults are the twin's own table.
+        assert_eq!(fault_at(10.01).map(|i| FAULTS[i].injected), Some(Injected::Spike));
+        assert_eq!(fault_at(10.02), None);
     }
 
     #[test]
     fn a_replica_agrees_with_itself_and_a_changed_row_is_found() {
-        // Two seconds of the paper preset with a spike: the comparison is
-        // exact on identical runs and names the column that moved.
+        // Two seconds of the paper preset (before the first fault): the
+        // comparison is exact on identical runs and names the column that
+        // moved.
         let raw = compensator_params::file::load(&crate::root().join("presets/paper.toml")).unwrap();
-        let s = Schedule::parse("piece 0.0 2.0 30.0 30.0\nfault 1.0 1.02 Spike\nspike_delta 40.0\n").unwrap();
+        let s = Schedule::parse("piece 0.0 2.0 30.0 30.0\nspike_delta 40.0\n").unwrap();
         let a = run(&raw, &s).unwrap();
         assert_eq!(a.len(), 3, "telemetry every 0.5 s");
         assert!(

@@ -126,7 +126,7 @@ pub struct Inversion {
     pub spread: Vec<f64>,
 }
 
-/// Inverts each column of Table 1 for `A(t)` (MODEL.md section 4).
+/// Inverts each column of Table 1 for `A(t)` (`docs/model.md` section 4).
 pub fn invert_table1(t1: &Table1) -> Inversion {
     let a: Vec<Vec<f64>> = t1
         .values

@@ -94,8 +94,11 @@ const MAX_TICKS: usize = 500;
 /// over the validated range `valid` [C]. Probe temperatures the oil model
 /// refuses are left out.
 ///
-/// Errors: a probe's finest twin fails (`NoConvergence`), or `tick` is not
-/// a positive duration (`OutOfRange`).
+/// # Errors
+///
+/// * `OutOfRange("tick")`: `tick` is not a positive, finite duration;
+/// * a probe's twin cannot be built ([`Twin::new`]'s errors);
+/// * `NoConvergence("twin probe")`: a probe's twin fails a tick.
 pub fn choose(params: &Params<f64>, tick: f64, valid: (f64, f64)) -> Result<Choice, ModelError> {
     if !(tick > 0.0 && tick.is_finite()) {
         return Err(ModelError::OutOfRange("tick"));

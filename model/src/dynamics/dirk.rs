@@ -46,7 +46,7 @@
 //! <= 1` on the left half-plane, `R(-inf) = 0`), and because the stage
 //! equations are solved rather than linearised, that holds for the
 //! nonlinear chamber rows too: a pressure rate of `1e9 1/s` only makes `k`
-//! small. `host-tests/tests/stiffness.rs` checks it on designs with chamber
+//! small. `host-tests/tests/twin_cases.rs` checks it on designs with chamber
 //! rates from `1e3` to `1e9 1/s`.
 //!
 //! | tableau | stages | order | source |
@@ -124,15 +124,6 @@ pub const SDIRK3: Tableau = {
 
 /// The scheme of a graded substep's short pieces (`Twin::substep`).
 pub const FINE: Tableau = SDIRK3;
-
-/// The implicit (backward) Euler method as a one-stage SDIRK: order 1,
-/// L-stable, stiffly accurate.
-pub const EULER: Tableau = Tableau {
-    stages: 1,
-    gamma: 1.0,
-    a: [[0.0; 3]; 3],
-    order: 1,
-};
 
 /// An SDIRK scheme prepared for a fixed step, in scalar type `T`.
 #[derive(Clone, Copy, Debug)]

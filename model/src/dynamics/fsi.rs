@@ -1,5 +1,5 @@
 //! The reduced-order fluid-structure model (paper section 4, Eqs. 33-36,
-//! signs of MODEL.md section 6), nondimensionalised for fixed point.
+//! signs of `docs/model.md` section 6), nondimensionalised for fixed point.
 //!
 //! Dimensional form:
 //!
@@ -219,6 +219,14 @@ pub struct Model<F> {
 
 impl<F: Float> Model<F> {
     /// Prepares the model for a parameter set.
+    ///
+    /// # Errors
+    ///
+    /// `NonFinite` or `OutOfRange` naming the velocity scale when `a_x` is
+    /// not a finite, positive number, and `NonFinite` naming `omega_a`,
+    /// `omega_b` or `sigma` when a chamber rate or the plunger's pumping
+    /// coefficient is not finite (parameters that validated but whose
+    /// combination overflows).
     pub fn new(params: &Params<F>) -> Result<Self, ModelError> {
         let p = params;
         let pl = &p.plunger;
@@ -283,6 +291,11 @@ impl<F: Float> Model<F> {
     }
 
     /// Temperature-dependent coefficients `(q_t, g_l)` for a fluid state.
+    ///
+    /// # Errors
+    ///
+    /// `NonFinite("q_t")` or `NonFinite("g_l")` when the fluid state makes
+    /// one of them infinite or NaN (a zero density or viscosity).
     pub fn hydraulic(&self, fluid: &FluidState<F>) -> Result<(F, F), ModelError> {
         let p = &self.params;
         let q_t = (p.oil.density_15 / fluid.density).sqrt();
@@ -292,6 +305,13 @@ impl<F: Float> Model<F> {
 
     /// All coefficients for a fluid state, converted to `T` (in the flow
     /// unit [`flow_shift`] picks for the fluid's `g_l`).
+    ///
+    /// # Errors
+    ///
+    /// As [`Model::hydraulic`], and, naming the coefficient,
+    /// [`ModelError::NotRepresentable`] when `T` cannot hold it (fixed point
+    /// saturating or losing it to rounding; `omega_a0` and `omega_b0` are
+    /// allowed to saturate) or `NonFinite` when it is not finite.
     pub fn coefficients<T: Real>(&self, fluid: &FluidState<F>) -> Result<Coefficients<T>, ModelError> {
         let p = &self.params;
         let pl = &p.plunger;
@@ -359,8 +379,13 @@ impl<T: Real> Coefficients<T> {
 
     /// Sets the temperature-dependent `q_t`, `g_l` for a fluid state, and
     /// the flow unit with them ([`flow_shift`]: `sigma` and the chamber
-    /// rates change only when the unit does); on error (not finite, or
-    /// not representable in `T`) nothing changes.
+    /// rates change only when the unit does).
+    ///
+    /// # Errors
+    ///
+    /// As [`Model::hydraulic`], and `NotRepresentable` naming `q_t`, `g_l`
+    /// or a coefficient of the new flow unit that `T` cannot hold. Nothing
+    /// changes then.
     pub fn set_hydraulic<F: Float>(&mut self, model: &Model<F>, fluid: &FluidState<F>) -> Result<(), ModelError> {
         let (q_t, g_l) = model.hydraulic(fluid)?;
         let shift = flow_shift(g_l);

@@ -49,6 +49,12 @@ fn sign<T: Real>(a: T, b: T) -> T {
 
 /// Eigenvalues of a real 4x4 matrix, sorted by real part, largest first
 /// (ties: larger imaginary part first).
+///
+/// # Errors
+///
+/// `NonFinite("Jacobian")` when an entry of `m` is not finite;
+/// `NoConvergence("eigenvalues")` when the QR iteration needs more than 30
+/// sweeps for one eigenvalue.
 pub fn eigenvalues<T: Float>(m: &[[T; 4]; 4]) -> Result<[Complex<T>; 4], ModelError> {
     const N: usize = 4;
     // 1-based working copy, as in EISPACK.
@@ -401,6 +407,11 @@ pub struct Linearisation<F> {
 }
 
 /// The model-unit Jacobian of the free motion at the equilibrium of `t` [C].
+///
+/// # Errors
+///
+/// As [`crate::equilibrium::equilibrium`] at `t` and
+/// [`Model::coefficients`] for its fluid state.
 pub fn jacobian_at_equilibrium<F: Float>(model: &Model<F>, t: F) -> Result<[[F; 4]; 4], ModelError> {
     let p = model.params();
     let eq = equilibrium(p, t)?;
@@ -414,6 +425,10 @@ pub fn jacobian_at_equilibrium<F: Float>(model: &Model<F>, t: F) -> Result<[[F; 
 }
 
 /// Linearises the FSI model at the equilibrium of `t` [C].
+///
+/// # Errors
+///
+/// As [`Model::new`], [`jacobian_at_equilibrium`] and [`eigenvalues`].
 pub fn linearise<F: Float>(params: &Params<F>, t: F) -> Result<Linearisation<F>, ModelError> {
     let model = Model::new(params)?;
     let jac = jacobian_at_equilibrium(&model, t)?;

@@ -99,6 +99,10 @@ pub struct ReducedTwin<F, T> {
 
 impl<F: Float, T: Real> ReducedTwin<F, T> {
     /// At rest in the equilibrium of `temperature` [C].
+    ///
+    /// # Errors
+    ///
+    /// As [`super::Twin::new`].
     pub fn new(params: &Params<F>, config: TwinConfig, temperature: F) -> Result<Self, ModelError> {
         config.validate()?;
         let model = Model::new(params)?;
@@ -114,6 +118,11 @@ impl<F: Float, T: Real> ReducedTwin<F, T> {
     }
 
     /// Sets the oil temperature [C] for the following ticks.
+    ///
+    /// # Errors
+    ///
+    /// As [`super::Twin::set_temperature`]; the previous coefficients stay
+    /// in force then.
     pub fn set_temperature(&mut self, temperature: F) -> Result<(), ModelError> {
         let fluid = self.model.params().oil.state(temperature)?;
         self.coefficients.set_hydraulic(&self.model, &fluid)
@@ -124,6 +133,12 @@ impl<F: Float, T: Real> ReducedTwin<F, T> {
     /// into it stays there, otherwise it moves freely and a substep ending
     /// beyond a stop ends on it at rest (no release redo: the pressures
     /// have no transient here).
+    ///
+    /// # Errors
+    ///
+    /// As [`Stepper::step`]: `Singular` when a Rosenbrock stage matrix
+    /// cannot be factorised, `NonFinite` when the state is not finite. The
+    /// state is then the last good substep's.
     pub fn tick(&mut self) -> Result<(), StepError> {
         for _ in 0..self.substeps {
             let probe = ReducedFsi {

@@ -2,7 +2,8 @@
 //! step, generic over the scalar type and the state dimension.
 //!
 //! Rosenbrock (linearly implicit Runge-Kutta) methods in the transformed
-//! form of Hairer & Wanner (IV.7), one LU factorisation per step:
+//! form of Hairer & Wanner (IV.7), one factorisation of the stage matrix
+//! per step (a dense LU, or the system's own: [`OdeSystem::linearise`]):
 //!
 //! ```text
 //! (I / (h gamma) - J) U_i = f(y + sum_j a_ij U_j) + sum_j (c_ij / h) U_j
@@ -76,7 +77,8 @@ impl<T: Real, const N: usize> ShiftedSolve<T, N> for Lu<T, N> {
 }
 
 /// [`OdeSystem::linearise`] for any system: `f(y)` and a dense pivoted LU
-/// of `shift I - J(y)`.
+/// of `shift I - J(y)`; `None` when [`Lu::new`] finds a zero or non-finite
+/// pivot (the matrix is singular, or `J(y)` is not finite).
 pub fn dense_linearisation<T: Real, S: OdeSystem<T, N> + ?Sized, const N: usize>(
     sys: &S,
     y: &[T; N],
@@ -150,7 +152,8 @@ impl Scheme {
         }
     }
 
-    /// The SDIRK tableau of an SDIRK scheme ([`super::dirk`]).
+    /// The SDIRK tableau of an SDIRK scheme ([`super::dirk`]); `None` for
+    /// the others.
     pub const fn dirk(self) -> Option<&'static super::dirk::Tableau> {
         match self {
             Scheme::Sdirk2 => Some(&super::dirk::SDIRK2),
@@ -170,7 +173,8 @@ impl Scheme {
         }
     }
 
-    /// The scheme with this [`Scheme::name`].
+    /// The scheme with this [`Scheme::name`]; `None` when no scheme has
+    /// that name.
     pub fn from_name(name: &str) -> Option<Scheme> {
         Scheme::ALL.iter().copied().find(|s| s.name() == name)
     }
@@ -275,9 +279,11 @@ pub enum StepError {
     Singular,
     /// The new state is not finite.
     NonFinite,
-    /// The state left its physical bounds (a chamber pressure far outside
-    /// `[p_c, p_p]`, the plunger far beyond a stop): the scheme is unstable
-    /// at this step length. An L-stable scheme or more steps per tick cure it.
+    /// The state left its physical bounds (a chamber pressure more than
+    /// [`super::twin::PRESSURE_MARGIN`] `dp` outside `[p_c, p_p]`; the
+    /// plunger cannot leave its stroke, the stops are events): the scheme
+    /// is unstable at this step length. An L-stable scheme or more steps
+    /// per tick cure it.
     Diverged,
 }
 
@@ -293,6 +299,8 @@ impl core::fmt::Display for StepError {
         })
     }
 }
+
+impl core::error::Error for StepError {}
 
 impl<T: Real> Stepper<T> {
     /// Prepares `scheme` for step `h` (in the system's time unit).
@@ -325,17 +333,28 @@ impl<T: Real> Stepper<T> {
         }
     }
 
-    /// The scheme.
-    pub fn scheme(&self) -> Scheme {
-        self.scheme
-    }
-
     /// Advances `y` by one step of `sys`.
+    ///
+    /// # Errors
+    ///
+    /// As [`Stepper::step_fraction`].
     pub fn step<S: OdeSystem<T, N>, const N: usize>(&self, sys: &S, y: &[T; N]) -> Result<[T; N], StepError> {
         self.step_fraction(sys, y, T::ONE)
     }
 
     /// Advances `y` by `frac` (in `(0, 1]`) of the prepared step.
+    ///
+    /// # Errors
+    ///
+    /// * [`StepError::Singular`]: a Rosenbrock scheme's stage matrix
+    ///   `D (I / (h gamma) - J)` could not be factorised
+    ///   ([`OdeSystem::linearise`] returned `None`: singular, or not finite).
+    /// * [`StepError::NonFinite`]: the new state has a NaN or infinite
+    ///   component (floating point only: fixed point saturates instead).
+    ///
+    /// A state that is finite but physically absurd is not caught here: the
+    /// caller's bounds do that ([`StepError::Diverged`] from
+    /// [`super::Twin::tick`]).
     pub fn step_fraction<S: OdeSystem<T, N>, const N: usize>(
         &self,
         sys: &S,

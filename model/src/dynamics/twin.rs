@@ -3,9 +3,17 @@
 //!
 //! A tick of length `dt` is `substeps` steps of one [`Scheme`]; the
 //! temperature-dependent coefficients are frozen over a tick (set them for
-//! the tick's midpoint to follow a ramp to second order). The cost of a
-//! tick depends on the configuration only: one Jacobian, one 4x4 LU and
-//! `stages` right-hand sides per substep, whatever the state.
+//! the tick's midpoint to follow a ramp to second order).
+//!
+//! The cost of a tick is bounded by the configuration. A substep is one
+//! step of the scheme: for the shipped SDIRK ([`super::dirk`]) `stages`
+//! stage solutions, each a fixed number of Newton iterations on the
+//! plunger velocity with both chamber pressures in closed form; for a
+//! Rosenbrock scheme one factorisation of the stage matrix with the
+//! pressures eliminated ([`super::fsi::FsiFactor`], a 2x2 system) and
+//! `stages` right-hand sides. A stop event adds at most one step per
+//! substep ([`EVENTS_PER_SUBSTEP`]), and the first substep after an abrupt
+//! change is at most [`MAX_GRADED_PIECES`] pieces ([`Twin::tick`]).
 //!
 //! The twin is generic over the parameters' float type `F` (used for the
 //! fluid properties at the sensor rate) and the integration scalar `T`
@@ -35,7 +43,14 @@ pub struct TwinConfig {
 }
 
 impl TwinConfig {
-    /// A positive, finite tick and `1..=MAX_SUBSTEPS` steps per tick.
+    /// Checks for a positive, finite tick and `1..=MAX_SUBSTEPS` steps
+    /// per tick.
+    ///
+    /// # Errors
+    ///
+    /// [`ModelError::OutOfRange`]`("tick")` for a tick that is not a
+    /// positive, finite duration, `OutOfRange("substeps")` for a substep
+    /// count outside `1..=MAX_SUBSTEPS`.
     pub fn validate(&self) -> Result<(), ModelError> {
         if !(self.tick > 0.0 && self.tick.is_finite()) {
             return Err(ModelError::OutOfRange("tick"));
@@ -163,6 +178,16 @@ pub struct Twin<F, T> {
 
 impl<F: Float, T: Real> Twin<F, T> {
     /// A twin at rest in the quasi-static equilibrium of `temperature` [C].
+    ///
+    /// # Errors
+    ///
+    /// * the configuration is refused ([`TwinConfig::validate`]);
+    /// * the parameters give no finite, positive unit of velocity
+    ///   ([`Model::new`]);
+    /// * the oil model refuses `temperature`, or the equilibrium there is
+    ///   not finite ([`crate::equilibrium::equilibrium`]);
+    /// * a coefficient of the model does not fit `T`
+    ///   ([`Model::coefficients`]: `NotRepresentable`, fixed point only).
     pub fn new(params: &Params<F>, config: TwinConfig, temperature: F) -> Result<Self, ModelError> {
         config.validate()?;
         let model = Model::new(params)?;
@@ -215,6 +240,11 @@ impl<F: Float, T: Real> Twin<F, T> {
 
     /// Sets the oil temperature [C] for the following ticks. On error the
     /// previous coefficients stay in force.
+    ///
+    /// # Errors
+    ///
+    /// The oil model refuses `temperature` ([`crate::fluid::Oil::state`]),
+    /// or its coefficients are refused as by [`Twin::set_fluid`].
     pub fn set_temperature(&mut self, temperature: F) -> Result<(), ModelError> {
         let fluid = self.model.params().oil.state(temperature)?;
         self.set_fluid(&fluid)
@@ -224,6 +254,12 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// A change of the capillary conductance by more than
     /// [`ABRUPT_CHANGE`] (relative), or of the flow unit
     /// ([`super::fsi::flow_shift`]), makes the next tick start graded.
+    ///
+    /// # Errors
+    ///
+    /// The fluid's coefficients `q_t`, `g_l` are not finite (`NonFinite`),
+    /// or do not fit `T` in any flow unit (`NotRepresentable`, fixed point
+    /// only); see [`Coefficients::set_hydraulic`]. Nothing changes then.
     pub fn set_fluid(&mut self, fluid: &FluidState<F>) -> Result<(), ModelError> {
         let (before, unit) = (self.coefficients.g_l, self.coefficients.flow_shift);
         self.coefficients.set_hydraulic(&self.model, fluid)?;
@@ -266,6 +302,17 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// or one held step; a graded substep at most [`MAX_GRADED_PIECES`]
     /// such pieces (host simulations of abrupt steps: the estimator never
     /// changes the coefficients abruptly).
+    ///
+    /// # Errors
+    ///
+    /// * [`StepError::Diverged`]: a chamber pressure is more than
+    ///   [`PRESSURE_MARGIN`] `dp` outside `[p_c, p_p]` (the scheme is
+    ///   unstable at this step);
+    /// * [`StepError::NonFinite`]: the state is not finite;
+    /// * [`StepError::Singular`]: a Rosenbrock scheme's stage matrix could
+    ///   not be factorised (the SDIRK schemes never fail this way).
+    ///
+    /// The state is then the last good substep's.
     pub fn tick(&mut self) -> Result<TickReport, StepError> {
         let mut events = 0u8;
         let graded = self.abrupt;

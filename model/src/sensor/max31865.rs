@@ -128,7 +128,8 @@ pub enum Wires {
 }
 
 impl Wires {
-    /// From the parameter file's wire count (2, 3 or 4).
+    /// From the parameter file's wire count (2, 3 or 4); `None` for any
+    /// other count.
     pub fn from_count(n: f64) -> Option<Wires> {
         match n {
             2.0 | 4.0 => Some(Wires::TwoOrFour),
@@ -149,7 +150,8 @@ pub enum Mains {
 }
 
 impl Mains {
-    /// From the parameter file's mains frequency (50 or 60 Hz).
+    /// From the parameter file's mains frequency (50 or 60 Hz); `None` for
+    /// any other frequency.
     pub fn from_hz(hz: f64) -> Option<Mains> {
         match hz {
             50.0 => Some(Mains::Hz50),
@@ -178,6 +180,18 @@ pub enum Error<E> {
     /// The code maps to no temperature of the RTD's range.
     Implausible(u16),
 }
+
+impl<E: core::fmt::Debug> core::fmt::Display for Error<E> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Error::Spi(e) => write!(f, "MAX31865: SPI error {e:?}"),
+            Error::Fault(status) => write!(f, "MAX31865: fault status {status:#04x} ({})", classify(*status)),
+            Error::Implausible(code) => write!(f, "MAX31865: RTD code {code:#06x} maps to no temperature"),
+        }
+    }
+}
+
+impl<E: core::fmt::Debug> core::error::Error for Error<E> {}
 
 /// The converter's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -401,6 +415,11 @@ impl<SPI: SpiDevice> Max31865<SPI> {
     /// on, and starts the start-up fault-detection cycle (its result is
     /// read by the next [`TemperatureSource::read`]; continuous conversion
     /// resumes after it).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Spi`] when a transaction fails; the diagnosis [`Phase`] is
+    /// then unchanged.
     pub fn configure(&mut self) -> Result<(), Error<SPI::Error>> {
         let (lo, hi) = self.settings.fault_band;
         let cvd = self.settings.cvd;
@@ -436,6 +455,10 @@ impl<SPI: SpiDevice> Max31865<SPI> {
     }
 
     /// Reads the fault status register.
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Spi`] when the transaction fails.
     pub fn fault_status(&mut self) -> Result<u8, Error<SPI::Error>> {
         let status = self.read_register(REG_FAULT_STATUS)?;
         #[cfg(feature = "defmt")]
@@ -444,12 +467,21 @@ impl<SPI: SpiDevice> Max31865<SPI> {
     }
 
     /// Clears latched faults (keeps the conversion running).
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Spi`] when the transaction fails.
     pub fn clear_faults(&mut self) -> Result<(), Error<SPI::Error>> {
         self.write_config(self.config_byte() | config::FAULT_CLEAR)
     }
 
     /// Reads the 15-bit RTD code. A set fault bit makes this read the
     /// status, clear it and return [`Error::Fault`].
+    ///
+    /// # Errors
+    ///
+    /// [`Error::Fault`] with the status register when the code's fault bit
+    /// is set; [`Error::Spi`] when a transaction fails.
     pub fn read_code(&mut self) -> Result<u16, Error<SPI::Error>> {
         let mut raw = [0u8; 2];
         self.spi
@@ -467,6 +499,12 @@ impl<SPI: SpiDevice> Max31865<SPI> {
     }
 
     /// Reads the temperature [C] of the latest conversion.
+    ///
+    /// # Errors
+    ///
+    /// As [`Max31865::read_code`], and [`Error::Implausible`] for a code
+    /// of zero or full scale, or one whose resistance no RTD temperature
+    /// has ([`super::rtd::Cvd::temperature`]).
     pub fn read_temperature(&mut self) -> Result<f32, Error<SPI::Error>> {
         let code = self.read_code()?;
         let r = code as f32 * self.settings.reference / 32768.0;

@@ -31,6 +31,21 @@ pub enum SensorFault {
     Implausible,
 }
 
+impl core::fmt::Display for SensorFault {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            SensorFault::Bus => "the sensor's bus transaction failed",
+            SensorFault::RtdHigh => "RTD reading above the high threshold (open RTD?)",
+            SensorFault::RtdLow => "RTD reading below the low threshold (shorted RTD?)",
+            SensorFault::Wiring => "a force or reference line of the RTD is open or shorted",
+            SensorFault::Voltage => "over- or under-voltage on a converter input",
+            SensorFault::Implausible => "a reading no RTD can produce",
+        })
+    }
+}
+
+impl core::error::Error for SensorFault {}
+
 /// A source of oil temperature samples [C].
 ///
 /// `Ok(Some(t))`: a new sample; `Ok(None)`: nothing new since the last call

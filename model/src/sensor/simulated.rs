@@ -25,6 +25,14 @@ use embedded_hal::spi::{ErrorKind, ErrorType, Operation, SpiDevice};
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct BusError;
 
+impl core::fmt::Display for BusError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("simulated SPI bus failure")
+    }
+}
+
+impl core::error::Error for BusError {}
+
 impl embedded_hal::spi::Error for BusError {
     fn kind(&self) -> ErrorKind {
         ErrorKind::Other

@@ -82,28 +82,23 @@ pub fn measure_firmware(elfs: &[(Image, PathBuf)], twin_lines: Option<&[String]>
     })
 }
 
-/// `cargo xtask bench [--params F] [--write]`: the images built for `F`
-/// (default `COMPENSATOR_PARAMS`, else the paper preset), the budget table
-/// with the twin configuration the build chose for it. The accuracy table
-/// needs the `host` feature; `main` re-runs xtask with it.
+/// `cargo xtask bench [--params F] [--write]` (the accuracy table needs
+/// the `host` feature; `main` re-runs xtask with it): the images built for
+/// `params` (resolved and checked by `main`; `None`: the paper preset), the
+/// budget table with the twin configuration the build chose for it, written
+/// to `docs/bench.md` with `write`.
 #[cfg(feature = "host")]
-pub fn cmd(root: &Path, args: &[String]) -> Result<i32, String> {
-    let flag = args
-        .iter()
-        .position(|a| a == "--params")
-        .map(|i| args.get(i + 1).cloned().ok_or("--params needs a file"))
-        .transpose()?;
-    let params = crate::params::from_args(flag.as_deref())?;
+pub fn cmd(root: &Path, params: Option<&Path>, write: bool) -> Result<i32, String> {
     let tc = crate::toolchain::get(root, &crate::firmware::TARGETS)?;
     eprintln!("xtask: toolchain: {}", tc.description);
     qemu::ensure()?;
-    let elfs = crate::firmware::build_all_params(&tc, root, params.as_deref())?;
+    let elfs = crate::firmware::build_all_params(&tc, root, params)?;
     let fw = measure_firmware(&elfs, None)?;
     let budget = Budget::of(&fw)?;
     let accuracy = accuracy::points(&fw.m4.configs())?;
     let text = report::document(&fw, &budget, &accuracy);
     print!("{text}");
-    if args.iter().any(|a| a == "--write") {
+    if write {
         let path = root.join("docs/bench.md");
         std::fs::write(&path, &text).map_err(|e| e.to_string())?;
         eprintln!("xtask: wrote {}", path.display());
