@@ -1,8 +1,8 @@
 //! Dynamic-model commands: step and ramp responses, eigenvalues, and the
 //! step-response indicators of the paper's Table 3.
 
-use crate::commands::{CliError, load_params};
 use crate::csv::Table;
+use crate::error::{CliError, load_params};
 use crate::temps;
 use compensator::ModelError;
 use compensator::dynamics::config::{Choice, TARGET_PCT, choose};
@@ -392,7 +392,7 @@ pub fn eigen(path: &Path, temps_spec: &str) -> Result<String, CliError> {
         "omega_n_dominant",
     ]);
     for &t in &temps {
-        let l = linearise(&p, t).map_err(|e| crate::commands::at_temperature(t, e))?;
+        let l = linearise(&p, t).map_err(|e| crate::error::at_temperature(t, e))?;
         let mut row = vec![t];
         for e in &l.eigenvalues {
             row.push(e.re);

@@ -1,16 +1,26 @@
-//! Host-side library of the `compensator` command-line tool: parameter
-//! files, temperature lists, CSV output, calibration against the paper's
-//! tables, design sizing and the dynamic-model commands.
+//! Host-side library of the `compensator` command-line tool, one module per
+//! concern:
 //!
-//! The binary (`src/main.rs`) is a thin argument parser over these modules,
-//! so that the tests can call the same code.
+//! * commands: [`statics`] (equilibrium, asymptotic, sensitivity),
+//!   [`dynamics`] (step, twin-config, eigen, indicators), [`sizing`]
+//!   (compensation, size), [`calibration`] (calibrate) and [`paper`] (the
+//!   paper report, with the paper's tables in [`paper::tables`]);
+//! * their plumbing: [`error`] (a command's failure and exit status,
+//!   parameter loading), [`temps`] (temperature lists), [`csv`] (output),
+//!   [`lsq`] (the least-squares solver of the calibration).
+//!
+//! Each command is a function returning its complete standard output; the
+//! binary (`src/main.rs`) is a thin argument parser over them, so that the
+//! tests can call the same code.
 
-pub mod commands;
+pub mod calibration;
 pub mod csv;
 pub mod dynamics;
+pub mod error;
 pub mod lsq;
 pub mod paper;
 pub mod sizing;
+pub mod statics;
 pub mod temps;
 
 pub use compensator_params::file as params_file;

@@ -6,7 +6,8 @@
 
 use clap::{Parser, Subcommand, ValueEnum};
 use compensator::dynamics::Scheme;
-use compensator_cli::commands::{self, CliError};
+use compensator_cli::error::CliError;
+use compensator_cli::{calibration, paper, sizing, statics};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -189,7 +190,7 @@ fn run(cli: Cli) -> Result<String, CliError> {
             params,
             temps,
             precision,
-        } => commands::equilibrium(&params, &temps, precision == StaticPrecision::F32),
+        } => statics::equilibrium(&params, &temps, precision == StaticPrecision::F32),
         Command::Asymptotic {
             params,
             order,
@@ -201,9 +202,9 @@ fn run(cli: Cli) -> Result<String, CliError> {
                 ReadingArg::Temperature => compensator::asymptotic::Reading::Temperature,
                 ReadingArg::Property => compensator::asymptotic::Reading::Property,
             };
-            commands::asymptotic(&params, order as usize, reading, &t0, &temps)
+            statics::asymptotic(&params, order as usize, reading, &t0, &temps)
         }
-        Command::Sensitivity { params, temps } => commands::sensitivity(&params, &temps),
+        Command::Sensitivity { params, temps } => statics::sensitivity(&params, &temps),
         Command::Step {
             params,
             from,
@@ -227,15 +228,15 @@ fn run(cli: Cli) -> Result<String, CliError> {
             dt,
             t_end,
         } => compensator_cli::dynamics::indicators(&params, &steps, dt, t_end),
-        Command::Compensation { params, temps } => commands::compensation_table(&params, &temps),
+        Command::Compensation { params, temps } => sizing::compensation_table(&params, &temps),
         Command::Size {
             params,
             what,
             temps,
             reference,
-        } => commands::size(&params, &what, &temps, reference),
-        Command::Calibrate { base, data } => commands::calibrate(&base, &data),
-        Command::Paper { params, data } => commands::paper(&params, &data),
+        } => sizing::size(&params, &what, &temps, reference),
+        Command::Calibrate { base, data } => calibration::calibrate(&base, &data),
+        Command::Paper { params, data } => paper::report(&params, &data),
     }
 }
 

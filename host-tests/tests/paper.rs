@@ -2,12 +2,13 @@
 
 use compensator::Params;
 use compensator::asymptotic::Reading;
-use compensator_cli::paper::{self, Table1, Table2};
-use compensator_cli::{commands, lsq, params_file};
+use compensator_cli::paper::tables::{Table1, Table2};
+use compensator_cli::paper::{self, tables};
+use compensator_cli::{calibration, lsq, params_file, statics};
 use host_tests::repo_root;
 
 fn tables() -> (Table1, Table2) {
-    paper::paper_tables(&repo_root()).unwrap()
+    tables::paper_tables(&repo_root()).unwrap()
 }
 
 fn preset() -> Params<f64> {
@@ -17,7 +18,7 @@ fn preset() -> Params<f64> {
 #[test]
 fn table1_columns_invert_to_one_temperature_law() {
     let (t1, _) = tables();
-    let inv = paper::invert_table1(&t1);
+    let inv = tables::invert_table1(&t1);
     // A(t) falls with temperature in every column...
     for j in 0..t1.drops_bar.len() {
         for i in 1..t1.temps.len() {
@@ -33,7 +34,7 @@ fn table1_columns_invert_to_one_temperature_law() {
 #[test]
 fn preset_reproduces_table1_within_0_06_bar_rms() {
     let (t1, _) = tables();
-    let r = paper::table1_residuals(&preset(), &t1);
+    let r = tables::table1_residuals(&preset(), &t1);
     assert_eq!(r.len(), 18);
     let rms = lsq::rms(&r);
     assert!(rms <= 0.06, "Table 1 RMS {rms} bar");
@@ -42,7 +43,7 @@ fn preset_reproduces_table1_within_0_06_bar_rms() {
 #[test]
 fn preset_reproduces_table2_quasi_static_within_0_02_mm() {
     let (_, t2) = tables();
-    let r = paper::table2_residuals(&preset(), &t2);
+    let r = tables::table2_residuals(&preset(), &t2);
     let worst = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     assert!(worst <= 0.02, "Table 2 worst {worst} mm");
 }
@@ -52,7 +53,7 @@ fn committed_preset_is_what_calibrate_produces() {
     let root = repo_root();
     let (t1, t2) = tables();
     let base = params_file::load(&root.join("presets/model-example.toml")).unwrap();
-    let cal = paper::calibrate(&base, &t1, &t2).unwrap();
+    let cal = calibration::fit(&base, &t1, &t2).unwrap();
     let committed = params_file::load(&root.join("presets/paper.toml")).unwrap();
     for (a, b) in cal.params.core.named().zip(committed.core.named()).into_array() {
         let (field, a, b) = (a.path, a.value, b.value);
@@ -68,7 +69,7 @@ fn table2_asym_column_is_the_property_reading_at_second_order_about_the_balance_
     let (_, t2) = tables();
     let p = preset();
     let raw = params_file::load(&repo_root().join("presets/paper.toml")).unwrap();
-    let balance = commands::find_balance(&raw, &p).unwrap();
+    let balance = statics::find_balance(&raw, &p).unwrap();
     let (best, at_balance) = paper::asymptotic_search(&p, &t2, 26.0, 80.0, Some(balance));
     let closest = best.iter().min_by(|a, b| a.rms_mm.total_cmp(&b.rms_mm)).unwrap();
     assert_eq!((closest.reading, closest.order), (Reading::Property, 2));

@@ -1,0 +1,132 @@
+//! Static-model commands: the quasi-static equilibrium (Eqs. 2-10), its
+//! asymptotic expansion (Eqs. 16-21) and the temperature sensitivities
+//! (Eqs. 30-32), one CSV row per temperature.
+
+use crate::csv::Table;
+use crate::error::{CliError, at_temperature, load_params};
+use crate::temps;
+use compensator::asymptotic::{Expansion, Reading, sensitivity as sens};
+use compensator::equilibrium::{self as eq, balance_temperature};
+use compensator::{Params, RawParams};
+use std::path::Path;
+
+/// Formats an `f32` result as the shortest decimal that reads back as the
+/// same `f32`, then as `f64` for the CSV writer.
+fn widen(v: f32) -> f64 {
+    format!("{v}").parse().unwrap_or(f64::NAN)
+}
+
+/// `equilibrium`: the quasi-static operating point per temperature.
+pub fn equilibrium_table(path: &Path, temps_spec: &str, single: bool) -> Result<Table, CliError> {
+    let temps = temps::parse(temps_spec)?;
+    let mut table = Table::new(&[
+        "t_c",
+        "a_sqrt_pa",
+        "p_a_pa",
+        "p_b_pa",
+        "dp_ab_pa",
+        "x_m",
+        "q_branch_m3s",
+        "q_throt_m3s",
+        "q_total_m3s",
+    ]);
+    if single {
+        let (_, p) = load_params::<f32>(path)?;
+        for &t in &temps {
+            let e = eq::equilibrium(&p, t as f32).map_err(|e| at_temperature(t, e))?;
+            table.row(&[
+                t,
+                widen(e.a),
+                widen(e.p_a),
+                widen(e.p_b),
+                widen(e.dp_ab),
+                widen(e.x),
+                widen(e.q_branch),
+                widen(e.q_throt),
+                widen(e.q_total),
+            ]);
+        }
+    } else {
+        let (_, p) = load_params::<f64>(path)?;
+        for &t in &temps {
+            let e = eq::equilibrium(&p, t).map_err(|e| at_temperature(t, e))?;
+            table.row(&[t, e.a, e.p_a, e.p_b, e.dp_ab, e.x, e.q_branch, e.q_throt, e.q_total]);
+        }
+    }
+    Ok(table)
+}
+
+/// `equilibrium` as text.
+pub fn equilibrium(path: &Path, temps_spec: &str, single: bool) -> Result<String, CliError> {
+    Ok(equilibrium_table(path, temps_spec, single)?.as_str().to_string())
+}
+
+/// Balance temperature (Eq. 2) searched over the estimator's oil range:
+/// a 1 C scan finds a bracket among evaluable temperatures, bisection
+/// refines it.
+pub fn find_balance(raw: &RawParams, p: &Params<f64>) -> Result<f64, CliError> {
+    let (lo, hi) = (raw.estimator.oil_min, raw.estimator.oil_max);
+    let target = (p.pressure_drop / 2.0).sqrt();
+    let g = |t: f64| {
+        p.oil
+            .state(t)
+            .ok()
+            .map(|f| compensator::equilibrium::a_parameter(p, &f) - target)
+    };
+    let mut prev: Option<(f64, f64)> = None;
+    let n = (hi - lo).ceil() as usize;
+    for i in 0..=n {
+        let t = (lo + i as f64).min(hi);
+        if let Some(v) = g(t) {
+            if let Some((tp, vp)) = prev
+                && (vp > 0.0) != (v > 0.0)
+            {
+                return balance_temperature(p, tp, t)
+                    .map_err(|e| CliError::Failed(format!("balance temperature: {e}")));
+            }
+            prev = Some((t, v));
+        }
+    }
+    Err(CliError::Input(format!(
+        "--t0 balance: p_a = p_b is not reached between estimator.oil_min = {lo} and estimator.oil_max = {hi} C"
+    )))
+}
+
+/// `asymptotic`: quasi-static and series displacement per temperature.
+pub fn asymptotic(path: &Path, order: usize, reading: Reading, t0: &str, temps_spec: &str) -> Result<String, CliError> {
+    let temps = temps::parse(temps_spec)?;
+    let (raw, p) = load_params::<f64>(path)?;
+    let t0 = if t0.trim() == "balance" {
+        find_balance(&raw, &p)?
+    } else {
+        let v: f64 = t0
+            .trim()
+            .parse()
+            .map_err(|_| CliError::Input(format!("--t0: '{t0}' is neither a number nor 'balance'")))?;
+        if !v.is_finite() {
+            return Err(CliError::Input(format!("--t0: '{t0}' is not finite")));
+        }
+        v
+    };
+    let e = Expansion::new(&p, t0, reading).map_err(|e| CliError::Input(format!("--t0: {t0} C: {e}")))?;
+    let mut table = Table::new(&["t_c", "x_qs_m", "x_asym_m"]);
+    for &t in &temps {
+        let qs = eq::equilibrium(&p, t).map_err(|e| at_temperature(t, e))?;
+        let terms = e.at(t).map_err(|e| at_temperature(t, e))?;
+        table.row(&[t, qs.x, terms.x(order).0]);
+    }
+    Ok(table.as_str().to_string())
+}
+
+/// `sensitivity`: Eqs. (30)-(31) per temperature, then the Eq. (32)
+/// verdict over the listed range as a trailing comment line.
+pub fn sensitivity(path: &Path, temps_spec: &str) -> Result<String, CliError> {
+    let temps = temps::parse(temps_spec)?;
+    let (_, p) = load_params::<f64>(path)?;
+    let mut table = Table::new(&["t_c", "dx_dt_branch_m_k", "dx_dt_m_k", "dq_throt_dt_m3s_k"]);
+    for &t in &temps {
+        let s = sens(&p, t).map_err(|e| at_temperature(t, e))?;
+        table.row(&[t, s.dx_dt_branch, s.dx_dt, s.dq_throt_dt]);
+    }
+    Ok(table.as_str().to_string())
+}
