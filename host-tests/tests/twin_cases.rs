@@ -69,7 +69,7 @@ fn ends_on_the_reference(raw: &RawParams, from: f64, to: f64, t_end: f64) {
 
 #[test]
 fn the_paper_preset_cooled_to_zero_ends_on_the_closed_stop_at_the_reference() {
-    // The issue: `step --from 40 --to 0 --t-end 0.5` ended at p_a = 183,035,
+    // The reported failure: `step --from 40 --to 0 --t-end 0.5` ended at p_a = 183,035,
     // p_b = 217,583 Pa; right: 396,912 / 3,088 Pa.
     ends_on_the_reference(&load("presets/paper.toml"), 40.0, 0.0, 0.5);
 }

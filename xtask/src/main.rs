@@ -318,7 +318,7 @@ fn host_cargo(root: &Path, args: &[&str], timeout: Duration) -> Result<(), Strin
 }
 
 /// A parameter file for a device with wide ranges: the paper's preset with
-/// the validated range 20-95 C (the file that made `build.rs`
+/// the validated range 20-95 C (the reported file that made `build.rs`
 /// panic), written under `target/`.
 fn wide_device_file(root: &Path) -> Result<PathBuf, String> {
     let text = std::fs::read_to_string(root.join("presets/paper.toml")).map_err(|e| e.to_string())?;
@@ -524,7 +524,7 @@ mod tests {
 
     #[test]
     fn misspelt_or_unknown_arguments_are_errors() {
-        // The case: `test --bles` used to run the tests without blessing.
+        // The reported case: `test --bles` used to run the tests without blessing.
         assert_eq!(parse(&["test", "--bles"]), Err(ErrorKind::UnknownArgument));
         assert_eq!(parse(&["bench", "--wrte"]), Err(ErrorKind::UnknownArgument));
         assert_eq!(parse(&["run", "extra"]), Err(ErrorKind::UnknownArgument));

@@ -1,11 +1,11 @@
-//! The firmware issue's budgets and the check of the measurements against
+//! The firmware's budgets and the check of the measurements against
 //! them (`cargo xtask bench`, and `cargo xtask test` through
 //! [`super::check`]).
 
 use super::Firmware;
 use super::measure::Built;
 
-/// The budgets of the firmware issue.
+/// The firmware's budgets.
 pub const BUDGET_INSTRUCTIONS: f64 = 3000.0;
 /// The twin's plain tick on the paper preset (the configuration its build
 /// chooses) [instructions].
