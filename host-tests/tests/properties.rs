@@ -29,11 +29,13 @@
 //! is one command (`docs/robustness.md`, "Property tests"):
 //!
 //! ```text
-//! PROPTEST_CASES=1000 PROPTEST_RNG_SEED=7 cargo test --release -p host-tests --test properties
+//! PROPTEST_CASES=1000 cargo test -p host-tests --test properties -- --nocapture 2>&1 | grep '^worst'
 //! ```
 //!
 //! `PROPTEST_CASES` sets every property's case count (the defaults below
-//! keep this file at a few seconds); `PROPTEST_RNG_SEED` replaces [`SEED`].
+//! keep this file at about 10 s of CPU); `PROPTEST_RNG_SEED=N` replaces
+//! [`SEED`]. With `--nocapture`, each figure's last `worst` line is its
+//! worst case over the run ([`record`]).
 
 use compensator::asymptotic::{Expansion, Reading, monotonicity};
 use compensator::dynamics::TwinConfig;
