@@ -18,8 +18,10 @@
 // written (EISPACK, Hairer & Wanner); iterator chains would obscure them.
 #![allow(clippy::needless_range_loop)]
 
-use super::fsi::{Contact, Fsi, Model};
+use super::coefficients::Model;
+use super::fsi::Fsi;
 use super::schemes::OdeSystem;
+use super::stops::Contact;
 use crate::equilibrium::{Stop, equilibrium};
 use crate::error::ModelError;
 pub use crate::linalg::eigen::{Complex, eigenvalues};
@@ -114,7 +116,7 @@ pub fn linearise<F: Float>(params: &Params<F>, t: F) -> Result<Linearisation<F>,
     }
     let eq = equilibrium(params, t)?;
     let c = model.coefficients::<F>(&eq.fluid)?;
-    let (s, ds) = super::reduced::quasi_steady(&c, F::ZERO);
+    let (s, ds) = c.quasi_steady(F::ZERO);
     // w' = ... - (2 zeta - 4 s ds phi / a_x) w: the plunger's total damping.
     let two_zeta_total = c.two_zeta - F::from_f64(4.0) * s * ds * c.phi_over_a_x;
     Ok(Linearisation {
