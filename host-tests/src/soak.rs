@@ -341,6 +341,9 @@ impl Drift {
 /// estimator hands its twin, without the spike filter's jumps): both twins
 /// get the same `f32` temperature every tick.
 pub fn drift(raw: &RawParams, ticks: u32, seed: u64) -> Result<Drift, String> {
+    if ticks < 10 {
+        return Err(format!("{ticks} ticks: a drift run needs tenths to compare"));
+    }
     let p32 = Params::<f32>::new(raw).map_err(|e| e.to_string())?;
     let p64 = Params::<f64>::new(raw).map_err(|e| e.to_string())?;
     let estimator = EstimatorConfig::new(&raw.estimator).map_err(|e| e.to_string())?;

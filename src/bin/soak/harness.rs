@@ -309,12 +309,15 @@ impl Limits {
     }
 
     /// Bound on the ticks from the end of a fault (or from a step) to the
-    /// next accepted sample, which clears every sensor flag: the next read
-    /// (`sensor_every - 1`), a diagnosis cycle the fault left pending or
-    /// found the converter unconfigured for (a configuration, its result,
-    /// `restart - 1` stale reads), then `spike_limit` samples rejected if
-    /// the temperature moved beyond the spike threshold meanwhile, and the
-    /// one accepted: `restart + spike_limit + 3` reads after the first.
+    /// next accepted sample, which clears every sensor flag: the first read
+    /// (at most `sensor_every - 1` ticks on), then at most one diagnosis
+    /// cycle (the cycle resets the driver's countdown to the next one),
+    /// after a reconfiguration when MISO was stuck high (a configuration,
+    /// the cycle's result, `restart - 1` stale reads), `spike_limit`
+    /// samples rejected when the oil moved beyond the spike threshold
+    /// meanwhile, and the one accepted: `restart + spike_limit + 2` reads,
+    /// the last `restart + spike_limit + 1` reads after the first; one read
+    /// of margin on top.
     pub fn recovery_bound(&self) -> u32 {
         (self.restart + self.spike_limit + 4) * self.sensor_every
     }
