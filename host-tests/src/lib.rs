@@ -10,6 +10,7 @@ pub mod bench;
 pub mod fixed_audit;
 pub mod probe;
 pub mod random;
+pub mod soak;
 pub mod survey;
 pub use compensator_reference::statics as reference;
 

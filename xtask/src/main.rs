@@ -429,6 +429,29 @@ fn cmd_test(bless: bool) -> Outcome {
     let raw = compensator_params::file::load(&root.join("presets/paper.toml")).map_err(|e| e.to_string())?;
     let host = replica::run(&raw, &schedule)?;
     eprintln!("xtask: {}: {}", csv_path.display(), replica::compare(&decoded, &host)?);
+    step("QEMU: the soak (1e6 ticks of a seeded walk with injected sensor faults, every tick checked)");
+    let soak = &elfs
+        .iter()
+        .find(|(i, _)| *i == firmware::Image::SOAK)
+        .ok_or("no soak image")?
+        .1;
+    let started = std::time::Instant::now();
+    let run = qemu::run(soak, qemu::NETDUINO, false, minutes(3), qemu::Show::Quiet)?;
+    if run.code != 0 {
+        for l in &run.lines {
+            eprintln!("{l}");
+        }
+        return Err(format!("the soak exited with {} (124: past its deadline)", run.code).into());
+    }
+    eprintln!(
+        "xtask: {} ({:.0} s)",
+        run.lines
+            .iter()
+            .rev()
+            .find(|l| l.contains("soak:"))
+            .map_or("", String::as_str),
+        started.elapsed().as_secs_f64()
+    );
     step("QEMU: a HardFault reports and exits 1 at once");
     let fault = firmware::build(&tc, &root, &firmware::Image::FAULT, None)?;
     flash::check_fault_report(&fault)?;
