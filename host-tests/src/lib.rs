@@ -8,6 +8,7 @@
 pub mod accuracy;
 pub mod bench;
 pub mod fixed_audit;
+pub mod matrix;
 pub mod probe;
 pub mod random;
 pub mod soak;
