@@ -61,7 +61,15 @@ pub struct Machine<T> {
     pub leakage_temperature: T,
 }
 
-/// A validated parameter set in scalar type `T`.
+/// A parameter set in scalar type `T` (SI units).
+///
+/// [`Params::new`] builds it from a [`RawParams`] it validates first (every
+/// field in its plausible range, the rules between fields). The fields are
+/// public, so that sizing tools and tests can vary one (a chamber's bulk
+/// modulus beyond any oil, say): a set changed by hand carries no such
+/// guarantee, and the model's functions do not assume one. They return a
+/// `ModelError` naming the quantity that came out not finite or out of
+/// range instead.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Params<T> {
     /// The oil.
