@@ -256,16 +256,16 @@ impl Limits {
             ..*settings
         };
         let accepts = |t: f32| params.oil.state(t).is_ok() && equilibrium(params, t).is_ok();
-        let (oil_lo, oil_hi) = config.oil;
+        let (oil_lo, oil_hi) = (config.oil.min, config.oil.max);
         // The coldest oil the model accepts, in whole degrees from the
         // range's bottom.
         let mut cold_lo = oil_lo + 0.5;
-        while !accepts(cold_lo) && cold_lo < config.valid.0 {
+        while !accepts(cold_lo) && cold_lo < config.valid.min {
             cold_lo += 1.0;
         }
         let cold = (cold_lo, cold_lo + 2.5);
-        let lo = (config.valid.0 - 6.0).max(cold.1 + 1.0);
-        let mut hi = (config.valid.1 + 12.0).min(oil_hi - 1.0);
+        let lo = (config.valid.min - 6.0).max(cold.1 + 1.0);
+        let mut hi = (config.valid.max + 12.0).min(oil_hi - 1.0);
         while !(accepts(hi) && accepts(hi + 1.0)) && hi > lo {
             hi -= 1.0;
         }
@@ -280,7 +280,7 @@ impl Limits {
             spike_limit: config.spike_limit,
             spike_threshold: config.spike_threshold,
             stale_after: config.stale_after,
-            oil: config.oil,
+            oil: (config.oil.min, config.oil.max),
             cold,
             range: (lo, hi),
         })
