@@ -6,9 +6,11 @@
 
 use clap::{Parser, Subcommand, ValueEnum};
 use compensator::dynamics::Scheme;
+use compensator_cli::csv::Format;
 use compensator_cli::error::CliError;
 use compensator_cli::{calibration, paper, sizing, statics};
-use std::path::PathBuf;
+use std::io::Write;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser, Debug)]
@@ -20,6 +22,12 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Output format of a table: csv, json (one object per row) or table (aligned columns).
+    #[arg(long, global = true, value_enum, default_value = "csv")]
+    format: Format,
+    /// Write the output to FILE instead of standard output (only once complete).
+    #[arg(short = 'o', long = "output", global = true, value_name = "FILE")]
+    output: Option<PathBuf>,
 }
 
 /// Scalar type of a static computation.
@@ -190,9 +198,12 @@ enum Command {
         /// Ramp rate [C/s]; without it, a step at t = 0.
         #[arg(long, allow_hyphen_values = true)]
         ramp: Option<f64>,
-        /// Tick [s]: output interval and integration step.
+        /// Tick [s]: the twin's integration step (and output interval without --sample).
         #[arg(long, default_value = "0.001", allow_hyphen_values = true)]
         dt: f64,
+        /// Output interval [s]: a row every round(S / dt) ticks (default: every tick).
+        #[arg(long, value_name = "S", allow_hyphen_values = true)]
+        sample: Option<f64>,
         /// Simulated time [s] (default: ramp duration + 0.5 s).
         #[arg(long, allow_hyphen_values = true)]
         t_end: Option<f64>,
@@ -295,8 +306,48 @@ enum Command {
     },
 }
 
+/// The command's output in the chosen format: the commands that write
+/// TOML or text (`size`, `calibrate`, `paper`) have only that.
 fn run(cli: Cli) -> Result<String, CliError> {
-    match cli.command {
+    let tabular = !matches!(
+        cli.command,
+        Command::Size { .. } | Command::Calibrate { .. } | Command::Paper { .. }
+    );
+    if !tabular && cli.format != Format::Csv {
+        return Err(CliError::Input(
+            "--format: size, calibrate and paper write TOML or text; json and table apply to the CSV commands".into(),
+        ));
+    }
+    let format = cli.format;
+    let out = run_command(cli.command)?;
+    Ok(if tabular {
+        compensator_cli::csv::render(&out, format)
+    } else {
+        out
+    })
+}
+
+/// Writes the output to `path` or standard output. A closed pipe on
+/// standard output (`| head`) ends quietly: `Ok(())`.
+fn write_output(out: &str, path: Option<&Path>) -> Result<(), CliError> {
+    match path {
+        Some(path) => {
+            std::fs::write(path, out).map_err(|e| CliError::Input(format!("--output: {}: {e}", path.display())))
+        }
+        None => {
+            let mut stdout = std::io::stdout().lock();
+            match stdout.write_all(out.as_bytes()).and_then(|()| stdout.flush()) {
+                Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+                    Err(CliError::Failed(format!("standard output: {e}")))
+                }
+                _ => Ok(()),
+            }
+        }
+    }
+}
+
+fn run_command(command: Command) -> Result<String, CliError> {
+    match command {
         Command::Equilibrium {
             params,
             temps,
@@ -322,14 +373,16 @@ fn run(cli: Cli) -> Result<String, CliError> {
             to,
             ramp,
             dt,
+            sample,
             t_end,
             precision,
             scheme,
             substeps,
         } => {
+            let every = compensator_cli::dynamics::sample_every(sample, dt)?;
             let out = compensator_cli::dynamics::step(&params, from, to, ramp, dt, t_end, precision, scheme, substeps)?;
-            eprintln!("{}", out.note);
-            Ok(out.csv)
+            let _ = writeln!(std::io::stderr(), "{}", out.note);
+            Ok(compensator_cli::dynamics::every_nth_row(&out.csv, every))
         }
         Command::TwinConfig { params, dt } => compensator_cli::dynamics::twin_config(&params, dt),
         Command::Eigen { params, temps } => compensator_cli::dynamics::eigen(&params, &temps),
@@ -379,13 +432,11 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    match run(cli) {
-        Ok(out) => {
-            print!("{out}");
-            ExitCode::SUCCESS
-        }
+    let output = cli.output.clone();
+    match run(cli).and_then(|out| write_output(&out, output.as_deref())) {
+        Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            let _ = writeln!(std::io::stderr(), "error: {e}");
             ExitCode::from(e.exit_code())
         }
     }
