@@ -428,7 +428,7 @@ fn main() -> ExitCode {
                 .lines()
                 .find(|l| !l.trim().is_empty())
                 .unwrap_or("invalid arguments");
-            eprintln!("{}", line.trim());
+            let _ = writeln!(std::io::stderr(), "{}", line.trim());
             return ExitCode::from(2);
         }
     };

@@ -260,3 +260,18 @@ pub fn size(path: &Path, what: &str, temps_spec: &str, reference: f64) -> Result
     }
     Ok(o)
 }
+
+#[cfg(test)]
+mod finite_tests {
+    use super::finite;
+
+    #[test]
+    fn a_non_finite_result_is_a_failure_naming_the_quantity() {
+        assert!(finite(&[("slot diameter", 1e-3), ("compensation error RMS", 1e-6)]).is_ok());
+        for bad in [f64::INFINITY, f64::NAN, f64::NEG_INFINITY] {
+            let e = finite(&[("slot diameter", 1e-3), ("compensation error RMS", bad)]).unwrap_err();
+            assert_eq!(e.exit_code(), 1);
+            assert!(e.to_string().starts_with("compensation error RMS is"), "{e}");
+        }
+    }
+}
