@@ -64,19 +64,19 @@ impl Field {
     /// [`Problem::Infinite`], [`Problem::Implausible`] (with the range and
     /// unit), [`Problem::NotWhole`] or [`Problem::NotOneOf`].
     pub fn check(&self, value: f64) -> Result<f64, ParamError> {
-        let n = Named { path: self.path, value };
-        let v = finite(n)?;
-        let zero = self.kind == Kind::OrZero && v == 0.0;
-        if !(zero || v >= self.min && v <= self.max) {
-            return Err(err(n, Problem::Implausible(self.range())));
-        }
-        match self.kind {
-            Kind::Real | Kind::OrZero => Ok(v),
-            // Exact for |v| < 2^63 (the saturating cast changes any fraction).
-            Kind::Whole if v as i64 as f64 == v => Ok(v),
-            Kind::Whole => Err(err(n, Problem::NotWhole)),
-            Kind::OneOf(values) if values.contains(&v) => Ok(v),
-            Kind::OneOf(values) => Err(err(n, Problem::NotOneOf(values))),
+        self.rule().check(value)
+    }
+
+    /// What [`Field::check`] needs of the field, without its description
+    /// (built at compile time by the generated `check_fields`, so that a
+    /// firmware image validating its parameters links no field docs).
+    pub const fn rule(&self) -> Rule {
+        Rule {
+            path: self.path,
+            unit: self.unit,
+            min: self.min,
+            max: self.max,
+            kind: self.kind,
         }
     }
 
@@ -88,6 +88,51 @@ impl Field {
             max: self.max,
             unit: self.unit,
             or_zero: self.kind == Kind::OrZero,
+        }
+    }
+}
+
+/// A field's rule: its name, plausible range and [`Kind`] ([`Field::rule`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rule {
+    /// `section.key`.
+    pub path: &'static str,
+    /// Unit.
+    pub unit: &'static str,
+    /// Lowest plausible value.
+    pub min: f64,
+    /// Highest plausible value.
+    pub max: f64,
+    /// What else the value must be.
+    pub kind: Kind,
+}
+
+impl Rule {
+    /// As [`Field::check`].
+    ///
+    /// # Errors
+    ///
+    /// As [`Field::check`].
+    pub fn check(&self, value: f64) -> Result<f64, ParamError> {
+        let n = Named { path: self.path, value };
+        let v = finite(n)?;
+        let zero = self.kind == Kind::OrZero && v == 0.0;
+        if !(zero || v >= self.min && v <= self.max) {
+            let range = Range {
+                min: self.min,
+                max: self.max,
+                unit: self.unit,
+                or_zero: self.kind == Kind::OrZero,
+            };
+            return Err(err(n, Problem::Implausible(range)));
+        }
+        match self.kind {
+            Kind::Real | Kind::OrZero => Ok(v),
+            // Exact for |v| < 2^63 (the saturating cast changes any fraction).
+            Kind::Whole if v as i64 as f64 == v => Ok(v),
+            Kind::Whole => Err(err(n, Problem::NotWhole)),
+            Kind::OneOf(values) if values.contains(&v) => Ok(v),
+            Kind::OneOf(values) => Err(err(n, Problem::NotOneOf(values))),
         }
     }
 }
@@ -225,7 +270,7 @@ macro_rules! schema {
             ///
             /// The first field's [`Field::check`] error.
             pub fn check_fields(&self) -> Result<(), ParamError> {
-                $( Self::FIELD.$field.check(self.$field)?; )*
+                $( const { Self::FIELD.$field.rule() }.check(self.$field)?; )*
                 Ok(())
             }
 
