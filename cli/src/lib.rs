@@ -19,6 +19,7 @@ pub mod dynamics;
 pub mod error;
 pub mod lsq;
 pub mod paper;
+pub mod plot;
 pub mod sizing;
 pub mod statics;
 pub mod temps;

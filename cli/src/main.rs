@@ -7,7 +7,7 @@
 use clap::{Parser, Subcommand, ValueEnum};
 use compensator::dynamics::Scheme;
 use compensator_cli::error::CliError;
-use compensator_cli::{calibration, paper, sizing, statics};
+use compensator_cli::{calibration, paper, plot, sizing, statics};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -56,6 +56,9 @@ enum Command {
         /// Scalar type of the computation.
         #[arg(long, value_enum, default_value = "f64")]
         precision: StaticPrecision,
+        /// Also draw the output as a figure (SVG; docs/plots.md).
+        #[arg(long, value_name = "FILE.svg", value_parser = plot::parse_path)]
+        plot: Option<PathBuf>,
     },
     /// Asymptotic displacement (Eqs. 16-21) beside the quasi-static one.
     Asymptotic {
@@ -72,6 +75,9 @@ enum Command {
         t0: String,
         #[arg(long, default_value = "30:80:10", allow_hyphen_values = true)]
         temps: String,
+        /// Also draw the output as a figure (SVG; docs/plots.md).
+        #[arg(long, value_name = "FILE.svg", value_parser = plot::parse_path)]
+        plot: Option<PathBuf>,
     },
     /// Temperature sensitivities (Eqs. 30-31) and the Eq. (32) verdict.
     Sensitivity {
@@ -111,6 +117,12 @@ enum Command {
         /// Steps per tick, overriding the chosen number (alone: with sdirk3).
         #[arg(long)]
         substeps: Option<u8>,
+        /// Also draw the output as a figure (SVG; docs/plots.md).
+        #[arg(long, value_name = "FILE.svg", value_parser = plot::parse_path)]
+        plot: Option<PathBuf>,
+        /// With --plot: also run the reference solver and draw it dashed over the twin.
+        #[arg(long, requires = "plot")]
+        overlay_reference: bool,
     },
     /// The twin's scheme and substeps per tick chosen for a file (CSV).
     ///
@@ -130,6 +142,9 @@ enum Command {
         params: PathBuf,
         #[arg(long, default_value = "30:80:10", allow_hyphen_values = true)]
         temps: String,
+        /// Also draw the output as a figure (SVG; docs/plots.md).
+        #[arg(long, value_name = "FILE.svg", value_parser = plot::parse_path)]
+        plot: Option<PathBuf>,
     },
     /// Step-response indicators of Table 3 (reference solver).
     Indicators {
@@ -151,6 +166,9 @@ enum Command {
         params: PathBuf,
         #[arg(long, default_value = "30:80:10", allow_hyphen_values = true)]
         temps: String,
+        /// Also draw the output as a figure (SVG; docs/plots.md).
+        #[arg(long, value_name = "FILE.svg", value_parser = plot::parse_path)]
+        plot: Option<PathBuf>,
     },
     /// Design sizing: the machine a compensator serves best (`machine`), or
     /// the window diameter a machine needs (`slot`); prints TOML.
@@ -184,25 +202,48 @@ enum Command {
     },
 }
 
+/// Draws `fig` (built from a command's output `out`) to `path` if given,
+/// and passes `out` on.
+fn plotted(
+    out: String,
+    path: Option<PathBuf>,
+    fig: impl FnOnce(&str) -> Result<plot::Figure, CliError>,
+) -> Result<String, CliError> {
+    if let Some(path) = path {
+        plot::write(&path, &fig(&out)?)?;
+    }
+    Ok(out)
+}
+
 fn run(cli: Cli) -> Result<String, CliError> {
     match cli.command {
         Command::Equilibrium {
             params,
             temps,
             precision,
-        } => statics::equilibrium(&params, &temps, precision == StaticPrecision::F32),
+            plot,
+        } => plotted(
+            statics::equilibrium(&params, &temps, precision == StaticPrecision::F32)?,
+            plot,
+            plot::equilibrium,
+        ),
         Command::Asymptotic {
             params,
             order,
             reading,
             t0,
             temps,
+            plot,
         } => {
             let reading = match reading {
                 ReadingArg::Temperature => compensator::asymptotic::Reading::Temperature,
                 ReadingArg::Property => compensator::asymptotic::Reading::Property,
             };
-            statics::asymptotic(&params, order as usize, reading, &t0, &temps)
+            plotted(
+                statics::asymptotic(&params, order as usize, reading, &t0, &temps)?,
+                plot,
+                |csv| plot::asymptotic(csv, order as usize),
+            )
         }
         Command::Sensitivity { params, temps } => statics::sensitivity(&params, &temps),
         Command::Step {
@@ -215,20 +256,58 @@ fn run(cli: Cli) -> Result<String, CliError> {
             precision,
             scheme,
             substeps,
+            plot,
+            overlay_reference,
         } => {
-            let out = compensator_cli::dynamics::step(&params, from, to, ramp, dt, t_end, precision, scheme, substeps)?;
+            use compensator_cli::dynamics::{Precision, step};
+            if overlay_reference && precision == Precision::Reference {
+                return Err(CliError::Input(
+                    "--overlay-reference: the run is the reference already (--precision reference)".into(),
+                ));
+            }
+            let out = step(&params, from, to, ramp, dt, t_end, precision, scheme, substeps)?;
             eprintln!("{}", out.note);
+            if let Some(path) = plot {
+                let name = match precision {
+                    Precision::Reference => "reference (Radau5)".to_string(),
+                    Precision::Reduced => "reduced model".to_string(),
+                    p => format!(
+                        "twin, {}",
+                        p.to_possible_value().map_or("?".into(), |v| v.get_name().to_string())
+                    ),
+                };
+                let reference = if overlay_reference {
+                    Some(step(&params, from, to, ramp, dt, t_end, Precision::Reference, None, None)?.csv)
+                } else {
+                    None
+                };
+                let title = match ramp {
+                    None => format!("Step {from} C to {to} C"),
+                    Some(r) => format!("Ramp {from} C to {to} C at {r} C/s"),
+                };
+                let fig = plot::step(
+                    &out.csv,
+                    &name,
+                    reference.as_deref().map(|r| (r, "reference (Radau5)")),
+                    &title,
+                )?;
+                plot::write(&path, &fig)?;
+            }
             Ok(out.csv)
         }
         Command::TwinConfig { params, dt } => compensator_cli::dynamics::twin_config(&params, dt),
-        Command::Eigen { params, temps } => compensator_cli::dynamics::eigen(&params, &temps),
+        Command::Eigen { params, temps, plot } => {
+            plotted(compensator_cli::dynamics::eigen(&params, &temps)?, plot, plot::eigen)
+        }
         Command::Indicators {
             params,
             steps,
             dt,
             t_end,
         } => compensator_cli::dynamics::indicators(&params, &steps, dt, t_end),
-        Command::Compensation { params, temps } => sizing::compensation_table(&params, &temps),
+        Command::Compensation { params, temps, plot } => {
+            plotted(sizing::compensation_table(&params, &temps)?, plot, plot::compensation)
+        }
         Command::Size {
             params,
             what,
