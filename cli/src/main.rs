@@ -121,7 +121,7 @@ enum Command {
         #[arg(long, value_name = "FILE.svg", value_parser = plot::parse_path)]
         plot: Option<PathBuf>,
         /// With --plot: also run the reference solver and draw it dashed over the twin.
-        #[arg(long, requires = "plot")]
+        #[arg(long)]
         overlay_reference: bool,
     },
     /// The twin's scheme and substeps per tick chosen for a file (CSV).
@@ -260,6 +260,11 @@ fn run(cli: Cli) -> Result<String, CliError> {
             overlay_reference,
         } => {
             use compensator_cli::dynamics::{Precision, step};
+            if overlay_reference && plot.is_none() {
+                return Err(CliError::Input(
+                    "--overlay-reference: draws over a figure; give --plot FILE.svg".into(),
+                ));
+            }
             if overlay_reference && precision == Precision::Reference {
                 return Err(CliError::Input(
                     "--overlay-reference: the run is the reference already (--precision reference)".into(),
