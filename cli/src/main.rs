@@ -221,10 +221,10 @@ fn run(cli: Cli) -> Result<String, CliError> {
             params,
             temps,
             precision,
-            plot,
+            plot: figure,
         } => plotted(
             statics::equilibrium(&params, &temps, precision == StaticPrecision::F32)?,
-            plot,
+            figure,
             plot::equilibrium,
         ),
         Command::Asymptotic {
@@ -233,7 +233,7 @@ fn run(cli: Cli) -> Result<String, CliError> {
             reading,
             t0,
             temps,
-            plot,
+            plot: figure,
         } => {
             let reading = match reading {
                 ReadingArg::Temperature => compensator::asymptotic::Reading::Temperature,
@@ -241,7 +241,7 @@ fn run(cli: Cli) -> Result<String, CliError> {
             };
             plotted(
                 statics::asymptotic(&params, order as usize, reading, &t0, &temps)?,
-                plot,
+                figure,
                 |csv| plot::asymptotic(csv, order as usize),
             )
         }
@@ -256,11 +256,11 @@ fn run(cli: Cli) -> Result<String, CliError> {
             precision,
             scheme,
             substeps,
-            plot,
+            plot: figure,
             overlay_reference,
         } => {
             use compensator_cli::dynamics::{Precision, step};
-            if overlay_reference && plot.is_none() {
+            if overlay_reference && figure.is_none() {
                 return Err(CliError::Input(
                     "--overlay-reference: draws over a figure; give --plot FILE.svg".into(),
                 ));
@@ -272,7 +272,7 @@ fn run(cli: Cli) -> Result<String, CliError> {
             }
             let out = step(&params, from, to, ramp, dt, t_end, precision, scheme, substeps)?;
             eprintln!("{}", out.note);
-            if let Some(path) = plot {
+            if let Some(path) = figure {
                 let name = match precision {
                     Precision::Reference => "reference (Radau5)".to_string(),
                     Precision::Reduced => "reduced model".to_string(),
@@ -301,18 +301,22 @@ fn run(cli: Cli) -> Result<String, CliError> {
             Ok(out.csv)
         }
         Command::TwinConfig { params, dt } => compensator_cli::dynamics::twin_config(&params, dt),
-        Command::Eigen { params, temps, plot } => {
-            plotted(compensator_cli::dynamics::eigen(&params, &temps)?, plot, plot::eigen)
-        }
+        Command::Eigen {
+            params,
+            temps,
+            plot: figure,
+        } => plotted(compensator_cli::dynamics::eigen(&params, &temps)?, figure, plot::eigen),
         Command::Indicators {
             params,
             steps,
             dt,
             t_end,
         } => compensator_cli::dynamics::indicators(&params, &steps, dt, t_end),
-        Command::Compensation { params, temps, plot } => {
-            plotted(sizing::compensation_table(&params, &temps)?, plot, plot::compensation)
-        }
+        Command::Compensation {
+            params,
+            temps,
+            plot: figure,
+        } => plotted(sizing::compensation_table(&params, &temps)?, figure, plot::compensation),
         Command::Size {
             params,
             what,

@@ -86,6 +86,42 @@ fn finite(points: &[(f64, f64)], log_y: bool) -> Vec<(f64, f64)> {
         .collect()
 }
 
+/// Points per curve beyond which a curve is thinned.
+const MAX_POINTS: usize = 4000;
+
+/// At most about `MAX_POINTS` of `points` (sorted along x), keeping each
+/// bucket's first, lowest, highest and last point in order, so that a
+/// peak survives: a long run (`step --t-end 100`) stays a small file.
+fn thin(points: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+    if points.len() <= MAX_POINTS {
+        return points;
+    }
+    let per = points.len().div_ceil(MAX_POINTS / 4);
+    let mut out = Vec::with_capacity(MAX_POINTS + 4);
+    for bucket in points.chunks(per) {
+        let lo = bucket
+            .iter()
+            .enumerate()
+            .min_by(|a, b| a.1.1.total_cmp(&b.1.1))
+            .map_or(0, |m| m.0);
+        let hi = bucket
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.1.total_cmp(&b.1.1))
+            .map_or(0, |m| m.0);
+        let mut keep = [0, lo, hi, bucket.len() - 1];
+        keep.sort_unstable();
+        let mut last = usize::MAX;
+        for k in keep {
+            if k != last {
+                out.push(bucket[k]);
+                last = k;
+            }
+        }
+    }
+    out
+}
+
 /// The range of `values`, padded by 5 % (a flat series gets a unit band).
 fn padded(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -156,6 +192,7 @@ fn draw_panel<'a, Y>(
     x_range: (f64, f64),
     y_range: Y,
     legend: SeriesLabelPosition,
+    zero_inside: bool,
     x_desc: &str,
     panel: &Panel,
 ) -> DrawResult<()>
@@ -179,10 +216,17 @@ where
         .light_line_style(WHITE.mix(0.0))
         .bold_line_style(BLACK.mix(0.12))
         .draw()?;
+    if !panel.log_y && zero_inside {
+        let (x0, x1) = x_range;
+        chart.draw_series(std::iter::once(PathElement::new(
+            vec![(x0, 0.0), (x1, 0.0)],
+            BLACK.mix(0.5).stroke_width(1),
+        )))?;
+    }
     for (i, s) in panel.series.iter().enumerate() {
         let color = COLORS[i % COLORS.len()];
         let style = color.stroke_width(2);
-        let points = finite(&s.points, panel.log_y);
+        let points = thin(finite(&s.points, panel.log_y));
         let anno = if s.dashed {
             chart.draw_series(DashedLineSeries::new(points.clone(), 8, 5, style))?
         } else {
@@ -243,7 +287,7 @@ fn draw(path: &Path, fig: &Figure) -> DrawResult<()> {
                 hi = (hi.ln() + (hi.ln() - lo.ln()) * (h + 0.04) / (1.0 - h - 0.04)).exp();
                 legend = legend_corner(panel, x_range, (lo.ln(), hi.ln())).0;
             }
-            draw_panel(area, x_range, (lo..hi).log_scale(), legend, &fig.x_desc, panel)?;
+            draw_panel(area, x_range, (lo..hi).log_scale(), legend, false, &fig.x_desc, panel)?;
         } else {
             let (mut legend, hidden) = legend_corner(panel, x_range, (lo, hi));
             if hidden > 0 && panel.legend {
@@ -252,7 +296,7 @@ fn draw(path: &Path, fig: &Figure) -> DrawResult<()> {
                 hi += (hi - lo) * (h + 0.04) / (1.0 - h - 0.04);
                 legend = legend_corner(panel, x_range, (lo, hi)).0;
             }
-            draw_panel(area, x_range, lo..hi, legend, &fig.x_desc, panel)?;
+            draw_panel(area, x_range, lo..hi, legend, lo < 0.0 && hi > 0.0, &fig.x_desc, panel)?;
         }
     }
     root.present()?;

@@ -169,3 +169,20 @@ fn a_file_that_is_not_svg_is_refused_naming_plot() {
     assert!(out.is_empty(), "{out}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_long_run_makes_a_small_figure_that_keeps_its_peak() {
+    let dir = temp_dir("long");
+    let file = dir.join("long.svg");
+    let args = [
+        "step", "--params", P, "--from", "40", "--to", "50", "--dt", "0.0001", "--t-end", "2", "--plot",
+    ];
+    let mut with_plot = args.to_vec();
+    with_plot.push(file.to_str().unwrap());
+    let (code, out, err) = run_cli(&with_plot);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(out.lines().count(), 20_002);
+    let size = std::fs::metadata(&file).unwrap().len();
+    assert!(size < 300_000, "{size} bytes for 20,001 samples");
+    let _ = std::fs::remove_dir_all(&dir);
+}
