@@ -7,6 +7,7 @@
 //!   paper report, with the paper's tables in [`paper::tables`]);
 //! * their plumbing: [`error`] (a command's failure and exit status,
 //!   parameter loading), [`temps`] (temperature lists), [`csv`] (output),
+//!   [`plot`] (`--plot FILE.svg`: a command's output as a figure),
 //!   [`lsq`] (the least-squares solver of the calibration).
 //!
 //! Each command is a function returning its complete standard output; the
