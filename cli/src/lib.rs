@@ -6,7 +6,8 @@
 //!   (compensation, size), [`calibration`] (calibrate) and [`paper`] (the
 //!   paper report, with the paper's tables in [`paper::tables`]);
 //! * their plumbing: [`error`] (a command's failure and exit status,
-//!   parameter loading), [`temps`] (temperature lists), [`csv`] (output),
+//!   parameter loading), [`input`] (bounded reading of a parameter file,
+//!   the built-in presets and paper data), [`temps`] (temperature lists), [`csv`] (output),
 //!   [`plot`] (`--plot FILE.svg`: a command's output as a figure),
 //!   [`lsq`] (the least-squares solver of the calibration).
 //!
@@ -18,6 +19,7 @@ pub mod calibration;
 pub mod csv;
 pub mod dynamics;
 pub mod error;
+pub mod input;
 pub mod lsq;
 pub mod paper;
 pub mod plot;

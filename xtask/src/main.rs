@@ -436,16 +436,17 @@ fn cmd_test(bless: bool) -> Outcome {
         .ok_or("no soak image")?
         .1;
     let started = std::time::Instant::now();
-    let run = qemu::run(soak, qemu::NETDUINO, false, minutes(3), qemu::Show::Quiet)?;
-    if run.code != 0 {
-        for l in &run.lines {
+    let soak_run = qemu::run(soak, qemu::NETDUINO, false, minutes(3), qemu::Show::Quiet)?;
+    if soak_run.code != 0 {
+        for l in &soak_run.lines {
             eprintln!("{l}");
         }
-        return Err(format!("the soak exited with {} (124: past its deadline)", run.code).into());
+        return Err(format!("the soak exited with {} (124: past its deadline)", soak_run.code).into());
     }
     eprintln!(
         "xtask: {} ({:.0} s)",
-        run.lines
+        soak_run
+            .lines
             .iter()
             .rev()
             .find(|l| l.contains("soak:"))
