@@ -8,6 +8,7 @@
 //! * their plumbing: [`error`] (a command's failure and exit status,
 //!   parameter loading), [`input`] (bounded reading of a parameter file,
 //!   the built-in presets and paper data), [`temps`] (temperature lists), [`csv`] (output),
+//!   [`plot`] (`--plot FILE.svg`: a command's output as a figure),
 //!   [`lsq`] (the least-squares solver of the calibration).
 //!
 //! Each command is a function returning its complete standard output; the
@@ -21,6 +22,7 @@ pub mod error;
 pub mod input;
 pub mod lsq;
 pub mod paper;
+pub mod plot;
 pub mod sizing;
 pub mod statics;
 pub mod temps;

@@ -8,7 +8,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use compensator::dynamics::Scheme;
 use compensator_cli::csv::Format;
 use compensator_cli::error::CliError;
-use compensator_cli::{calibration, paper, sizing, statics};
+use compensator_cli::{calibration, paper, plot, sizing, statics};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -150,6 +150,9 @@ enum Command {
         /// Scalar type of the computation.
         #[arg(long, value_enum, default_value = "f64")]
         precision: StaticPrecision,
+        /// Also draw the output as a figure (SVG; docs/plots.md).
+        #[arg(long, value_name = "FILE.svg", value_parser = plot::parse_path)]
+        plot: Option<PathBuf>,
     },
     /// Asymptotic displacement (Eqs. 16-21) beside the quasi-static one.
     #[command(after_long_help = ASYMPTOTIC_HELP)]
@@ -169,6 +172,9 @@ enum Command {
         /// Temperatures [C]: start:end:step or a comma list.
         #[arg(long, default_value = "30:80:10", allow_hyphen_values = true)]
         temps: String,
+        /// Also draw the output as a figure (SVG; docs/plots.md).
+        #[arg(long, value_name = "FILE.svg", value_parser = plot::parse_path)]
+        plot: Option<PathBuf>,
     },
     /// Temperature sensitivities (Eqs. 30-31) and the Eq. (32) verdict.
     #[command(after_long_help = SENSITIVITY_HELP)]
@@ -216,6 +222,12 @@ enum Command {
         /// Steps per tick, overriding the chosen number (alone: with sdirk3).
         #[arg(long)]
         substeps: Option<u8>,
+        /// Also draw the output as a figure (SVG; docs/plots.md).
+        #[arg(long, value_name = "FILE.svg", value_parser = plot::parse_path)]
+        plot: Option<PathBuf>,
+        /// With --plot: also run the reference solver and draw it dashed over the twin.
+        #[arg(long)]
+        overlay_reference: bool,
     },
     /// The twin's scheme and substeps per tick chosen for a file (CSV).
     ///
@@ -240,6 +252,9 @@ enum Command {
         /// Temperatures [C]: start:end:step or a comma list.
         #[arg(long, default_value = "30:80:10", allow_hyphen_values = true)]
         temps: String,
+        /// Also draw the output as a figure (SVG; docs/plots.md).
+        #[arg(long, value_name = "FILE.svg", value_parser = plot::parse_path)]
+        plot: Option<PathBuf>,
     },
     /// Step-response indicators of Table 3 (reference solver).
     #[command(after_long_help = INDICATORS_HELP)]
@@ -266,6 +281,9 @@ enum Command {
         /// Temperatures [C]: start:end:step or a comma list.
         #[arg(long, default_value = "30:80:10", allow_hyphen_values = true)]
         temps: String,
+        /// Also draw the output as a figure (SVG; docs/plots.md).
+        #[arg(long, value_name = "FILE.svg", value_parser = plot::parse_path)]
+        plot: Option<PathBuf>,
     },
     /// Design sizing: the machine a compensator serves best (`machine`), or
     /// the window diameter a machine needs (`slot`); prints TOML.
@@ -346,25 +364,48 @@ fn write_output(out: &str, path: Option<&Path>) -> Result<(), CliError> {
     }
 }
 
+/// Draws `fig` (built from a command's CSV output `out`) to `path` if
+/// given, and passes `out` on.
+fn plotted(
+    out: String,
+    path: Option<PathBuf>,
+    fig: impl FnOnce(&str) -> Result<plot::Figure, CliError>,
+) -> Result<String, CliError> {
+    if let Some(path) = path {
+        plot::write(&path, &fig(&out)?)?;
+    }
+    Ok(out)
+}
+
 fn run_command(command: Command) -> Result<String, CliError> {
     match command {
         Command::Equilibrium {
             params,
             temps,
             precision,
-        } => statics::equilibrium(&params, &temps, precision == StaticPrecision::F32),
+            plot: figure,
+        } => plotted(
+            statics::equilibrium(&params, &temps, precision == StaticPrecision::F32)?,
+            figure,
+            plot::equilibrium,
+        ),
         Command::Asymptotic {
             params,
             order,
             reading,
             t0,
             temps,
+            plot: figure,
         } => {
             let reading = match reading {
                 ReadingArg::Temperature => compensator::asymptotic::Reading::Temperature,
                 ReadingArg::Property => compensator::asymptotic::Reading::Property,
             };
-            statics::asymptotic(&params, order as usize, reading, &t0, &temps)
+            plotted(
+                statics::asymptotic(&params, order as usize, reading, &t0, &temps)?,
+                figure,
+                |csv| plot::asymptotic(csv, order as usize),
+            )
         }
         Command::Sensitivity { params, temps } => statics::sensitivity(&params, &temps),
         Command::Step {
@@ -378,21 +419,70 @@ fn run_command(command: Command) -> Result<String, CliError> {
             precision,
             scheme,
             substeps,
+            plot: figure,
+            overlay_reference,
         } => {
+            use compensator_cli::dynamics::{Precision, every_nth_row, step};
+            if overlay_reference && figure.is_none() {
+                return Err(CliError::Input(
+                    "--overlay-reference: draws over a figure; give --plot FILE.svg".into(),
+                ));
+            }
+            if overlay_reference && precision == Precision::Reference {
+                return Err(CliError::Input(
+                    "--overlay-reference: the run is the reference already (--precision reference)".into(),
+                ));
+            }
             let every = compensator_cli::dynamics::sample_every(sample, dt)?;
-            let out = compensator_cli::dynamics::step(&params, from, to, ramp, dt, t_end, precision, scheme, substeps)?;
+            let out = step(&params, from, to, ramp, dt, t_end, precision, scheme, substeps)?;
             let _ = writeln!(std::io::stderr(), "{}", out.note);
-            Ok(compensator_cli::dynamics::every_nth_row(&out.csv, every))
+            let csv = every_nth_row(&out.csv, every);
+            if let Some(path) = figure {
+                let name = match precision {
+                    Precision::Reference => "reference (Radau5)".to_string(),
+                    Precision::Reduced => "reduced model".to_string(),
+                    p => format!(
+                        "twin, {}",
+                        p.to_possible_value().map_or("?".into(), |v| v.get_name().to_string())
+                    ),
+                };
+                let reference = if overlay_reference {
+                    let r = step(&params, from, to, ramp, dt, t_end, Precision::Reference, None, None)?;
+                    Some(every_nth_row(&r.csv, every))
+                } else {
+                    None
+                };
+                let title = match ramp {
+                    None => format!("Step {from} C to {to} C"),
+                    Some(r) => format!("Ramp {from} C to {to} C at {r} C/s"),
+                };
+                let fig = plot::step(
+                    &csv,
+                    &name,
+                    reference.as_deref().map(|r| (r, "reference (Radau5)")),
+                    &title,
+                )?;
+                plot::write(&path, &fig)?;
+            }
+            Ok(csv)
         }
         Command::TwinConfig { params, dt } => compensator_cli::dynamics::twin_config(&params, dt),
-        Command::Eigen { params, temps } => compensator_cli::dynamics::eigen(&params, &temps),
+        Command::Eigen {
+            params,
+            temps,
+            plot: figure,
+        } => plotted(compensator_cli::dynamics::eigen(&params, &temps)?, figure, plot::eigen),
         Command::Indicators {
             params,
             steps,
             dt,
             t_end,
         } => compensator_cli::dynamics::indicators(&params, &steps, dt, t_end),
-        Command::Compensation { params, temps } => sizing::compensation_table(&params, &temps),
+        Command::Compensation {
+            params,
+            temps,
+            plot: figure,
+        } => plotted(sizing::compensation_table(&params, &temps)?, figure, plot::compensation),
         Command::Size {
             params,
             what,
