@@ -392,11 +392,13 @@ impl<T: Real> Coefficients<T> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::throttle::regularised_root;
 
-    fn coefficients() -> Coefficients<f64> {
+    /// A paper-like coefficient set for unit tests (`u_tr` is the
+    /// regularised law's transition: zero for the plain root).
+    pub(crate) fn coefficients_with(u_tr: f64) -> Coefficients<f64> {
         Coefficients {
             a_x: 0.062,
             inv_a_x: 1.0 / 0.062,
@@ -410,11 +412,15 @@ mod tests {
             inv_omega_b0: 1.0 / 13.4,
             eps_b: 0.059,
             sigma: 1.02,
-            u_tr: 0.0,
+            u_tr,
             q_t: 1.02,
             g_l: 1.4,
             flow_shift: 0,
         }
+    }
+
+    fn coefficients() -> Coefficients<f64> {
+        coefficients_with(0.0)
     }
 
     #[test]

@@ -286,24 +286,7 @@ mod tests {
     use crate::dynamics::schemes::dense_linearisation;
 
     fn coefficients() -> Coefficients<f64> {
-        Coefficients {
-            a_x: 0.062,
-            inv_a_x: 1.0 / 0.062,
-            phi_over_a_x: 13.5,
-            two_zeta: 0.09,
-            xi0: 0.007,
-            omega_a0: 13.4,
-            inv_omega_a0: 1.0 / 13.4,
-            eps_a: 0.059,
-            omega_b0: 13.4,
-            inv_omega_b0: 1.0 / 13.4,
-            eps_b: 0.059,
-            sigma: 1.02,
-            u_tr: 1e-5,
-            q_t: 1.02,
-            g_l: 1.4,
-            flow_shift: 0,
-        }
+        crate::dynamics::coefficients::tests::coefficients_with(1e-5)
     }
 
     #[test]
