@@ -26,7 +26,6 @@
 mod harness;
 
 use compensator::Params;
-use compensator::estimator::EstimatorConfig;
 use compensator::sensor::max31865::Settings;
 use compensator_firmware::qemu::exit;
 use cortex_m as _; // links the critical-section implementation defmt needs
@@ -65,17 +64,7 @@ fn main() -> ! {
             exit(false)
         }
     };
-    let mut config = match EstimatorConfig::new(&RAW_PARAMS.estimator) {
-        Ok(c) => c,
-        Err(e) => {
-            error!("estimator settings rejected: {=str}", e.field);
-            exit(false)
-        }
-    };
-    if let Err(what) = compensator_firmware::use_built_twin(&mut config, TWIN_SCHEME, TWIN_SUBSTEPS) {
-        error!("twin configuration: {=str}", what);
-        exit(false)
-    }
+    let config = compensator_firmware::qemu::built_estimator_config(&RAW_PARAMS.estimator, TWIN_SCHEME, TWIN_SUBSTEPS);
     let settings = Settings::from_params(&RAW_PARAMS.estimator);
     let mut soak = match Soak::new(&params, &params64, config, &settings, SEED) {
         Ok(s) => s,
