@@ -22,7 +22,8 @@ use std::path::{Path, PathBuf};
 /// One curve of a panel.
 #[derive(Clone, Debug)]
 pub struct Series {
-    /// Legend text.
+    /// Legend text (empty: no legend entry, e.g. the second of two
+    /// series that share one).
     pub label: String,
     /// Points (x, y); non-finite ones are skipped.
     pub points: Vec<(f64, f64)>,
@@ -125,9 +126,28 @@ const COLORS: [RGBColor; 6] = [
     RGBColor(23, 190, 207),
 ];
 
-/// Width of the figure [px]; each panel is `PANEL_HEIGHT` high.
+/// Width of the figure [px]; each panel is `PANEL_HEIGHT` high (a figure
+/// of one panel `SINGLE_PANEL_HEIGHT`).
 const WIDTH: u32 = 900;
 const PANEL_HEIGHT: u32 = 300;
+const SINGLE_PANEL_HEIGHT: u32 = 460;
+
+/// Height of a panel of `fig` [px].
+fn panel_height(fig: &Figure) -> u32 {
+    if fig.panels.len() == 1 {
+        SINGLE_PANEL_HEIGHT
+    } else {
+        PANEL_HEIGHT
+    }
+}
+
+/// The legend's height as a fraction of a panel's plotting area `height`
+/// [px] high: about 23 px a labelled series and a margin.
+fn legend_height(panel: &Panel, height: u32) -> f64 {
+    let lines = panel.series.iter().filter(|s| !s.label.is_empty()).count() as f64;
+    let per_line = 23.0 / (height as f64 - 70.0).max(100.0);
+    0.06 + per_line * lines
+}
 
 fn finite(points: &[(f64, f64)], log_y: bool) -> Vec<(f64, f64)> {
     points
@@ -196,8 +216,7 @@ fn padded(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
 
 /// The corner of the panel where the legend hides the fewest points (in
 /// the panel's fractions: the legend is about 40 % wide, 10 % high per line).
-fn legend_corner(panel: &Panel, x: (f64, f64), y: (f64, f64)) -> (SeriesLabelPosition, usize) {
-    let h = 0.06 + 0.1 * panel.series.len() as f64;
+fn legend_corner(panel: &Panel, h: f64, x: (f64, f64), y: (f64, f64)) -> (SeriesLabelPosition, usize) {
     let fy = |v: f64| if panel.log_y { v.ln() } else { v };
     let corners = [
         (SeriesLabelPosition::UpperRight, 0.6, 1.0 - h),
@@ -288,11 +307,15 @@ where
         let style = color.stroke_width(2);
         let points = thin(finite(&s.points, panel.log_y));
         if !s.line {
-            chart
-                .draw_series(points.iter().map(|&p| Circle::new(p, 4, color.stroke_width(2))))?
-                .label(s.label.as_str())
-                .legend(move |(x, y)| Circle::new((x + 10, y), 4, color.stroke_width(2)));
+            let anno = chart.draw_series(points.iter().map(|&p| Circle::new(p, 4, color.stroke_width(2))))?;
+            if !s.label.is_empty() {
+                anno.label(s.label.as_str())
+                    .legend(move |(x, y)| Circle::new((x + 10, y), 4, color.stroke_width(2)));
+            }
             continue;
+        }
+        if s.marks {
+            chart.draw_series(points.iter().map(|&p| Circle::new(p, 3, color.filled())))?;
         }
         let anno = if s.dashed {
             chart.draw_series(DashedLineSeries::new(points.clone(), 8, 5, style))?
@@ -300,6 +323,9 @@ where
             chart.draw_series(LineSeries::new(points.clone(), style))?
         };
         let dashed = s.dashed;
+        if s.label.is_empty() {
+            continue;
+        }
         anno.label(s.label.as_str()).legend(move |(x, y)| {
             if dashed {
                 PathElement::new(vec![(x, y), (x + 8, y)], style)
@@ -307,9 +333,6 @@ where
                 PathElement::new(vec![(x, y), (x + 20, y)], style)
             }
         });
-        if s.marks {
-            chart.draw_series(points.iter().map(|&p| Circle::new(p, 3, color.filled())))?;
-        }
     }
     if !panel.legend {
         return Ok(());
@@ -327,7 +350,7 @@ where
 /// Size of `fig` in pixels.
 fn size(fig: &Figure) -> (u32, u32) {
     let n = fig.panels.len().max(1) as u32;
-    (WIDTH, n * PANEL_HEIGHT + 40)
+    (WIDTH, n * panel_height(fig) + 40)
 }
 
 /// Registers DejaVu Sans (built in) as the `sans-serif` family for the
@@ -382,21 +405,22 @@ where
                 .map(|p| p.1)
         };
         let (lo, mut hi) = padded(ys(), panel.log_y);
+        let h = legend_height(panel, panel_height(fig));
         if panel.log_y {
-            let (mut legend, hidden) = legend_corner(panel, x_range, (lo.ln(), hi.ln()));
+            let (mut legend, hidden) = legend_corner(panel, h, x_range, (lo.ln(), hi.ln()));
             if hidden > 0 && panel.legend {
-                let h = (0.06 + 0.1 * panel.series.len() as f64).min(0.6);
+                let h = h.min(0.6);
                 hi = (hi.ln() + (hi.ln() - lo.ln()) * (h + 0.04) / (1.0 - h - 0.04)).exp();
-                legend = legend_corner(panel, x_range, (lo.ln(), hi.ln())).0;
+                legend = legend_corner(panel, h, x_range, (lo.ln(), hi.ln())).0;
             }
             draw_panel(area, x_range, (lo..hi).log_scale(), legend, false, &fig.x_desc, panel)?;
         } else {
-            let (mut legend, hidden) = legend_corner(panel, x_range, (lo, hi));
+            let (mut legend, hidden) = legend_corner(panel, h, x_range, (lo, hi));
             if hidden > 0 && panel.legend {
                 // No free corner: headroom over the data for the legend.
-                let h = (0.06 + 0.1 * panel.series.len() as f64).min(0.6);
+                let h = h.min(0.6);
                 hi += (hi - lo) * (h + 0.04) / (1.0 - h - 0.04);
-                legend = legend_corner(panel, x_range, (lo, hi)).0;
+                legend = legend_corner(panel, h, x_range, (lo, hi)).0;
             }
             draw_panel(area, x_range, lo..hi, legend, lo < 0.0 && hi > 0.0, &fig.x_desc, panel)?;
         }

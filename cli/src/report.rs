@@ -125,8 +125,8 @@ fn sig(v: f64) -> String {
     if !v.is_finite() {
         return "-".into();
     }
-    if v == 0.0 {
-        return "0".into();
+    if v.fract() == 0.0 && v.abs() < 1e6 {
+        return format!("{v:.0}");
     }
     let mag = v.abs().log10().floor() as i32;
     if !(-3..6).contains(&mag) {
@@ -298,9 +298,11 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
         line.color = Some(j);
         fig2.push(line);
     }
-    for (j, &dp) in t1.drops_bar.iter().enumerate() {
+    for j in 0..t1.drops_bar.len() {
         let pts = t1.temps.iter().enumerate().map(|(i, &t)| (t, pr.apply(t1.values[i][j] * BAR)));
-        let mut s = Series::points(format!("paper Table 1, {dp} bar"), pts.collect());
+        // One legend entry for the three drops' points (colours as the lines).
+        let label = if j == 0 { "paper Table 1 (circles)".to_string() } else { String::new() };
+        let mut s = Series::points(label, pts.collect());
         s.color = Some(j);
         fig2.push(s);
     }
