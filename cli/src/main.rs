@@ -181,7 +181,8 @@ Output: the completion script for the shell, on stdout.
 Example:
   compensator completions bash > /etc/bash_completion.d/compensator";
 const MAN_HELP: &str = "\
-Output: the man page compensator(1) in roff, on stdout.
+Output: the man page compensator(1) in roff, on stdout; with --dir, the
+files compensator.1 and compensator-<command>.1 (one per subcommand).
 
 Example:
   compensator man > compensator.1 && man ./compensator.1";
@@ -426,9 +427,13 @@ enum Command {
         #[arg(value_enum)]
         shell: clap_complete::Shell,
     },
-    /// The man page compensator(1) (roff).
+    /// The man page compensator(1) (roff), or with --dir one page per subcommand.
     #[command(after_long_help = MAN_HELP)]
-    Man,
+    Man {
+        /// Write compensator.1 and compensator-<command>.1 into DIR instead of printing compensator(1).
+        #[arg(long, value_name = "DIR")]
+        dir: Option<PathBuf>,
+    },
 }
 
 /// A command's output in the chosen format and units, and its rows that
@@ -443,7 +448,7 @@ fn run(cli: Cli) -> Result<(String, (usize, usize)), CliError> {
             | Command::Paper { .. }
             | Command::Report { .. }
             | Command::Completions { .. }
-            | Command::Man
+            | Command::Man { .. }
     );
     if !tabular && cli.format != Format::Csv {
         return Err(CliError::Input(
@@ -638,7 +643,13 @@ fn run_command(command: Command, units: Units) -> Result<String, CliError> {
             clap_complete::generate(shell, &mut Cli::command(), "compensator", &mut buf);
             String::from_utf8(buf).map_err(|e| CliError::Failed(format!("completions: {e}")))
         }
-        Command::Man => {
+        Command::Man { dir: Some(dir) } => {
+            std::fs::create_dir_all(&dir)
+                .and_then(|()| clap_mangen::generate_to(Cli::command().name("compensator"), &dir))
+                .map_err(|e| CliError::Input(format!("--dir: {}: {e}", dir.display())))?;
+            Ok(String::new())
+        }
+        Command::Man { dir: None } => {
             let mut buf = Vec::new();
             clap_mangen::Man::new(Cli::command())
                 .render(&mut buf)
