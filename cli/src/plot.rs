@@ -240,23 +240,28 @@ fn legend_corner(panel: &Panel, h: f64, x: (f64, f64), y: (f64, f64)) -> (Series
     (best.0.clone(), hidden(best))
 }
 
-/// A tick label: integers without a fraction, others to six decimals at
-/// most, large magnitudes in scientific notation.
-fn tick(v: &f64) -> String {
-    let v = *v;
-    if v == 0.0 {
-        "0".into()
-    } else if v.abs() >= 1e6 || v.abs() < 1e-4 {
-        // Up to three significant digits, trailing zeros dropped: 1.5e-5,
-        // not 2e-5.
+/// A tick label on an axis spanning `[lo, hi]`: zero as `0` (a tick
+/// computed as a multiple of the step lands a rounding error away from
+/// it); on an axis whose largest magnitude is below 1e-3 or from 1e6 on,
+/// every tick in scientific notation with up to three significant digits
+/// (1.5e-5, not 2e-5); otherwise integers without a fraction and other
+/// values to six decimals at most.
+fn tick(v: f64, lo: f64, hi: f64) -> String {
+    let span = (hi - lo).abs();
+    if v == 0.0 || v.abs() <= 1e-9 * span {
+        return "0".into();
+    }
+    let mag = lo.abs().max(hi.abs());
+    if !(1e-3..1e6).contains(&mag) {
         let s = format!("{v:.2e}");
-        match s.split_once('e') {
+        return match s.split_once('e') {
             Some((m, e)) if m.contains('.') => {
                 format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.'))
             }
             _ => s,
-        }
-    } else if v.fract() == 0.0 {
+        };
+    }
+    if v.fract() == 0.0 {
         format!("{v:.0}")
     } else {
         format!("{}", (v * 1e6).round() / 1e6)
@@ -269,6 +274,7 @@ fn draw_panel<DB: DrawingBackend, Y>(
     area: &DrawingArea<DB, Shift>,
     x_range: (f64, f64),
     y_range: Y,
+    y_bounds: (f64, f64),
     legend: SeriesLabelPosition,
     zero_inside: bool,
     x_desc: &str,
@@ -286,8 +292,8 @@ where
         .build_cartesian_2d(x_range.0..x_range.1, y_range)?;
     chart
         .configure_mesh()
-        .x_label_formatter(&tick)
-        .y_label_formatter(&tick)
+        .x_label_formatter(&|v: &f64| tick(*v, x_range.0, x_range.1))
+        .y_label_formatter(&|v: &f64| tick(*v, y_bounds.0, y_bounds.1))
         .x_desc(x_desc)
         .y_desc(panel.y_desc.as_str())
         .axis_desc_style(("sans-serif", 16))
@@ -413,7 +419,7 @@ where
                 hi = (hi.ln() + (hi.ln() - lo.ln()) * (h + 0.04) / (1.0 - h - 0.04)).exp();
                 legend = legend_corner(panel, h, x_range, (lo.ln(), hi.ln())).0;
             }
-            draw_panel(area, x_range, (lo..hi).log_scale(), legend, false, &fig.x_desc, panel)?;
+            draw_panel(area, x_range, (lo..hi).log_scale(), (lo, hi), legend, false, &fig.x_desc, panel)?;
         } else {
             let (mut legend, hidden) = legend_corner(panel, h, x_range, (lo, hi));
             if hidden > 0 && panel.legend {
@@ -422,7 +428,7 @@ where
                 hi += (hi - lo) * (h + 0.04) / (1.0 - h - 0.04);
                 legend = legend_corner(panel, h, x_range, (lo, hi)).0;
             }
-            draw_panel(area, x_range, lo..hi, legend, lo < 0.0 && hi > 0.0, &fig.x_desc, panel)?;
+            draw_panel(area, x_range, lo..hi, (lo, hi), legend, lo < 0.0 && hi > 0.0, &fig.x_desc, panel)?;
         }
     }
     root.present()?;
@@ -668,4 +674,25 @@ pub fn compensation(csv: &str, u: Units) -> Result<Figure, CliError> {
             panel(&desc("x", len), vec![c.series("t_c", "x_m", len, "spool displacement x")?, required]),
         ],
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::tick;
+
+    #[test]
+    fn tick_labels_read_as_their_axis() {
+        // A rounding error at zero is zero.
+        assert_eq!(tick(-3.39e-21, -2.5e-5, 1.7e-5), "0");
+        // One notation per axis: small quantities in scientific notation,
+        // three significant digits.
+        assert_eq!(tick(-1.5e-5, -2.5e-5, 1.7e-5), "-1.5e-5");
+        assert_eq!(tick(1.0e-4, 0.0, 1.5e-4), "1e-4");
+        assert_eq!(tick(1.25e-4, 0.0, 1.5e-4), "1.25e-4");
+        assert_eq!(tick(2.0e6, 0.0, 4.5e6), "2e6");
+        // Ordinary magnitudes in decimals.
+        assert_eq!(tick(0.0005, 0.0, 0.001), "0.0005");
+        assert_eq!(tick(40.0, 26.0, 80.0), "40");
+        assert_eq!(tick(2.5, 0.0, 5.0), "2.5");
+    }
 }
