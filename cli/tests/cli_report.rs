@@ -24,8 +24,9 @@ fn plot_png_writes_a_bitmap_and_leaves_the_csv() {
     let bytes = std::fs::read(&file).unwrap();
     // Three panels of 300 px under a 40 px title, 900 px wide.
     assert_eq!(png_size(&bytes), Some((900, 940)));
-    // Text and curves make a compressed bitmap far larger than a blank one.
-    assert!(bytes.len() > 30_000, "{} bytes", bytes.len());
+    // Text and curves make a compressed bitmap far larger than a blank one
+    // (a few kB).
+    assert!(bytes.len() > 15_000, "{} bytes", bytes.len());
     // Upper-case extension too; the step figure with its overlay.
     let file = dir.join("STEP.PNG");
     let (code, _, err) = run(&[
