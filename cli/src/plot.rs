@@ -276,7 +276,6 @@ fn draw_panel<DB: DrawingBackend, Y>(
     y_range: Y,
     y_bounds: (f64, f64),
     legend: SeriesLabelPosition,
-    zero_inside: bool,
     x_desc: &str,
     panel: &Panel,
 ) -> DrawResult<()>
@@ -301,7 +300,8 @@ where
         .light_line_style(WHITE.mix(0.0))
         .bold_line_style(BLACK.mix(0.12))
         .draw()?;
-    if !panel.log_y && zero_inside {
+    // A zero line where a linear panel spans 0.
+    if !panel.log_y && y_bounds.0 < 0.0 && y_bounds.1 > 0.0 {
         let (x0, x1) = x_range;
         chart.draw_series(std::iter::once(PathElement::new(
             vec![(x0, 0.0), (x1, 0.0)],
@@ -435,7 +435,15 @@ where
                 hi = (hi.ln() + (hi.ln() - lo.ln()) * (h + 0.04) / (1.0 - h - 0.04)).exp();
                 legend = legend_corner(panel, h, x_range, (lo.ln(), hi.ln())).0;
             }
-            draw_panel(area, x_range, (lo..hi).log_scale(), (lo, hi), legend, false, &fig.x_desc, panel)?;
+            draw_panel(
+                area,
+                x_range,
+                (lo..hi).log_scale(),
+                (lo, hi),
+                legend,
+                &fig.x_desc,
+                panel,
+            )?;
         } else {
             let (mut legend, hidden) = legend_corner(panel, h, x_range, (lo, hi));
             if hidden > 0 && panel.legend {
@@ -444,7 +452,7 @@ where
                 hi += (hi - lo) * (h + 0.04) / (1.0 - h - 0.04);
                 legend = legend_corner(panel, h, x_range, (lo, hi)).0;
             }
-            draw_panel(area, x_range, lo..hi, (lo, hi), legend, lo < 0.0 && hi > 0.0, &fig.x_desc, panel)?;
+            draw_panel(area, x_range, lo..hi, (lo, hi), legend, &fig.x_desc, panel)?;
         }
     }
     root.present()?;
@@ -551,7 +559,10 @@ pub fn equilibrium(csv: &str, u: Units) -> Result<Figure, CliError> {
         title: "Quasi-static equilibrium".into(),
         x_desc: TEMPERATURE.into(),
         panels: vec![
-            panel(&desc("x", len), vec![c.series("t_c", "x_m", len, "spool displacement x")?]),
+            panel(
+                &desc("x", len),
+                vec![c.series("t_c", "x_m", len, "spool displacement x")?],
+            ),
             panel(
                 &desc("p", pr),
                 vec![
@@ -598,7 +609,10 @@ pub fn asymptotic(csv: &str, order: usize, u: Units) -> Result<Figure, CliError>
     Ok(Figure {
         title: format!("Asymptotic displacement (order {order}) and the quasi-static one"),
         x_desc: TEMPERATURE.into(),
-        panels: vec![panel(&desc("x", len), vec![qs, asym]), panel(&desc("error", small), vec![diff])],
+        panels: vec![
+            panel(&desc("x", len), vec![qs, asym]),
+            panel(&desc("error", small), vec![diff]),
+        ],
     })
 }
 
@@ -682,12 +696,18 @@ pub fn compensation(csv: &str, u: Units) -> Result<Figure, CliError> {
         title: "Compensation: flow supplied against the machine's demand".into(),
         x_desc: TEMPERATURE.into(),
         panels: vec![
-            panel(&desc("Q", q), vec![c.series("t_c", "supply_m3s", q, "supply (total flow)")?, demand]),
+            panel(
+                &desc("Q", q),
+                vec![c.series("t_c", "supply_m3s", q, "supply (total flow)")?, demand],
+            ),
             panel(
                 &desc("error", q),
                 vec![c.series("t_c", "error_m3s", q, "supply minus demand")?],
             ),
-            panel(&desc("x", len), vec![c.series("t_c", "x_m", len, "spool displacement x")?, required]),
+            panel(
+                &desc("x", len),
+                vec![c.series("t_c", "x_m", len, "spool displacement x")?, required],
+            ),
         ],
     })
 }

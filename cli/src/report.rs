@@ -154,9 +154,12 @@ fn write_file(path: &Path, text: &str) -> Result<(), CliError> {
     std::fs::write(path, text).map_err(|e| CliError::Input(format!("--out: {}: {e}", path.display())))
 }
 
+/// A sampled response: times [s] and displacements [m].
+type Run = (Vec<f64>, Vec<f64>);
+
 /// The steps' responses x(t) from the reference solver (Radau5), sampled
 /// every `STEP_DT` over `STEP_T_END`: (times [s], x [m]) per step.
-fn responses(raw: &RawParams, steps: &[(f64, f64)]) -> Result<Vec<(Vec<f64>, Vec<f64>)>, CliError> {
+fn responses(raw: &RawParams, steps: &[(f64, f64)]) -> Result<Vec<Run>, CliError> {
     let n = (STEP_T_END / STEP_DT).round() as usize;
     steps
         .par_iter()
@@ -178,8 +181,7 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
     let (raw, p) = load(opts.params)?;
     let (t1, t2) = load_tables(opts.data).map_err(CliError::Input)?;
     let t3 = Table3::load(opts.data).map_err(CliError::Input)?;
-    std::fs::create_dir_all(opts.out)
-        .map_err(|e| CliError::Input(format!("--out: {}: {e}", opts.out.display())))?;
+    std::fs::create_dir_all(opts.out).map_err(|e| CliError::Input(format!("--out: {}: {e}", opts.out.display())))?;
     let mut written: Vec<PathBuf> = Vec::new();
     let shown = opts
         .params
@@ -196,7 +198,10 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
             if r.is_finite() {
                 table1.row(&[t, dp * BAR, paper * BAR, (paper + r) * BAR, r * BAR]);
             } else {
-                table1.row_error(&[t, dp * BAR, paper * BAR], "the model cannot evaluate this temperature");
+                table1.row_error(
+                    &[t, dp * BAR, paper * BAR],
+                    "the model cannot evaluate this temperature",
+                );
             }
         }
     }
@@ -273,7 +278,11 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
         }
     }
     let table3 = u.convert_csv(table3.as_str());
-    for (name, text) in [("table1.csv", &table1), ("table2.csv", &table2), ("table3.csv", &table3)] {
+    for (name, text) in [
+        ("table1.csv", &table1),
+        ("table2.csv", &table2),
+        ("table3.csv", &table3),
+    ] {
         let path = opts.out.join(name);
         write_file(&path, text)?;
         written.push(path);
@@ -299,9 +308,17 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
         fig2.push(line);
     }
     for j in 0..t1.drops_bar.len() {
-        let pts = t1.temps.iter().enumerate().map(|(i, &t)| (t, pr.apply(t1.values[i][j] * BAR)));
+        let pts = t1
+            .temps
+            .iter()
+            .enumerate()
+            .map(|(i, &t)| (t, pr.apply(t1.values[i][j] * BAR)));
         // One legend entry for the three drops' points (colours as the lines).
-        let label = if j == 0 { "paper Table 1 (circles)".to_string() } else { String::new() };
+        let label = if j == 0 {
+            "paper Table 1 (circles)".to_string()
+        } else {
+            String::new()
+        };
         let mut s = Series::points(label, pts.collect());
         s.color = Some(j);
         fig2.push(s);
@@ -337,13 +354,21 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
     }
     let mut s = Series::points(
         "paper Table 2, quasi-static",
-        t2.temps.iter().zip(&t2.x_qs_mm).map(|(&t, &x)| (t, len.apply(x * 1e-3))).collect(),
+        t2.temps
+            .iter()
+            .zip(&t2.x_qs_mm)
+            .map(|(&t, &x)| (t, len.apply(x * 1e-3)))
+            .collect(),
     );
     s.color = Some(0);
     fig3.push(s);
     let mut s = Series::points(
         "paper Table 2, asymptotic",
-        t2.temps.iter().zip(&t2.x_asym_mm).map(|(&t, &x)| (t, len.apply(x * 1e-3))).collect(),
+        t2.temps
+            .iter()
+            .zip(&t2.x_asym_mm)
+            .map(|(&t, &x)| (t, len.apply(x * 1e-3)))
+            .collect(),
     );
     s.color = Some(1);
     fig3.push(s);
@@ -453,7 +478,8 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
         md,
         "Parameters: {shown}. Tables in {units_note}; each model value beside the paper's. \
          Regenerate with `compensator report --out DIR{}{}`.\n",
-        opts.params.map_or(String::new(), |p| format!(" --params {}", p.display())),
+        opts.params
+            .map_or(String::new(), |p| format!(" --params {}", p.display())),
         match (u, opts.png) {
             (Units::Eng, true) => " --units eng --png",
             (Units::Eng, false) => " --units eng",
@@ -504,11 +530,7 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
     md.push_str(&markdown(&table3));
     let _ = writeln!(md, "\n## Figures\n{figure_links}");
     let findings = paper::report(opts.params, opts.data)?;
-    let _ = writeln!(
-        md,
-        "## Findings (`compensator paper`)\n\n```text\n{}```",
-        findings
-    );
+    let _ = writeln!(md, "## Findings (`compensator paper`)\n\n```text\n{}```", findings);
     let md_path = opts.out.join("report.md");
     write_file(&md_path, &md)?;
     written.insert(0, md_path);
@@ -519,4 +541,3 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
     }
     Ok(listing)
 }
-

@@ -212,26 +212,26 @@ impl Sweep {
     }
 
     /// Number of variants: the grid's points times the samples.
-    pub fn len(&self) -> Result<usize, CliError> {
+    ///
+    /// # Errors
+    ///
+    /// More than [`MAX_VARIANTS`] (bad input naming `--set/--samples`).
+    pub fn variant_count(&self) -> Result<usize, CliError> {
         let mut n = self.samples.max(1);
         for a in &self.grid {
-            n = n.checked_mul(a.values.len()).filter(|&n| n <= MAX_VARIANTS).ok_or_else(|| {
-                CliError::Input(format!("--set/--samples: more than {MAX_VARIANTS} variants"))
-            })?;
+            n = n
+                .checked_mul(a.values.len())
+                .filter(|&n| n <= MAX_VARIANTS)
+                .ok_or_else(|| CliError::Input(format!("--set/--samples: more than {MAX_VARIANTS} variants")))?;
         }
         Ok(n)
-    }
-
-    /// Whether there are no variants (never: at least the base file).
-    pub fn is_empty(&self) -> bool {
-        false
     }
 
     /// Every variant's parameter values (in [`Self::parameter_names`]
     /// order), in variant order: grid points, and for each `samples`
     /// draws from one generator seeded with `seed` (Xoshiro256++).
     pub fn variants(&self) -> Result<Vec<Vec<f64>>, CliError> {
-        let n = self.len()?;
+        let n = self.variant_count()?;
         let names = self.parameter_names();
         let samples = self.samples.max(1);
         let base_value = |name: &str| {
@@ -341,10 +341,7 @@ impl Progress {
     }
 
     fn inc(&self) {
-        if self.terminal
-            && self.start.elapsed() > Duration::from_secs(1)
-            && !self.shown.swap(true, Ordering::Relaxed)
-        {
+        if self.terminal && self.start.elapsed() > Duration::from_secs(1) && !self.shown.swap(true, Ordering::Relaxed) {
             self.bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
         }
         self.bar.inc(1);
@@ -449,7 +446,9 @@ pub fn build(
     }
     let steps = parse_steps(step_spec).map_err(|e| CliError::Input(e.to_string().replace("--steps", "--step")))?;
     let [step] = steps[..] else {
-        return Err(CliError::Input(format!("--step: '{step_spec}' is not one from:to pair")));
+        return Err(CliError::Input(format!(
+            "--step: '{step_spec}' is not one from:to pair"
+        )));
     };
     tick_count(t_end, dt)?;
     let sweep = Sweep {
@@ -458,14 +457,9 @@ pub fn build(
         vary,
         samples,
         seed,
-        metrics: Metrics {
-            temps,
-            step,
-            dt,
-            t_end,
-        },
+        metrics: Metrics { temps, step, dt, t_end },
     };
-    sweep.len()?;
+    sweep.variant_count()?;
     Ok(sweep)
 }
 

@@ -33,7 +33,11 @@ pub struct Scale {
 
 impl Scale {
     const fn si(unit: &'static str) -> Self {
-        Scale { mul: 1.0, div: 1.0, unit }
+        Scale {
+            mul: 1.0,
+            div: 1.0,
+            unit,
+        }
     }
 
     /// `v` [SI] in this unit.
@@ -47,15 +51,87 @@ impl Scale {
 /// `_m_s` before `_m`).
 const COLUMN_SUFFIXES: [(&str, &str, Scale); 9] = [
     // sqrt(Pa) -> sqrt(bar): divide by sqrt(1e5).
-    ("_sqrt_pa", "_sqrt_bar", Scale { mul: 1.0, div: 316.227_766_016_837_94, unit: "sqrt(bar)" }),
-    ("_m3s_k", "_lpm_k", Scale { mul: 6.0e4, div: 1.0, unit: "L/(min K)" }),
-    ("_m3s", "_lpm", Scale { mul: 6.0e4, div: 1.0, unit: "L/min" }),
-    ("_m2s", "_cst", Scale { mul: 1.0e6, div: 1.0, unit: "cSt" }),
-    ("_m2", "_mm2", Scale { mul: 1.0e6, div: 1.0, unit: "mm^2" }),
-    ("_m_s", "_mm_s", Scale { mul: 1.0e3, div: 1.0, unit: "mm/s" }),
-    ("_m_k", "_mm_k", Scale { mul: 1.0e3, div: 1.0, unit: "mm/K" }),
-    ("_pa", "_bar", Scale { mul: 1.0, div: 1.0e5, unit: "bar" }),
-    ("_m", "_mm", Scale { mul: 1.0e3, div: 1.0, unit: "mm" }),
+    (
+        "_sqrt_pa",
+        "_sqrt_bar",
+        Scale {
+            mul: 1.0,
+            div: 316.227_766_016_837_94,
+            unit: "sqrt(bar)",
+        },
+    ),
+    (
+        "_m3s_k",
+        "_lpm_k",
+        Scale {
+            mul: 6.0e4,
+            div: 1.0,
+            unit: "L/(min K)",
+        },
+    ),
+    (
+        "_m3s",
+        "_lpm",
+        Scale {
+            mul: 6.0e4,
+            div: 1.0,
+            unit: "L/min",
+        },
+    ),
+    (
+        "_m2s",
+        "_cst",
+        Scale {
+            mul: 1.0e6,
+            div: 1.0,
+            unit: "cSt",
+        },
+    ),
+    (
+        "_m2",
+        "_mm2",
+        Scale {
+            mul: 1.0e6,
+            div: 1.0,
+            unit: "mm^2",
+        },
+    ),
+    (
+        "_m_s",
+        "_mm_s",
+        Scale {
+            mul: 1.0e3,
+            div: 1.0,
+            unit: "mm/s",
+        },
+    ),
+    (
+        "_m_k",
+        "_mm_k",
+        Scale {
+            mul: 1.0e3,
+            div: 1.0,
+            unit: "mm/K",
+        },
+    ),
+    (
+        "_pa",
+        "_bar",
+        Scale {
+            mul: 1.0,
+            div: 1.0e5,
+            unit: "bar",
+        },
+    ),
+    (
+        "_m",
+        "_mm",
+        Scale {
+            mul: 1.0e3,
+            div: 1.0,
+            unit: "mm",
+        },
+    ),
 ];
 
 /// The engineering name and scale of an SI column, if it has a unit suffix.
@@ -72,7 +148,11 @@ impl Units {
     pub fn length(self) -> Scale {
         match self {
             Units::Si => Scale::si("m"),
-            Units::Eng => Scale { mul: 1.0e3, div: 1.0, unit: "mm" },
+            Units::Eng => Scale {
+                mul: 1.0e3,
+                div: 1.0,
+                unit: "mm",
+            },
         }
     }
 
@@ -80,7 +160,11 @@ impl Units {
     pub fn small_length(self) -> Scale {
         match self {
             Units::Si => Scale::si("m"),
-            Units::Eng => Scale { mul: 1.0e6, div: 1.0, unit: "um" },
+            Units::Eng => Scale {
+                mul: 1.0e6,
+                div: 1.0,
+                unit: "um",
+            },
         }
     }
 
@@ -88,7 +172,11 @@ impl Units {
     pub fn velocity(self) -> Scale {
         match self {
             Units::Si => Scale::si("m/s"),
-            Units::Eng => Scale { mul: 1.0e3, div: 1.0, unit: "mm/s" },
+            Units::Eng => Scale {
+                mul: 1.0e3,
+                div: 1.0,
+                unit: "mm/s",
+            },
         }
     }
 
@@ -96,7 +184,11 @@ impl Units {
     pub fn pressure(self) -> Scale {
         match self {
             Units::Si => Scale::si("Pa"),
-            Units::Eng => Scale { mul: 1.0, div: 1.0e5, unit: "bar" },
+            Units::Eng => Scale {
+                mul: 1.0,
+                div: 1.0e5,
+                unit: "bar",
+            },
         }
     }
 
@@ -104,7 +196,11 @@ impl Units {
     pub fn flow(self) -> Scale {
         match self {
             Units::Si => Scale::si("m^3/s"),
-            Units::Eng => Scale { mul: 6.0e4, div: 1.0, unit: "L/min" },
+            Units::Eng => Scale {
+                mul: 6.0e4,
+                div: 1.0,
+                unit: "L/min",
+            },
         }
     }
 
@@ -134,10 +230,12 @@ impl Units {
             let cells: Vec<String> = line
                 .split(',')
                 .enumerate()
-                .map(|(i, cell)| match (columns.get(i).and_then(|c| c.1), cell.parse::<f64>()) {
-                    (Some(scale), Ok(v)) => format!("{}", scale.apply(v)),
-                    _ => cell.to_string(),
-                })
+                .map(
+                    |(i, cell)| match (columns.get(i).and_then(|c| c.1), cell.parse::<f64>()) {
+                        (Some(scale), Ok(v)) => format!("{}", scale.apply(v)),
+                        _ => cell.to_string(),
+                    },
+                )
                 .collect();
             out.push_str(&cells.join(","));
             out.push('\n');
@@ -161,8 +259,26 @@ mod tests {
             lines.next().unwrap(),
             "t_c,a_sqrt_bar,dp_ab_bar,x_mm,v_mm_s,q_total_lpm,dq_throt_dt_lpm_k,required_area_mm2,dx_dt_mm_k,nu_cst,re_1,scheme,error"
         );
-        let row: Vec<f64> = lines.next().unwrap().split(',').take(11).map(|c| c.parse().unwrap()).collect();
-        let want = [40.0, 1e5 / 1e5f64.sqrt(), 2.5, 0.5, 20.0, 6.0, 0.06, 3.0, 0.02, 46.0, -90.0];
+        let row: Vec<f64> = lines
+            .next()
+            .unwrap()
+            .split(',')
+            .take(11)
+            .map(|c| c.parse().unwrap())
+            .collect();
+        let want = [
+            40.0,
+            1e5 / 1e5f64.sqrt(),
+            2.5,
+            0.5,
+            20.0,
+            6.0,
+            0.06,
+            3.0,
+            0.02,
+            46.0,
+            -90.0,
+        ];
         for (got, want) in row.iter().zip(want) {
             assert!((got - want).abs() <= 1e-12 * want.abs(), "{got} != {want}");
         }

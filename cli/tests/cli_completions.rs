@@ -46,7 +46,11 @@ fn every_shell_completes_every_subcommand() {
 fn the_man_page_names_every_subcommand() {
     let (code, out, err) = run(&["man"]);
     assert_eq!(code, 0, "{err}");
-    assert!(out.starts_with(".ie") || out.starts_with(".TH") || out.contains("\n.TH "), "{}", &out[..80]);
+    assert!(
+        out.starts_with(".ie") || out.starts_with(".TH") || out.contains("\n.TH "),
+        "{}",
+        &out[..80]
+    );
     assert!(out.contains("compensator"));
     // roff escapes hyphens: compensator\-twin\-config(1).
     let plain = out.replace("\\-", "-");
@@ -61,7 +65,10 @@ fn the_man_page_names_every_subcommand() {
     assert!(dir.join("compensator.1").exists());
     for name in &names {
         let page = std::fs::read_to_string(dir.join(format!("compensator-{name}.1"))).unwrap();
-        assert!(page.contains(".SH OPTIONS") || name == "man" || name == "calibrate", "{name}");
+        assert!(
+            page.contains(".SH OPTIONS") || name == "man" || name == "calibrate",
+            "{name}"
+        );
     }
     let sweep = std::fs::read_to_string(dir.join("compensator-sweep.1")).unwrap();
     assert!(sweep.replace("\\-", "-").contains("--vary"), "{sweep}");

@@ -98,14 +98,20 @@ fn report_writes_tables_figures_and_a_summary_from_any_directory() {
     assert_eq!(paper.len(), 18);
     let data = std::fs::read_to_string(common::root().join("data/paper/table1.csv")).unwrap();
     let (_, rows) = csv(&data);
-    let published: Vec<f64> = rows.iter().flat_map(|r| r[1..].iter().map(|c| c.parse::<f64>().unwrap())).collect();
+    let published: Vec<f64> = rows
+        .iter()
+        .flat_map(|r| r[1..].iter().map(|c| c.parse::<f64>().unwrap()))
+        .collect();
     for (a, b) in paper.iter().zip(&published) {
         assert!((a - b).abs() < 1e-12, "{a} {b}");
     }
     let rms = (paper.iter().zip(&model).map(|(p, m)| (m - p).powi(2)).sum::<f64>() / 18.0).sqrt();
     let (code, text, _) = run(&["paper"]);
     assert_eq!(code, 0);
-    let line = text.lines().find(|l| l.starts_with("RMS") && l.contains("bar")).unwrap();
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("RMS") && l.contains("bar"))
+        .unwrap();
     assert!(line.starts_with(&format!("RMS {rms:.4} bar")), "{line} vs {rms}");
     assert!(md.contains(&format!("RMS residual {rms:.4} bar")), "{md}");
 
@@ -126,7 +132,10 @@ fn report_writes_tables_figures_and_a_summary_from_any_directory() {
     assert_eq!(code, 0, "{err}");
     assert!(!si_dir.join("eigenvalues.png").exists());
     let t1 = std::fs::read_to_string(si_dir.join("table1.csv")).unwrap();
-    assert!(t1.starts_with("t_c,dp_pa,paper_dp_ab_pa,model_dp_ab_pa,residual_pa\n"), "{t1}");
+    assert!(
+        t1.starts_with("t_c,dp_pa,paper_dp_ab_pa,model_dp_ab_pa,residual_pa\n"),
+        "{t1}"
+    );
 
     // An output folder that cannot be made: bad input naming --out.
     let (code, _, err) = run(&["report", "--out", "/proc/no/such"]);

@@ -60,13 +60,20 @@ fn a_grid_row_is_what_the_single_commands_compute_for_that_design() {
         ]
     );
     assert_eq!(rows.len(), 6);
-    assert_eq!(column(&out, "plunger.spring_rate"), [20e3, 20e3, 25e3, 25e3, 30e3, 30e3]);
+    assert_eq!(
+        column(&out, "plunger.spring_rate"),
+        [20e3, 20e3, 25e3, 25e3, 30e3, 30e3]
+    );
     assert_eq!(column(&out, "plunger.mass"), [0.01, 0.03, 0.01, 0.03, 0.01, 0.03]);
     // Variant 4 (spring 30e3, mass 0.01) through the single commands.
     let text = with(&paper_preset(), "plunger", "spring_rate", 30e3);
     let text = with(&text, "plunger", "mass", 0.01);
     let here = root();
-    let (code, eq, err) = run_in(&here, &["equilibrium", "--params", "-", "--temps", "40,70"], text.as_bytes());
+    let (code, eq, err) = run_in(
+        &here,
+        &["equilibrium", "--params", "-", "--temps", "40,70"],
+        text.as_bytes(),
+    );
     assert_eq!(code, 0, "{err}");
     let row = &rows[4];
     assert_eq!(row[3].parse::<f64>().unwrap(), column(&eq, "x_m")[0]);
@@ -79,7 +86,11 @@ fn a_grid_row_is_what_the_single_commands_compute_for_that_design() {
     assert_eq!(row[7].parse::<f64>().unwrap(), column(&ind, "dominant_re")[0]);
     assert_eq!(row[8].parse::<f64>().unwrap(), column(&ind, "settling_time_s")[0]);
     // Compensation error RMS over the validated range (26-78 C) at 1 C.
-    let (_, comp, _) = run_in(&here, &["compensation", "--params", "-", "--temps", "26:78:1"], text.as_bytes());
+    let (_, comp, _) = run_in(
+        &here,
+        &["compensation", "--params", "-", "--temps", "26:78:1"],
+        text.as_bytes(),
+    );
     let e = column(&comp, "error_m3s");
     let rms = (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt();
     let got: f64 = row[9].parse().unwrap();
@@ -87,10 +98,19 @@ fn a_grid_row_is_what_the_single_commands_compute_for_that_design() {
     // Eq. (32): the sensitivity over the range never changes sign, and the
     // smallest |dx/dt| is no larger than any sampled one.
     assert_eq!(row[5], "true");
-    let (_, sens, _) = run_in(&here, &["sensitivity", "--params", "-", "--temps", "26:78:2"], text.as_bytes());
-    let min_sampled = column(&sens, "dx_dt_branch_m_k").iter().fold(f64::INFINITY, |m, v| m.min(v.abs()));
+    let (_, sens, _) = run_in(
+        &here,
+        &["sensitivity", "--params", "-", "--temps", "26:78:2"],
+        text.as_bytes(),
+    );
+    let min_sampled = column(&sens, "dx_dt_branch_m_k")
+        .iter()
+        .fold(f64::INFINITY, |m, v| m.min(v.abs()));
     let worst: f64 = row[6].parse().unwrap();
-    assert!(worst > 0.0 && worst <= min_sampled * (1.0 + 1e-12), "{worst} vs {min_sampled}");
+    assert!(
+        worst > 0.0 && worst <= min_sampled * (1.0 + 1e-12),
+        "{worst} vs {min_sampled}"
+    );
 }
 
 #[test]
@@ -117,8 +137,14 @@ fn tolerance_draws_stay_in_their_band_and_repeat_with_the_seed() {
     let s = column(&a, "slot.diameter");
     assert_eq!(d.len(), 40);
     let nominal = raw.core.plunger_diameter;
-    assert!(d.iter().all(|v| (v - nominal).abs() <= 0.01 * nominal * (1.0 + 1e-12)), "{d:?}");
-    assert!(s.iter().all(|v| (v - raw.core.slot_diameter).abs() <= 1e-5 * (1.0 + 1e-9)));
+    assert!(
+        d.iter().all(|v| (v - nominal).abs() <= 0.01 * nominal * (1.0 + 1e-12)),
+        "{d:?}"
+    );
+    assert!(
+        s.iter()
+            .all(|v| (v - raw.core.slot_diameter).abs() <= 1e-5 * (1.0 + 1e-9))
+    );
     // The draws spread over the band (not one value, not a corner).
     let lo = d.iter().cloned().fold(f64::INFINITY, f64::min);
     let hi = d.iter().cloned().fold(f64::NEG_INFINITY, f64::max);

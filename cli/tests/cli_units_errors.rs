@@ -105,7 +105,10 @@ fn eng_units_rename_and_convert_every_tables_columns() {
 #[test]
 fn eng_units_reach_the_figures() {
     let dir = temp_dir("units-plot");
-    for (units, shows) in [("si", ["x [m]", "p [Pa]", "Q [m^3/s]"]), ("eng", ["x [mm]", "p [bar]", "Q [L/min]"])] {
+    for (units, shows) in [
+        ("si", ["x [m]", "p [Pa]", "Q [m^3/s]"]),
+        ("eng", ["x [mm]", "p [bar]", "Q [L/min]"]),
+    ] {
         let file = dir.join(format!("{units}.svg"));
         let (code, _, err) = run(&[
             "equilibrium",
@@ -202,6 +205,9 @@ fn failed_rows_still_reach_the_output_file_and_bad_input_stays_status_2() {
     let (code, out, err) = run(&["indicators", "--params", P, "--steps", "40:50,40:200", "--t-end", "0.1"]);
     assert_eq!(code, 1, "{err}");
     let (_, rows) = csv(&out);
-    assert!(rows[0].last().unwrap().is_empty() && !rows[1].last().unwrap().is_empty(), "{out}");
+    assert!(
+        rows[0].last().unwrap().is_empty() && !rows[1].last().unwrap().is_empty(),
+        "{out}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -50,7 +50,12 @@ pub fn run(args: &[&str]) -> (i32, String, String) {
 /// Runs the binary in the repository root with extra environment
 /// variables: (code, stdout, stderr).
 pub fn run_env(args: &[&str], env: &[(&str, &str)]) -> (i32, String, String) {
-    let out = cli().args(args).envs(env.iter().copied()).stdin(Stdio::null()).output().unwrap();
+    let out = cli()
+        .args(args)
+        .envs(env.iter().copied())
+        .stdin(Stdio::null())
+        .output()
+        .unwrap();
     (
         out.status.code().unwrap_or(-1),
         String::from_utf8(out.stdout).unwrap(),
@@ -70,14 +75,28 @@ pub fn temp_dir(name: &str) -> PathBuf {
 pub fn csv(text: &str) -> (Vec<String>, Vec<Vec<String>>) {
     let mut lines = text.lines().filter(|l| !l.is_empty() && !l.starts_with('#'));
     let header = lines.next().unwrap_or("").split(',').map(String::from).collect();
-    (header, lines.map(|l| l.split(',').map(String::from).collect()).collect())
+    (
+        header,
+        lines.map(|l| l.split(',').map(String::from).collect()).collect(),
+    )
 }
 
 /// Column `name` of CSV text as numbers (NaN for an empty cell).
 pub fn column(text: &str, name: &str) -> Vec<f64> {
     let (header, rows) = csv(text);
-    let i = header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name} in {header:?}"));
-    rows.iter().map(|r| if r[i].is_empty() { f64::NAN } else { r[i].parse().unwrap() }).collect()
+    let i = header
+        .iter()
+        .position(|h| h == name)
+        .unwrap_or_else(|| panic!("no column {name} in {header:?}"));
+    rows.iter()
+        .map(|r| {
+            if r[i].is_empty() {
+                f64::NAN
+            } else {
+                r[i].parse().unwrap()
+            }
+        })
+        .collect()
 }
 
 /// The paper preset's text.
