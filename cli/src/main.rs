@@ -457,6 +457,18 @@ fn run(cli: Cli) -> Result<(String, (usize, usize)), CliError> {
                 .into(),
         ));
     }
+    if cli.units != Units::Si
+        && matches!(
+            cli.command,
+            Command::Size { .. } | Command::Calibrate { .. } | Command::Paper { .. }
+        )
+    {
+        return Err(CliError::Input(
+            "--units: size and calibrate write a parameter file and paper its report in the file's SI units; \
+             eng applies to the tables, figures and report"
+                .into(),
+        ));
+    }
     let (format, units) = (cli.format, cli.units);
     let out = run_command(cli.command, units)?;
     Ok(if tabular {

@@ -103,6 +103,22 @@ fn eng_units_rename_and_convert_every_tables_columns() {
 }
 
 #[test]
+fn eng_units_are_refused_where_the_output_is_a_parameter_file_or_text() {
+    for args in [
+        &["size", "--params", P, "--for", "machine"][..],
+        &["calibrate"][..],
+        &["paper"][..],
+    ] {
+        let (code, out, err) = run(&[args, &["--units", "eng"]].concat());
+        assert_eq!(code, 2, "{args:?}");
+        assert!(out.is_empty());
+        assert!(err.contains("--units"), "{err}");
+        let (code, _, err) = run(&[args, &["--units", "si"]].concat());
+        assert_eq!(code, 0, "{args:?}: {err}");
+    }
+}
+
+#[test]
 fn eng_units_reach_the_figures() {
     let dir = temp_dir("units-plot");
     for (units, shows) in [
