@@ -328,9 +328,12 @@ impl Progress {
     fn new(n: usize) -> Self {
         let bar = indicatif::ProgressBar::with_draw_target(Some(n as u64), indicatif::ProgressDrawTarget::hidden());
         if let Ok(style) =
-            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} variants, {per_sec}, eta {eta}")
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} variants, {rate} variants/s, eta {eta}")
         {
-            bar.set_style(style);
+            let rate = |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                let _ = write!(w, "{:.0}", state.per_sec());
+            };
+            bar.set_style(style.with_key("rate", rate));
         }
         Progress {
             bar,
