@@ -5,10 +5,37 @@ use std::fmt::Write;
 
 /// A CSV table built in memory and printed only when complete, so that a
 /// failure half-way leaves standard output empty.
+///
+/// A row that could not be computed ([`Table::row_error`]) keeps its
+/// leading cells (the temperature, say), leaves the others empty and says
+/// why in a last column `error`, which the table gains with its first
+/// such row (a table without failures has no `error` column).
 #[derive(Debug, Default, Clone)]
 pub struct Table {
     text: String,
     columns: usize,
+    has_error: bool,
+}
+
+/// Name of the column that says why a row could not be computed.
+pub const ERROR_COLUMN: &str = "error";
+
+/// `message` as one CSV cell: commas become semicolons and line breaks
+/// spaces, so that the cell needs no quoting; never empty.
+pub fn error_cell(message: &str) -> String {
+    let cell: String = message
+        .chars()
+        .map(|c| match c {
+            ',' => ';',
+            '\n' | '\r' => ' ',
+            c => c,
+        })
+        .collect();
+    if cell.trim().is_empty() {
+        "failed".to_string()
+    } else {
+        cell.trim().to_string()
+    }
 }
 
 impl Table {
@@ -17,6 +44,7 @@ impl Table {
         let mut t = Table {
             text: String::new(),
             columns: header.len(),
+            has_error: false,
         };
         t.text.push_str(&header.join(","));
         t.text.push('\n');
@@ -32,7 +60,49 @@ impl Table {
             }
             let _ = write!(self.text, "{v}");
         }
+        if self.has_error {
+            self.text.push(',');
+        }
         self.text.push('\n');
+    }
+
+    /// Appends a row of cells already formatted (numbers as `{}` of `f64`,
+    /// `true`/`false`, text without commas); panics in debug builds on a
+    /// wrong width.
+    pub fn row_cells(&mut self, cells: &[String]) {
+        debug_assert_eq!(cells.len(), self.columns);
+        self.text.push_str(&cells.join(","));
+        if self.has_error {
+            self.text.push(',');
+        }
+        self.text.push('\n');
+    }
+
+    /// Appends a row that could not be computed: its first cells `leading`
+    /// (e.g. the temperature), empty cells for the rest, and `message` in
+    /// the `error` column (added to the header and to the rows so far
+    /// with this first failure).
+    pub fn row_error(&mut self, leading: &[f64], message: &str) {
+        debug_assert!(leading.len() <= self.columns);
+        if !self.has_error {
+            self.has_error = true;
+            let mut text = String::with_capacity(self.text.len() + 16);
+            for (i, line) in self.text.lines().enumerate() {
+                text.push_str(line);
+                text.push_str(if i == 0 { ",error\n" } else { ",\n" });
+            }
+            self.text = text;
+        }
+        let mut cells: Vec<String> = leading.iter().map(|v| format!("{v}")).collect();
+        cells.resize(self.columns, String::new());
+        cells.push(error_cell(message));
+        self.text.push_str(&cells.join(","));
+        self.text.push('\n');
+    }
+
+    /// Whether some row could not be computed.
+    pub fn has_errors(&self) -> bool {
+        self.has_error
     }
 
     /// The CSV text.
@@ -89,18 +159,21 @@ pub enum Format {
     Table,
 }
 
-/// Splits CSV text (as written by [`Table`]) into its header and rows of cells.
-fn cells(text: &str) -> (Vec<&str>, Vec<Vec<&str>>) {
+/// Splits CSV text (as written by [`Table`]: no quoted cells) into its
+/// header and rows of cells.
+pub fn cells(text: &str) -> (Vec<&str>, Vec<Vec<&str>>) {
     let mut lines = text.lines().filter(|l| !l.is_empty());
     let header = lines.next().map(|l| l.split(',').collect()).unwrap_or_default();
     (header, lines.map(|l| l.split(',').collect()).collect())
 }
 
 /// A cell as a JSON value: a finite number, `true`/`false`, `null` for a
-/// non-finite number (JSON has none), else a string.
+/// non-finite number (JSON has none) or an empty cell (a row that could not
+/// be computed), else a string.
 fn json_value(cell: &str) -> serde_json::Value {
     use serde_json::Value;
     match cell {
+        "" => Value::Null,
         "true" => Value::Bool(true),
         "false" => Value::Bool(false),
         _ if !cell.is_empty() && cell.bytes().all(|b| b.is_ascii_digit() || b == b'-') => {
@@ -117,6 +190,20 @@ fn json_value_f64(cell: &str) -> serde_json::Value {
         Ok(v) => serde_json::Number::from_f64(v).map_or(Value::Null, Value::Number),
         Err(_) => Value::String(cell.to_string()),
     }
+}
+
+/// Rows of CSV text (as written by [`Table`]) whose `error` cell is not
+/// empty, and all rows: (failed, total).
+pub fn failed_rows(text: &str) -> (usize, usize) {
+    let (header, rows) = cells(text);
+    let Some(col) = header.iter().position(|h| *h == ERROR_COLUMN) else {
+        return (0, rows.len());
+    };
+    let failed = rows
+        .iter()
+        .filter(|r| r.get(col).is_some_and(|c| !c.is_empty()))
+        .count();
+    (failed, rows.len())
 }
 
 /// Renders CSV text with a header row in `format`.

@@ -19,6 +19,8 @@ pub const MODEL_EXAMPLE: &str = include_str!("../../presets/model-example.toml")
 pub const TABLE1_CSV: &str = include_str!("../../data/paper/table1.csv");
 /// `data/paper/table2.csv`, built in.
 pub const TABLE2_CSV: &str = include_str!("../../data/paper/table2.csv");
+/// `data/paper/table3.csv`, built in.
+pub const TABLE3_CSV: &str = include_str!("../../data/paper/table3.csv");
 
 /// Reads at most `MAX_PARAMS_BYTES` from `r`; more is bad input of `flag`.
 fn read_bounded(r: impl Read, flag: &str, what: &str) -> Result<String, CliError> {
