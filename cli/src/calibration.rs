@@ -345,11 +345,14 @@ pub fn fit(
         )
     })?;
     lsq::check_design(&j0, &names1).map_err(|e| undetermined("--pressure-data", &names1, e))?;
-    let fit1 = least_squares(r1, &u0, &steps(&u0))
-        .map_err(|e| CliError::Failed(format!("--pressure-data: {e}")))?;
+    let fit1 = least_squares(r1, &u0, &steps(&u0)).map_err(|e| CliError::Failed(format!("--pressure-data: {e}")))?;
     let unc1 = lsq::analyse(&fit1.jacobian, &fit1.residuals, &names1)
         .map_err(|e| undetermined("--pressure-data", &names1, e))?;
-    let mut warnings: Vec<String> = unc1.warnings().into_iter().map(|w| format!("pressure data: {w}")).collect();
+    let mut warnings: Vec<String> = unc1
+        .warnings()
+        .into_iter()
+        .map(|w| format!("pressure data: {w}"))
+        .collect();
     let fluid_core = oil.core(&fit1.x);
     // Covariance of (walther_a, walther_b, log10 G) from that of (w_ref, b, log10 G).
     let to_ab = DMatrix::from_row_slice(3, 3, &[1.0, log_t_ref, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
@@ -386,8 +389,8 @@ pub fn fit(
             CliError::Input("--displacement-data: the model cannot be evaluated at the data's temperatures".into())
         })?;
         lsq::check_design(&j0, &names2).map_err(|e| undetermined("--displacement-data", &names2, e))?;
-        let fit2 = least_squares(r2, &v0, &steps(&v0))
-            .map_err(|e| CliError::Failed(format!("--displacement-data: {e}")))?;
+        let fit2 =
+            least_squares(r2, &v0, &steps(&v0)).map_err(|e| CliError::Failed(format!("--displacement-data: {e}")))?;
         let unc2 = lsq::analyse(&fit2.jacobian, &fit2.residuals, &names2)
             .map_err(|e| undetermined("--displacement-data", &names2, e))?;
         warnings.extend(unc2.warnings().into_iter().map(|w| format!("displacement data: {w}")));
@@ -784,10 +787,7 @@ pub fn calibrate(opts: &Options) -> Result<Output, CliError> {
                 "--displacement-data",
                 crate::input::PAPER_DISPLACEMENT_CSV,
             )?;
-            Some(
-                read_displacement(&text)
-                    .map_err(|e| CliError::Input(format!("--displacement-data: {name}: {e}")))?,
-            )
+            Some(read_displacement(&text).map_err(|e| CliError::Input(format!("--displacement-data: {name}: {e}")))?)
         }
         None => None,
     };

@@ -151,11 +151,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
 /// central-difference step of parameter `j`. Fails (with the minimiser's
 /// reason) when the start cannot be evaluated, or when the minimiser stops
 /// for a reason other than convergence.
-pub fn least_squares(
-    residuals: impl Fn(&[f64]) -> Option<Vec<f64>>,
-    x0: &[f64],
-    step: &[f64],
-) -> Result<Fit, String> {
+pub fn least_squares(residuals: impl Fn(&[f64]) -> Option<Vec<f64>>, x0: &[f64], step: &[f64]) -> Result<Fit, String> {
     let r0 = residuals(x0)
         .filter(|r| r.iter().all(|v| v.is_finite()))
         .ok_or("the model cannot be evaluated at the starting parameters")?;
@@ -170,7 +166,10 @@ pub fn least_squares(
     };
     let (problem, report) = LevenbergMarquardt::new().with_patience(200).minimize(problem);
     if !report.termination.was_successful() {
-        return Err(format!("the least-squares fit did not converge ({:?})", report.termination));
+        return Err(format!(
+            "the least-squares fit did not converge ({:?})",
+            report.termination
+        ));
     }
     let x: Vec<f64> = problem.x.iter().copied().collect();
     let r = problem.eval(&x);
@@ -250,7 +249,9 @@ pub struct Uncertainty {
 impl Uncertainty {
     /// Standard error of each parameter, `sqrt(cov_ii)`.
     pub fn std_errors(&self) -> Vec<f64> {
-        (0..self.cov.nrows()).map(|i| self.cov[(i, i)].max(0.0).sqrt()).collect()
+        (0..self.cov.nrows())
+            .map(|i| self.cov[(i, i)].max(0.0).sqrt())
+            .collect()
     }
 
     /// Correlation matrix (p x p).

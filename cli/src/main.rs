@@ -145,6 +145,27 @@ Example:
     --pressure-data data/calibration/paper-pressure.csv \\
     --displacement-data data/calibration/paper-displacement.csv \\
     --write-preset my-paper.toml --plot fit.svg --format table";
+const IDENTIFY_HELP: &str = "\
+Simulates the measured temperature history with the dynamic twin in f64
+(the substeps twin-config chooses for the sample interval) and fits the
+dynamic parameters by least squares in log coordinates. A parameter whose
+relative standard error exceeds 50 %, or that the data cannot separate
+from another, is reported as not identifiable (no value printed), kept at
+the --params value, and the others are fitted again without it.
+
+Data: time_s [s] (uniform samples), t_c [C], x_m [m], optionally
+p_a_pa, p_b_pa [Pa]; the record starts at rest at the first temperature.
+
+Output: CSV, one row per parameter of --fit:
+  parameter, unit, identifiable (true|false), value [unit],
+  std_error [unit], rel_std_error [-], ci95_low [unit], ci95_high [unit]
+  (the numbers are empty when identifiable is false)
+stderr: the twin used, residuals, degrees of freedom, residual RMS [m]
+(and [Pa]), and why each parameter is not identifiable.
+
+Example:
+  compensator identify --params my-device.toml --data step.csv \\
+    --fit mass,damping --write-preset my-device-dynamic.toml --format table";
 const PAPER_HELP: &str = "\
 Output: a text report: Table 1 inverted for A(t) [sqrt(Pa)], Table 1
 residuals [bar], Table 2 displacements [mm], the \"asym\" column's expansion,
@@ -341,6 +362,25 @@ enum Command {
         #[arg(long, value_name = "FILE.svg", value_parser = plot::parse_path)]
         plot: Option<PathBuf>,
     },
+    /// Fit the dynamic parameters (mass, damping, compliance) to a measured transient, with intervals.
+    #[command(after_long_help = IDENTIFY_HELP)]
+    Identify {
+        /// Parameter file (TOML) with the static parameters calibrated; `-` reads standard input.
+        #[arg(long)]
+        params: PathBuf,
+        /// Transient time_s,t_c,x_m[,p_a_pa,p_b_pa] (CSV).
+        #[arg(long, value_name = "STEP.csv")]
+        data: PathBuf,
+        /// Parameters to fit, comma list of mass, damping, bulk_modulus, volume_a, volume_b.
+        #[arg(long, default_value = "mass,damping,bulk_modulus")]
+        fit: String,
+        /// Write the parameter file with the identified values (TOML) to FILE.
+        #[arg(long, value_name = "FILE")]
+        write_preset: Option<PathBuf>,
+        /// Draw the measured and simulated transient (SVG).
+        #[arg(long, value_name = "FILE.svg", value_parser = plot::parse_path)]
+        plot: Option<PathBuf>,
+    },
     /// Reproduce the paper's tables and report the findings (text).
     #[command(after_long_help = PAPER_HELP)]
     Paper {
@@ -534,6 +574,26 @@ fn run_command(command: Command) -> Result<String, CliError> {
                 let _ = writeln!(stderr, "calibrate: {line}");
             }
             Ok(out.table)
+        }
+        Command::Identify {
+            params,
+            data,
+            fit,
+            write_preset,
+            plot: figure,
+        } => {
+            let (table, notes) = compensator_cli::identify::identify(&compensator_cli::identify::Options {
+                params,
+                data,
+                fit: Some(fit),
+                write_preset,
+                plot: figure,
+            })?;
+            let mut stderr = std::io::stderr().lock();
+            for line in &notes {
+                let _ = writeln!(stderr, "identify: {line}");
+            }
+            Ok(table)
         }
         Command::Paper { params, data } => paper::report(params.as_deref(), data.as_deref()),
     }

@@ -10,7 +10,10 @@ use std::path::PathBuf;
 use std::process::Command;
 
 fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap()
+        .to_path_buf()
 }
 
 /// Runs the binary in the repository root: (code, stdout, stderr).
@@ -52,16 +55,7 @@ fn a_spreadsheet_export_with_bom_semicolons_quotes_and_decimal_commas_is_read() 
         sheet.push_str(&format!("\"{}\";{},0;\"{},0\"\r\n", cells[0], cells[1], cells[2]));
     }
     let path = temp_file("sheet.csv", sheet.as_bytes());
-    let args = |p: &str| {
-        [
-            "calibrate",
-            "--pressure-data",
-            p,
-            "--displacement-data",
-            DISPLACEMENT,
-        ]
-        .map(str::to_string)
-    };
+    let args = |p: &str| ["calibrate", "--pressure-data", p, "--displacement-data", DISPLACEMENT].map(str::to_string);
     let a = args(&path.to_string_lossy());
     let (code, out, err) = run(&a.iter().map(String::as_str).collect::<Vec<_>>());
     assert_eq!(code, 0, "{err}");
@@ -88,7 +82,10 @@ fn a_bad_cell_exits_2_naming_file_row_and_column() {
     // A missing column, a physically impossible pressure, a short row.
     for (text, why) in [
         ("t_c,x_m\n30,0\n", "no column dp_pa"),
-        ("t_c,dp_pa,dp_ab_pa\n30,400000,500000\n", "row 1 (line 2), column dp_ab_pa"),
+        (
+            "t_c,dp_pa,dp_ab_pa\n30,400000,500000\n",
+            "row 1 (line 2), column dp_ab_pa",
+        ),
         ("t_c,dp_pa,dp_ab_pa\n30,-4,0\n", "row 1 (line 2), column dp_pa"),
         ("t_c,dp_pa,dp_ab_pa\n30,400000\n", "row 1 (line 2): 2 cells"),
         ("", "empty file"),
@@ -107,7 +104,10 @@ fn a_bad_cell_exits_2_naming_file_row_and_column() {
         &path.to_string_lossy(),
     ]);
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("row 3 (line 4), column x_m") && err.contains("not a finite number"), "{err}");
+    assert!(
+        err.contains("row 3 (line 4), column x_m") && err.contains("not a finite number"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -119,7 +119,9 @@ fn as_many_points_as_parameters_is_refused() {
     assert_eq!(code, 2, "{err}");
     assert!(out.is_empty());
     assert!(
-        err.contains("--pressure-data") && err.contains("3 points for 3 parameters") && err.contains("0 degrees of freedom"),
+        err.contains("--pressure-data")
+            && err.contains("3 points for 3 parameters")
+            && err.contains("0 degrees of freedom"),
         "{err}"
     );
     // Two displacement points for the spring rate and the preload.
@@ -150,7 +152,10 @@ fn one_temperature_cannot_separate_the_oil_from_the_throttle() {
     let (code, _, err) = run(&["calibrate", "--pressure-data", &path.to_string_lossy()]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("do not separate"), "{err}");
-    assert!(err.contains("fluid.walther_b") && err.contains("laminar_throttle.length"), "{err}");
+    assert!(
+        err.contains("fluid.walther_b") && err.contains("laminar_throttle.length"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -179,7 +184,10 @@ fn the_paper_fit_reports_its_uncertainty_and_warns_about_what_it_cannot_determin
     // The digitised table's scatter: sqrt(RSS / 15) between 4 and 8 kPa.
     let s = get("fluid.walther_b")["residual_rms"].as_f64().unwrap();
     assert!((4e3..8e3).contains(&s), "{s}");
-    assert!(err.contains("15 degrees of freedom") && err.contains("4 degrees of freedom"), "{err}");
+    assert!(
+        err.contains("15 degrees of freedom") && err.contains("4 degrees of freedom"),
+        "{err}"
+    );
     assert!(err.contains("WARNING: plunger.preload"), "{err}");
     // The preset round-trips with the fitted values.
     let written = params_file::load(&preset).unwrap();
@@ -206,13 +214,7 @@ const SIGMA_X: f64 = 5e-6;
 /// times, preload 5-50 um) and a random measurement plan (6-12 temperatures
 /// in 20-90 C at 2-4 drops of 3-8 bar; 6-12 displacement temperatures),
 /// with at least five displacement points off the stops.
-fn design(
-    rng: &mut StdRng,
-) -> (
-    compensator::RawParams,
-    Vec<PressurePoint>,
-    Vec<DisplacementPoint>,
-) {
+fn design(rng: &mut StdRng) -> (compensator::RawParams, Vec<PressurePoint>, Vec<DisplacementPoint>) {
     let paper = params_file::parse(input::PAPER_PRESET).unwrap();
     loop {
         let mut truth = paper;
@@ -296,8 +298,8 @@ fn synthetic_data_recover_the_parameters_within_their_reported_standard_errors()
         base.core.laminar_length = example.core.laminar_length;
         base.core.spring_rate = example.core.spring_rate;
         base.core.preload = example.core.preload;
-        let cal = calibration::fit(&base, &pressure, Some(&displacement))
-            .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+        let cal =
+            calibration::fit(&base, &pressure, Some(&displacement)).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
         let t = truth.core;
         let want = [t.walther_a, t.walther_b, t.laminar_length, t.spring_rate, t.preload];
         for (e, want) in cal.estimates.iter().zip(want) {
@@ -322,7 +324,10 @@ fn synthetic_data_recover_the_parameters_within_their_reported_standard_errors()
     }
     let rms = (z_all.iter().map(|z| z * z).sum::<f64>() / z_all.len() as f64).sqrt();
     let within2 = z_all.iter().filter(|z| z.abs() <= 2.0).count() as f64 / z_all.len() as f64;
-    eprintln!("normalised errors: RMS {rms:.3}, {:.1} % within 2 standard errors", 100.0 * within2);
+    eprintln!(
+        "normalised errors: RMS {rms:.3}, {:.1} % within 2 standard errors",
+        100.0 * within2
+    );
     assert!((0.7..=1.3).contains(&rms), "RMS of normalised errors {rms}");
     assert!(within2 >= 0.88, "{within2}");
 }

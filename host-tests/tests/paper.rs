@@ -71,7 +71,10 @@ fn long_form_data_are_the_paper_tables() {
     assert_eq!(pressure.len(), expected.len());
     for (p, e) in pressure.iter().zip(&expected) {
         assert_eq!(p.t_c, e.0);
-        assert!((p.dp_pa - e.1).abs() < 1e-6 && (p.dp_ab_pa - e.2).abs() < 1e-6, "{p:?} vs {e:?}");
+        assert!(
+            (p.dp_pa - e.1).abs() < 1e-6 && (p.dp_ab_pa - e.2).abs() < 1e-6,
+            "{p:?} vs {e:?}"
+        );
     }
     assert_eq!(displacement.len(), t2.temps.len());
     for (p, (&t, &x)) in displacement.iter().zip(t2.temps.iter().zip(&t2.x_qs_mm)) {
