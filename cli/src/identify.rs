@@ -114,7 +114,7 @@ impl Transient {
 ///
 /// Errors (naming row and column): a missing column, a cell that is not a
 /// finite number, fewer than 3 rows, sample times not increasing or not
-/// uniform (within [`UNIFORM_TOL`] of the mean interval), only one of the
+/// uniform (within [`UNIFORM_TOL`] of the first interval), only one of the
 /// two pressure columns.
 pub fn read_transient(text: &str) -> Result<Transient, String> {
     let t = read_numeric(text)?;
@@ -137,13 +137,13 @@ pub fn read_transient(text: &str) -> Result<Transient, String> {
         return Err(format!("{} data rows: a transient needs at least 3", t.rows.len()));
     }
     let time: Vec<f64> = t.rows.iter().map(|r| r[ct]).collect();
-    let mean = (time[time.len() - 1] - time[0]) / (time.len() - 1) as f64;
+    let first = time[1] - time[0];
     for i in 1..time.len() {
         let dt = time[i] - time[i - 1];
-        if !(dt > 0.0) || (dt - mean).abs() > UNIFORM_TOL * mean.abs() + 1e-12 {
+        if !(dt > 0.0) || (dt - first).abs() > UNIFORM_TOL * first.abs() {
             return Err(format!(
                 "row {} (line {}), column time_s: interval {dt} s after the previous sample; the samples \
-                 must be uniform (mean interval {mean} s, tolerance {UNIFORM_TOL} relative)",
+                 must be uniform (the first interval is {first} s, tolerance {UNIFORM_TOL} relative)",
                 i + 1,
                 t.lines[i]
             ));
@@ -843,14 +843,14 @@ pub struct Options {
 /// Errors: bad parameter file or data (exit 2, naming the field, row and
 /// column), too few degrees of freedom (exit 2), a fit that fails (exit 1).
 pub fn identify(opts: &Options) -> Result<(String, Vec<String>), CliError> {
-    let base = crate::input::load_raw(&opts.params, "--params")?;
-    let shown = opts.data.display().to_string();
-    let text = crate::input::params_text(&opts.data, "--data")?;
-    let data = read_transient(&text).map_err(|e| CliError::Input(format!("--data: {shown}: {e}")))?;
     let fit = match &opts.fit {
         Some(list) => parse_fit(list).map_err(|e| CliError::Input(format!("--fit: {e}")))?,
         None => DEFAULT_FIT.to_vec(),
     };
+    let base = crate::input::load_raw(&opts.params, "--params")?;
+    let shown = opts.data.display().to_string();
+    let text = crate::input::params_text(&opts.data, "--data")?;
+    let data = read_transient(&text).map_err(|e| CliError::Input(format!("--data: {shown}: {e}")))?;
     let id = identify_params(&base, &data, &fit)?;
     if let Some(path) = &opts.write_preset {
         let command = format!(

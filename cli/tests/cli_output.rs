@@ -44,7 +44,7 @@ fn run(args: &[&str]) -> (i32, String, String) {
     run_in(&root(), args, b"")
 }
 
-const COMMANDS: [&str; 11] = [
+const COMMANDS: [&str; 12] = [
     "equilibrium",
     "asymptotic",
     "sensitivity",
@@ -55,6 +55,7 @@ const COMMANDS: [&str; 11] = [
     "compensation",
     "size",
     "calibrate",
+    "identify",
     "paper",
 ];
 
