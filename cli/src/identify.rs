@@ -377,6 +377,10 @@ fn profile(f: &dyn Fn(&[f64]) -> Option<Vec<f64>>, x: &[f64], i: usize, delta: f
     profile_at(f, x, i, -delta, step).min(profile_at(f, x, i, delta, step))
 }
 
+/// The accepted fit: its uncertainty, optimum (fit coordinates), the
+/// coordinates and the profile-likelihood intervals of its parameters.
+type Accepted = (lsq::Uncertainty, Vec<f64>, Vec<Coord>, Vec<(f64, f64)>);
+
 /// Residual scales of the channels: displacement [m], pressures [Pa].
 #[derive(Clone, Copy, Debug)]
 struct Scales {
@@ -435,7 +439,7 @@ pub fn identify_params(base: &RawParams, data: &Transient, fit: &[&'static str])
     let mut dropped: Vec<(&'static str, String)> = Vec::new();
     let mut warnings = Vec::new();
     let mut core = base.core;
-    let mut last: Option<(lsq::Uncertainty, Vec<f64>, Vec<Coord>, Vec<(f64, f64)>)> = None;
+    let mut last: Option<Accepted> = None;
     let mut reweighted = data.p_pa.is_none();
     while !free.is_empty() {
         if n_res < free.len() + MIN_DOF {

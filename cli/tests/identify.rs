@@ -80,6 +80,10 @@ fn an_underdamped_design_gives_its_mass_and_damping_back_within_the_intervals() 
                 r.path,
                 e.value
             );
+            eprintln!(
+                "seed {seed}: {} = {:.4} +- {:.4} (95 % profile interval {:.4} .. {:.4}), true {want:.4}",
+                r.path, e.value, e.std_error, lo, hi
+            );
             total += 1;
             if (lo..=hi).contains(&want) {
                 inside += 1;
@@ -108,6 +112,7 @@ fn the_paper_design_reports_its_mass_as_not_identifiable() {
         let mass = &id.results[0];
         assert_eq!(mass.path, "plunger.mass");
         assert!(mass.estimate.is_none(), "seed {seed}: mass {:?}", mass.estimate);
+        eprintln!("seed {seed}: {}", id.notes()[1..].join("; "));
         assert!(!mass.reason.is_empty());
         let table = id.table();
         assert!(table.contains("plunger.mass,kg,false,,,,,"), "{table}");
