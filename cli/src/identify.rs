@@ -80,6 +80,14 @@ pub const PROFILE_MIN_RISE: f64 = 0.25;
 /// longer shows) even if its local standard error looks small.
 pub const PROFILE_FAR: f64 = 10.0;
 
+/// Fewest samples a parameter's information may come from: the
+/// participation ratio `(sum J_i^2)^2 / sum J_i^4` of its Jacobian column
+/// (`n` when every residual is equally sensitive, 1 when one is). A
+/// parameter seen by a handful of samples (the bulk modulus, in the first
+/// millisecond after a step) would be fitted to their noise, with an
+/// interval the asymptotic theory does not cover.
+pub const MIN_EFFECTIVE_SAMPLES: f64 = 10.0;
+
 /// Bisection steps locating each end of a profile-likelihood interval
 /// (the bracket, a factor [`PROFILE_FAR`] wide, shrinks to 2^-12 of it).
 pub const PROFILE_BISECTIONS: usize = 12;
@@ -540,6 +548,30 @@ pub fn identify_params(base: &RawParams, data: &Transient, fit: &[&'static str])
                         "the fit runs to the edge of its plausible range (docs/parameters.md): the data bound it \
                          from one side only"
                             .into(),
+                    ));
+                    free.remove(i);
+                    continue;
+                }
+                // Where the information comes from: the participation
+                // ratio of each Jacobian column (MIN_EFFECTIVE_SAMPLES).
+                let effective = |j: usize| {
+                    let col = fit_result.jacobian.column(j);
+                    let s2: f64 = col.iter().map(|v| v * v).sum();
+                    let s4: f64 = col.iter().map(|v| v.powi(4)).sum();
+                    if s4 > 0.0 { s2 * s2 / s4 } else { 0.0 }
+                };
+                if let Some((i, n_eff)) = (0..free.len())
+                    .map(|i| (i, effective(i)))
+                    .filter(|(_, n)| !(*n >= MIN_EFFECTIVE_SAMPLES))
+                    .min_by(|a, b| a.1.total_cmp(&b.1))
+                {
+                    dropped.push((
+                        free[i],
+                        format!(
+                            "its effect is concentrated in about {n_eff:.1} samples (fewer than \
+                             {MIN_EFFECTIVE_SAMPLES}): a fit to so few points adapts to their noise, and no \
+                             interval from them can be trusted"
+                        ),
                     ));
                     free.remove(i);
                     continue;

@@ -25,9 +25,14 @@ fn normal(rng: &mut StdRng) -> f64 {
     (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
 }
 
+/// Chamber pressure noise when pressures are recorded: 2 kPa (0.1 % of a
+/// 20 bar transducer).
+const SIGMA_P: f64 = 2e3;
+
 /// The reference solver's response of `truth` to a step `from -> to` C over
-/// `t_end` s, sampled every `DT`, with seeded displacement noise.
-fn record(truth: &RawParams, from: f64, to: f64, t_end: f64, seed: u64) -> Transient {
+/// `t_end` s, sampled every `DT`, with seeded displacement noise (and the
+/// chamber pressures with their noise if `pressures`).
+fn record_with(truth: &RawParams, from: f64, to: f64, t_end: f64, seed: u64, pressures: bool) -> Transient {
     let tr = simulate(
         &truth.core,
         Profile::Step { from, to },
@@ -38,12 +43,23 @@ fn record(truth: &RawParams, from: f64, to: f64, t_end: f64, seed: u64) -> Trans
     )
     .unwrap();
     let mut rng = StdRng::seed_from_u64(seed);
+    let x_m = tr.state.iter().map(|s| s[0] + SIGMA_X * normal(&mut rng)).collect();
+    let p_pa = pressures.then(|| {
+        tr.state
+            .iter()
+            .map(|s| (s[2] + SIGMA_P * normal(&mut rng), s[3] + SIGMA_P * normal(&mut rng)))
+            .collect()
+    });
     Transient {
         t_c: (0..tr.time.len()).map(|k| if k == 0 { from } else { to }).collect(),
-        x_m: tr.state.iter().map(|s| s[0] + SIGMA_X * normal(&mut rng)).collect(),
+        x_m,
         time_s: tr.time,
-        p_pa: None,
+        p_pa,
     }
+}
+
+fn record(truth: &RawParams, from: f64, to: f64, t_end: f64, seed: u64) -> Transient {
+    record_with(truth, from, to, t_end, seed, false)
 }
 
 fn paper() -> RawParams {
@@ -103,16 +119,50 @@ fn an_underdamped_design_gives_its_mass_and_damping_back_within_the_intervals() 
 #[test]
 fn the_paper_design_reports_its_mass_as_not_identifiable() {
     // Hydraulic damping of the paper's design (~280 N s/m) makes the
-    // plunger's 20 g invisible in x(t) sampled at 1 kHz with 5 um noise: the
-    // command must say so instead of printing a number.
+    // plunger's 20 g invisible in x(t) sampled at 1 kHz with 5 um noise:
+    // the command must say so instead of printing a number. With the
+    // chamber pressures too (seeds 3-5) the mass shows in the first
+    // milliseconds and may be bounded, widely. Whatever it does identify
+    // must hold the truth in its interval.
     let truth = paper();
-    for seed in 0..4u64 {
-        let data = record(&truth, 40.0, 50.0, 0.3, 200 + seed);
+    let want = |path: &str| match path {
+        "plunger.mass" => truth.core.mass,
+        "plunger.damping" => truth.core.damping,
+        _ => truth.core.bulk_modulus,
+    };
+    for seed in 0..6u64 {
+        let data = record_with(&truth, 40.0, 50.0, 0.3, 200 + seed, seed >= 3);
         let id = identify::identify_params(&truth, &data, &identify::DEFAULT_FIT).unwrap();
         let mass = &id.results[0];
         assert_eq!(mass.path, "plunger.mass");
+        eprintln!(
+            "seed {seed} ({}): {}",
+            if seed >= 3 { "x, p_a, p_b" } else { "x" },
+            id.notes()[1..].join("; ")
+        );
+        for r in &id.results {
+            if let Some(e) = r.estimate {
+                eprintln!(
+                    "seed {seed}: {} = {} in {:?}, true {}",
+                    r.path,
+                    e.value,
+                    e.ci95,
+                    want(r.path)
+                );
+                assert!(
+                    (e.ci95.0..=e.ci95.1).contains(&want(r.path)),
+                    "seed {seed}: {} {e:?}, true {}",
+                    r.path,
+                    want(r.path)
+                );
+            }
+        }
+        if data.p_pa.is_some() {
+            // With the chamber pressures the mass may be bounded (weakly):
+            // then only its interval is checked, above.
+            continue;
+        }
         assert!(mass.estimate.is_none(), "seed {seed}: mass {:?}", mass.estimate);
-        eprintln!("seed {seed}: {}", id.notes()[1..].join("; "));
         assert!(!mass.reason.is_empty());
         let table = id.table();
         assert!(table.contains("plunger.mass,kg,false,,,,,"), "{table}");
