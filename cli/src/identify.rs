@@ -26,16 +26,20 @@
 //! `k + 1`'s temperature, as the firmware ticks on its newest reading, so a
 //! step between the first two samples is a step at `t = 0`.
 //!
-//! Parameters are fitted in logarithmic coordinates (`ln m`, `ln b`, ...),
-//! so their standard errors are relative ones and stay positive in their
-//! intervals. The 95 % interval is `value * exp(+-1.96 se_ln)` (the normal
-//! quantile: a transient has hundreds of samples, at least
-//! [`MIN_DOF`] degrees of freedom are required).
+//! Parameters are fitted in logarithmic coordinates (mass, bulk modulus,
+//! volumes) or scaled linear ones (the damping, which may be zero:
+//! [`Coord`]). Standard errors are those of [`crate::lsq::analyse`]
+//! (with pressures, each channel weighted by its own residual RMS after a
+//! first fit); the 95 % interval is the profile-likelihood one
+//! ([`Estimate::ci95`]). At least [`MIN_DOF`] degrees of freedom are
+//! required.
 //!
-//! Identifiability: a parameter whose relative standard error exceeds
-//! [`crate::calibration::REL_SE_LIMIT`] (50 %), or that lies along a
-//! direction the data do not see (rank-deficient Jacobian,
-//! [`crate::lsq::RANK_TOL`]), is reported as *not identifiable*: it is
+//! Identifiability: a parameter is reported as *not identifiable* when
+//! the Jacobian cannot separate it (rank-deficient, [`crate::lsq::RANK_TOL`]),
+//! its relative standard error exceeds [`crate::calibration::REL_SE_LIMIT`]
+//! (50 %), it runs to the edge of its plausible range, its information
+//! comes from fewer than [`MIN_EFFECTIVE_SAMPLES`] samples, or its profile
+//! likelihood is flat ([`PROFILE_MIN_RISE`], [`PROFILE_FAR`]). It is then
 //! fixed at the base file's value and the others are fitted again without
 //! it, until every remaining parameter is determined. Its value is not
 //! printed (the fit's number for it would be noise).

@@ -107,18 +107,10 @@ impl Problem<'_> {
     }
 
     fn jacobian_at(&self, x: &[f64]) -> DMatrix<f64> {
-        let mut jac = DMatrix::zeros(self.m, x.len());
-        for j in 0..x.len() {
-            let h = self.step[j];
-            let (mut xp, mut xm) = (x.to_vec(), x.to_vec());
-            xp[j] += h;
-            xm[j] -= h;
-            let (rp, rm) = (self.eval(&xp), self.eval(&xm));
-            for i in 0..self.m {
-                jac[(i, j)] = (rp[i] - rm[i]) / (2.0 * h);
-            }
-        }
-        jac
+        // Non-finite only if the penalty itself overflows: NaN makes the
+        // minimiser stop with a numerical error instead of a wrong step.
+        jacobian(|y| Some(self.eval(y)), x, self.step)
+            .unwrap_or_else(|| DMatrix::from_element(self.m, x.len(), f64::NAN))
     }
 }
 
