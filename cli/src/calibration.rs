@@ -638,7 +638,7 @@ impl Calibration {
                     .collect();
                 pts.sort_by(|a, b| a.0.total_cmp(&b.0));
                 series.push(Series {
-                    label: format!("measured, dp = {} bar", dp * 1e-5),
+                    label: format!("measured, dp = {} bar", bar(dp)),
                     points: pts,
                     dashed: true,
                     marks: true,
@@ -655,7 +655,7 @@ impl Calibration {
                     })
                     .collect();
                 series.push(Series {
-                    label: format!("fitted, dp = {} bar", dp * 1e-5),
+                    label: format!("fitted, dp = {} bar", bar(dp)),
                     points: model,
                     dashed: false,
                     marks: false,
@@ -703,7 +703,7 @@ impl Calibration {
                         marks: true,
                     },
                     Series {
-                        label: format!("fitted, dp = {} bar", core.pressure_drop * 1e-5),
+                        label: format!("fitted, dp = {} bar", bar(core.pressure_drop)),
                         points: model,
                         dashed: false,
                         marks: false,
@@ -717,6 +717,13 @@ impl Calibration {
             panels,
         }
     }
+}
+
+/// A drop [Pa] in bar for a legend, without representation noise (`6`, not
+/// `6.000000000000001`).
+fn bar(dp: f64) -> String {
+    let s = format!("{:.4}", dp * 1e-5);
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
 /// Reads a data file given to `flag` (bounded like a parameter file), or
@@ -762,6 +769,13 @@ pub struct Output {
 /// column), data that cannot determine the parameters (exit 2, naming
 /// them), a fit that does not converge (exit 1).
 pub fn calibrate(opts: &Options) -> Result<Output, CliError> {
+    if opts.pressure.is_none() && opts.displacement.is_some() {
+        return Err(CliError::Input(
+            "--displacement-data: needs --pressure-data (the displacement fit runs at the oil the pressure data \
+             give; without --pressure-data the paper's two tables are used together)"
+                .into(),
+        ));
+    }
     let base = match &opts.base {
         Some(path) => crate::input::load_raw(path, "--base")?,
         None => params_file::parse(crate::input::MODEL_EXAMPLE)?,
@@ -775,8 +789,8 @@ pub fn calibrate(opts: &Options) -> Result<Output, CliError> {
     )?)
     .map_err(|e| CliError::Input(format!("--pressure-data: {p_name}: {e}")))?;
     let displacement_path = match (&opts.pressure, &opts.displacement) {
-        (_, Some(p)) => Some(Some(p.clone())),
-        (None, None) => Some(None),
+        (Some(_), Some(p)) => Some(Some(p.clone())),
+        (None, _) => Some(None),
         (Some(_), None) => None,
     };
     let displacement = match &displacement_path {

@@ -219,6 +219,7 @@ fn the_command_reports_csv_json_and_writes_the_preset() {
     base.core.mass = 3.0;
     let params = temp_file("base.toml", &params_file::to_toml(&base));
     let preset = temp_file("out.toml", "");
+    let svg = temp_file("fit.svg", "");
     let (code, out, err) = run(&[
         "identify",
         "--params",
@@ -229,6 +230,8 @@ fn the_command_reports_csv_json_and_writes_the_preset() {
         "mass,damping",
         "--write-preset",
         &preset,
+        "--plot",
+        &svg,
         "--format",
         "json",
     ]);
@@ -242,6 +245,11 @@ fn the_command_reports_csv_json_and_writes_the_preset() {
     assert!(err.contains("degrees of freedom"), "{err}");
     let written = params_file::load(std::path::Path::new(&preset)).unwrap();
     assert_eq!(written.core.mass, mass);
+    let figure = std::fs::read_to_string(&svg).unwrap();
+    assert!(
+        figure.contains("<svg") && figure.contains("identified twin"),
+        "{figure}"
+    );
 }
 
 #[test]
