@@ -255,3 +255,37 @@ pub fn render(text: &str, format: Format) -> String {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_what_spreadsheets_write() {
+        let plain = read_numeric("t_c,x_m\n30,0.5\n40,0.75\n").unwrap();
+        assert_eq!(plain.rows, [[30.0, 0.5], [40.0, 0.75]]);
+        assert_eq!(plain.lines, [2, 3]);
+        // BOM, `;`, quotes, padding, decimal commas, CRLF, comments, blank lines.
+        let sheet =
+            read_numeric("\u{feff}# exported\r\n\"t_c\";\"x_m\"\r\n\r\n\"30\"; 0,5\r\n 40 ;\"0,75\"\r\n").unwrap();
+        assert_eq!(sheet.header, plain.header);
+        assert_eq!(sheet.rows, plain.rows);
+        let tabs = read_numeric("t_c\tx_m\n30\t0.5\n40\t0,75\n").unwrap();
+        assert_eq!(tabs.rows, plain.rows);
+        // With `,` separators a decimal comma is a column break, so a bad row.
+        let e = read_numeric("t_c,x_m\n30,0,5\n").unwrap_err();
+        assert!(e.contains("row 1 (line 2): 3 cells"), "{e}");
+    }
+
+    #[test]
+    fn errors_name_row_line_and_column() {
+        let e = read_numeric("# c\nt_c,x_m\n30,0.5\n40,x\n").unwrap_err();
+        assert_eq!(e, "row 2 (line 4), column x_m: 'x' is not a number");
+        let e = read_numeric("t_c,x_m\n30,inf\n").unwrap_err();
+        assert!(e.contains("column x_m: 'inf' is not a finite number"), "{e}");
+        assert!(read_numeric("").unwrap_err().contains("empty file"));
+        // The command's own output may hold NaN: `parse` keeps it.
+        let (_, rows) = parse("a\nNaN\n").unwrap();
+        assert!(rows[0][0].is_nan());
+    }
+}
