@@ -190,12 +190,15 @@ fn cells(text: &str) -> (Vec<&str>, Vec<Vec<&str>>) {
 }
 
 /// A cell as a JSON value: a finite number, `true`/`false`, `null` for a
-/// non-finite number (JSON has none), else a string.
+/// non-finite number (JSON has none) or an empty cell, else a string.
 fn json_value(cell: &str) -> serde_json::Value {
     use serde_json::Value;
     match cell {
         "true" => Value::Bool(true),
         "false" => Value::Bool(false),
+        // An empty cell is a value not given (e.g. a parameter `identify`
+        // could not determine).
+        "" => Value::Null,
         _ if !cell.is_empty() && cell.bytes().all(|b| b.is_ascii_digit() || b == b'-') => {
             cell.parse::<i64>().map_or_else(|_| json_value_f64(cell), Value::from)
         }

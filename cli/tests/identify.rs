@@ -166,6 +166,9 @@ fn the_paper_design_reports_its_mass_as_not_identifiable() {
         assert!(!mass.reason.is_empty());
         let table = id.table();
         assert!(table.contains("plunger.mass,kg,false,,,,,"), "{table}");
+        let json = compensator_cli::csv::render(&table, compensator_cli::csv::Format::Json);
+        let rows: Vec<serde_json::Value> = serde_json::from_str(&json).unwrap();
+        assert!(rows[0]["value"].is_null() && rows[0]["identifiable"] == false, "{json}");
         assert!(
             id.notes()
                 .iter()
