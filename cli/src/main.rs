@@ -147,11 +147,14 @@ Example:
     --write-preset my-paper.toml --plot fit.svg --format table";
 const IDENTIFY_HELP: &str = "\
 Simulates the measured temperature history with the dynamic twin in f64
-(the substeps twin-config chooses for the sample interval) and fits the
-dynamic parameters by least squares in log coordinates. A parameter whose
-relative standard error exceeds 50 %, or that the data cannot separate
-from another, is reported as not identifiable (no value printed), kept at
-the --params value, and the others are fitted again without it.
+(four times the substeps twin-config chooses for the sample interval) and
+fits the dynamic parameters by least squares. 95 % intervals are profile
+likelihood ones. A parameter is reported as not identifiable (no value
+printed; kept at the --params value, the others fitted again without it)
+when its relative standard error exceeds 50 %, the data cannot separate it
+from another, it runs to the edge of its plausible range, fewer than 10
+samples carry its information, or its profile likelihood is flat
+(docs/calibration.md).
 
 Data: time_s [s] (uniform samples), t_c [C], x_m [m], optionally
 p_a_pa, p_b_pa [Pa]; the record starts at rest at the first temperature.
