@@ -324,8 +324,9 @@ fn synthetic_data_recover_the_parameters_within_their_reported_standard_errors()
     }
     let rms = (z_all.iter().map(|z| z * z).sum::<f64>() / z_all.len() as f64).sqrt();
     let within2 = z_all.iter().filter(|z| z.abs() <= 2.0).count() as f64 / z_all.len() as f64;
+    let worst = z_all.iter().fold(0.0f64, |m, z| m.max(z.abs()));
     eprintln!(
-        "normalised errors: RMS {rms:.3}, {:.1} % within 2 standard errors",
+        "normalised errors: RMS {rms:.3}, {:.1} % within 2 standard errors, largest {worst:.2}",
         100.0 * within2
     );
     assert!((0.7..=1.3).contains(&rms), "RMS of normalised errors {rms}");
