@@ -111,39 +111,132 @@ impl Table {
     }
 }
 
-/// Parses CSV text with a header row into (header, rows of numbers).
-/// Lines starting with `#` are comments.
-pub fn parse(text: &str) -> Result<(Vec<String>, Vec<Vec<f64>>), String> {
-    let mut lines = text
+/// A table of numbers read from a data file: its header and its rows, with
+/// each row's line number in the file (for error messages).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Numeric {
+    /// Column names, trimmed.
+    pub header: Vec<String>,
+    /// Rows of finite numbers, each as wide as the header.
+    pub rows: Vec<Vec<f64>>,
+    /// Line of each row in the file (1-based).
+    pub lines: Vec<u64>,
+}
+
+impl Numeric {
+    /// Index of column `name`, if present.
+    pub fn column(&self, name: &str) -> Option<usize> {
+        self.header.iter().position(|h| h == name)
+    }
+}
+
+/// The field separator of a data file: `;` or a tab when its header line
+/// (the first line that is neither blank nor a `#` comment) has one and no
+/// comma, else `,`.
+fn detect_delimiter(text: &str) -> u8 {
+    let header = text
         .lines()
-        .filter(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-    let header: Vec<String> = lines
-        .next()
-        .ok_or("empty CSV")?
-        .split(',')
-        .map(|s| s.trim().to_string())
+        .find(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
+        .unwrap_or("");
+    if header.contains(',') {
+        b','
+    } else if header.contains(';') {
+        b';'
+    } else if header.contains('\t') {
+        b'\t'
+    } else {
+        b','
+    }
+}
+
+/// Reads a data file's text (as a spreadsheet exports it) into numbers,
+/// with the `csv` crate: a UTF-8 byte-order mark is skipped, the separator
+/// is detected (`,`, `;` or tab, [`detect_delimiter`]), cells may be quoted
+/// and padded with spaces, lines starting with `#` are comments, blank
+/// lines are skipped. With `;` or tab separators a decimal comma (`0,5`) is
+/// read as a decimal point, as such spreadsheets write it.
+///
+/// Errors (one line each): an empty file, a row whose width differs from
+/// the header's, a cell that is not a finite number; a cell's error names
+/// its data row (1-based, the header not counted), its line in the file
+/// and its column by name.
+pub fn read_numeric(text: &str) -> Result<Numeric, String> {
+    read(text, true)
+}
+
+/// [`read_numeric`], accepting `NaN` and infinities unless `finite_only`.
+fn read(text: &str, finite_only: bool) -> Result<Numeric, String> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let delimiter = detect_delimiter(text);
+    let mut reader = ::csv::ReaderBuilder::new()
+        .delimiter(delimiter)
+        .comment(Some(b'#'))
+        .trim(::csv::Trim::All)
+        .flexible(true)
+        .has_headers(true)
+        .from_reader(text.as_bytes());
+    let header: Vec<String> = reader
+        .headers()
+        .map_err(|e| format!("header: {e}"))?
+        .iter()
+        .map(str::to_string)
         .collect();
-    let mut rows = Vec::new();
-    for (i, line) in lines.enumerate() {
-        let row: Vec<f64> = line
-            .split(',')
-            .map(|s| {
-                s.trim()
-                    .parse::<f64>()
-                    .map_err(|_| format!("row {}: '{}' is not a number", i + 1, s.trim()))
-            })
-            .collect::<Result<_, _>>()?;
-        if row.len() != header.len() {
+    if header.iter().all(String::is_empty) {
+        return Err("empty file: no header row".into());
+    }
+    let mut out = Numeric {
+        header,
+        rows: Vec::new(),
+        lines: Vec::new(),
+    };
+    for (i, record) in reader.records().enumerate() {
+        let row_no = i + 1;
+        let record = record.map_err(|e| format!("row {row_no}: {e}"))?;
+        let line = record.position().map_or(0, |p| p.line());
+        if record.iter().all(str::is_empty) {
+            continue;
+        }
+        if record.len() != out.header.len() {
             return Err(format!(
-                "row {}: {} columns, header has {}",
-                i + 1,
-                row.len(),
-                header.len()
+                "row {row_no} (line {line}): {} cells, the header has {} columns",
+                record.len(),
+                out.header.len()
             ));
         }
-        rows.push(row);
+        let row = record
+            .iter()
+            .zip(&out.header)
+            .map(|(cell, name)| {
+                let parsed = cell.parse::<f64>().or_else(|e| {
+                    if delimiter != b',' && cell.matches(',').count() == 1 && !cell.contains('.') {
+                        cell.replace(',', ".").parse::<f64>()
+                    } else {
+                        Err(e)
+                    }
+                });
+                match parsed {
+                    Ok(v) if v.is_finite() || !finite_only => Ok(v),
+                    Ok(_) => Err(format!(
+                        "row {row_no} (line {line}), column {name}: '{cell}' is not a finite number"
+                    )),
+                    Err(_) => Err(format!(
+                        "row {row_no} (line {line}), column {name}: '{cell}' is not a number"
+                    )),
+                }
+            })
+            .collect::<Result<Vec<f64>, String>>()?;
+        out.rows.push(row);
+        out.lines.push(line);
     }
-    Ok((header, rows))
+    Ok(out)
+}
+
+/// Parses CSV text with a header row into (header, rows of numbers), as
+/// [`read_numeric`] but accepting `NaN` and infinities (a command's own
+/// output may hold them).
+pub fn parse(text: &str) -> Result<(Vec<String>, Vec<Vec<f64>>), String> {
+    let t = read(text, false)?;
+    Ok((t.header, t.rows))
 }
 
 /// Output format of a table: the CSV itself, JSON (an array of one object
@@ -169,7 +262,7 @@ pub fn cells(text: &str) -> (Vec<&str>, Vec<Vec<&str>>) {
 
 /// A cell as a JSON value: a finite number, `true`/`false`, `null` for a
 /// non-finite number (JSON has none) or an empty cell (a row that could not
-/// be computed), else a string.
+/// be computed, a parameter `identify` could not determine), else a string.
 fn json_value(cell: &str) -> serde_json::Value {
     use serde_json::Value;
     match cell {
@@ -247,5 +340,39 @@ pub fn render(text: &str, format: Format) -> String {
             }
             out
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_what_spreadsheets_write() {
+        let plain = read_numeric("t_c,x_m\n30,0.5\n40,0.75\n").unwrap();
+        assert_eq!(plain.rows, [[30.0, 0.5], [40.0, 0.75]]);
+        assert_eq!(plain.lines, [2, 3]);
+        // BOM, `;`, quotes, padding, decimal commas, CRLF, comments, blank lines.
+        let sheet =
+            read_numeric("\u{feff}# exported\r\n\"t_c\";\"x_m\"\r\n\r\n\"30\"; 0,5\r\n 40 ;\"0,75\"\r\n").unwrap();
+        assert_eq!(sheet.header, plain.header);
+        assert_eq!(sheet.rows, plain.rows);
+        let tabs = read_numeric("t_c\tx_m\n30\t0.5\n40\t0,75\n").unwrap();
+        assert_eq!(tabs.rows, plain.rows);
+        // With `,` separators a decimal comma is a column break, so a bad row.
+        let e = read_numeric("t_c,x_m\n30,0,5\n").unwrap_err();
+        assert!(e.contains("row 1 (line 2): 3 cells"), "{e}");
+    }
+
+    #[test]
+    fn errors_name_row_line_and_column() {
+        let e = read_numeric("# c\nt_c,x_m\n30,0.5\n40,x\n").unwrap_err();
+        assert_eq!(e, "row 2 (line 4), column x_m: 'x' is not a number");
+        let e = read_numeric("t_c,x_m\n30,inf\n").unwrap_err();
+        assert!(e.contains("column x_m: 'inf' is not a finite number"), "{e}");
+        assert!(read_numeric("").unwrap_err().contains("empty file"));
+        // The command's own output may hold NaN: `parse` keeps it.
+        let (_, rows) = parse("a\nNaN\n").unwrap();
+        assert!(rows[0][0].is_nan());
     }
 }

@@ -123,14 +123,58 @@ Output: TOML with the fit's provenance in comments:
 Example:
   compensator size --params presets/paper.toml --for machine --temps 30:80:1";
 const CALIBRATE_HELP: &str = "\
-Output: a complete parameter file (TOML, SI units as in docs/model.md
-section 8) with the fit's RMS and max residuals in comments.
+Fits fluid.walther_a, fluid.walther_b and laminar_throttle.length (through
+the geometry factor G of A = G nu sqrt(rho)) to the pressure data, then
+plunger.spring_rate and plunger.preload to the displacement data; the
+other fields are the base file's. Refuses (exit 2, naming why) data that
+cannot determine them: no more points than parameters, or parameters the
+data do not separate; warns on stderr when they are barely separated.
 
-Without --base / --data the copies built into the binary are used, so the
-command works from any directory.
+Data (long form, one row per measurement; ',' ';' or tab separated, a BOM
+and quoted cells accepted, '#' lines are comments):
+  pressure:     t_c [C], dp_pa [Pa] (p_p - p_c), dp_ab_pa [Pa] (p_b - p_a)
+  displacement: t_c [C], x_m [m] (optional dp_pa [Pa]; default: the base
+                file's operating.pressure_drop)
+
+Output: CSV, one row per fitted parameter:
+  parameter, unit, value, std_error [unit], rel_std_error [-],
+  data (pressure|displacement), points, dof (points - parameters of that
+  data), residual_rms [residual_unit] (sqrt(RSS/dof)), residual_unit (Pa|m),
+  corr_<parameter> [-] (the correlation matrix, one column per parameter)
+stderr: points, dof and residual RMS per data set, and any warning.
+
+Without --pressure-data the paper's Tables 1 and 2 built into the binary
+are used (data/calibration/), so the command works from any directory.
 
 Example:
-  compensator calibrate > my-paper.toml";
+  compensator calibrate --base presets/model-example.toml \\
+    --pressure-data data/calibration/paper-pressure.csv \\
+    --displacement-data data/calibration/paper-displacement.csv \\
+    --write-preset my-paper.toml --plot fit.svg --format table";
+const IDENTIFY_HELP: &str = "\
+Simulates the measured temperature history with the dynamic twin in f64
+(four times the substeps twin-config chooses for the sample interval) and
+fits the dynamic parameters by least squares. 95 % intervals are profile
+likelihood ones. A parameter is reported as not identifiable (no value
+printed; kept at the --params value, the others fitted again without it)
+when its relative standard error exceeds 50 %, the data cannot separate it
+from another, it runs to the edge of its plausible range, fewer than 10
+samples carry its information, or its profile likelihood is flat
+(docs/calibration.md).
+
+Data: time_s [s] (uniform samples), t_c [C], x_m [m], optionally
+p_a_pa, p_b_pa [Pa]; the record starts at rest at the first temperature.
+
+Output: CSV, one row per parameter of --fit:
+  parameter, unit, identifiable (true|false), value [unit],
+  std_error [unit], rel_std_error [-], ci95_low [unit], ci95_high [unit]
+  (the numbers are empty when identifiable is false)
+stderr: the twin used, residuals, degrees of freedom, residual RMS [m]
+(and [Pa]), and why each parameter is not identifiable.
+
+Example:
+  compensator identify --params my-device.toml --data step.csv \\
+    --fit mass,damping --write-preset my-device-dynamic.toml --format table";
 const PAPER_HELP: &str = "\
 Output: a text report: Table 1 inverted for A(t) [sqrt(Pa)], Table 1
 residuals [bar], Table 2 displacements [mm], the \"asym\" column's expansion,
@@ -353,15 +397,43 @@ enum Command {
         #[arg(long, default_value = "40", allow_hyphen_values = true)]
         reference: f64,
     },
-    /// Fit a base parameter set to the paper's Tables 1 and 2; prints TOML.
+    /// Fit the static parameters to measured pressures and displacements, with standard errors.
     #[command(after_long_help = CALIBRATE_HELP)]
     Calibrate {
-        /// Base parameter file whose geometry is kept [default: the built-in presets/model-example.toml].
+        /// Base parameter file whose other fields are kept [default: the built-in presets/model-example.toml].
         #[arg(long)]
         base: Option<PathBuf>,
-        /// Folder with table1.csv and table2.csv [default: the built-in data/paper].
+        /// Pressure data t_c,dp_pa,dp_ab_pa (CSV) [default: the paper's Table 1, built in].
+        #[arg(long, value_name = "P.csv")]
+        pressure_data: Option<PathBuf>,
+        /// Displacement data t_c,x_m[,dp_pa] (CSV) [default: the paper's Table 2 without --pressure-data].
+        #[arg(long, value_name = "X.csv")]
+        displacement_data: Option<PathBuf>,
+        /// Write the calibrated parameter file (TOML, the fit in comments) to FILE.
+        #[arg(long, value_name = "FILE")]
+        write_preset: Option<PathBuf>,
+        /// Draw the data against the fitted curves (SVG).
+        #[arg(long, value_name = "FILE.svg", value_parser = plot::parse_path)]
+        plot: Option<PathBuf>,
+    },
+    /// Fit the dynamic parameters (mass, damping, compliance) to a measured transient, with intervals.
+    #[command(after_long_help = IDENTIFY_HELP)]
+    Identify {
+        /// Parameter file (TOML) with the static parameters calibrated; `-` reads standard input.
         #[arg(long)]
-        data: Option<PathBuf>,
+        params: PathBuf,
+        /// Transient time_s,t_c,x_m[,p_a_pa,p_b_pa] (CSV).
+        #[arg(long, value_name = "STEP.csv")]
+        data: PathBuf,
+        /// Parameters to fit, comma list of mass, damping, bulk_modulus, volume_a, volume_b.
+        #[arg(long, default_value = "mass,damping,bulk_modulus")]
+        fit: String,
+        /// Write the parameter file with the identified values (TOML) to FILE.
+        #[arg(long, value_name = "FILE")]
+        write_preset: Option<PathBuf>,
+        /// Draw the measured and simulated transient (SVG).
+        #[arg(long, value_name = "FILE.svg", value_parser = plot::parse_path)]
+        plot: Option<PathBuf>,
     },
     /// Reproduce the paper's tables and report the findings (text).
     #[command(after_long_help = PAPER_HELP)]
@@ -438,13 +510,11 @@ enum Command {
 
 /// A command's output in the chosen format and units, and its rows that
 /// could not be computed (failed, total): the commands that write TOML or
-/// text (`size`, `calibrate`, `paper`, `report`, `completions`, `man`)
-/// have only that.
+/// text (`size`, `paper`, `report`, `completions`, `man`) have only that.
 fn run(cli: Cli) -> Result<(String, (usize, usize)), CliError> {
     let tabular = !matches!(
         cli.command,
         Command::Size { .. }
-            | Command::Calibrate { .. }
             | Command::Paper { .. }
             | Command::Report { .. }
             | Command::Completions { .. }
@@ -452,7 +522,7 @@ fn run(cli: Cli) -> Result<(String, (usize, usize)), CliError> {
     );
     if !tabular && cli.format != Format::Csv {
         return Err(CliError::Input(
-            "--format: size, calibrate, paper, report, completions and man write files, TOML or text; \
+            "--format: size, paper, report, completions and man write files, TOML or text; \
              json and table apply to the CSV commands"
                 .into(),
         ));
@@ -460,11 +530,11 @@ fn run(cli: Cli) -> Result<(String, (usize, usize)), CliError> {
     if cli.units != Units::Si
         && matches!(
             cli.command,
-            Command::Size { .. } | Command::Calibrate { .. } | Command::Paper { .. }
+            Command::Size { .. } | Command::Calibrate { .. } | Command::Identify { .. } | Command::Paper { .. }
         )
     {
         return Err(CliError::Input(
-            "--units: size and calibrate write a parameter file and paper its report in the file's SI units; \
+            "--units: size, calibrate and identify write parameter values and paper its report in the file's SI units; \
              eng applies to the tables, figures and report"
                 .into(),
         ));
@@ -626,7 +696,46 @@ fn run_command(command: Command, units: Units) -> Result<String, CliError> {
             temps,
             reference,
         } => sizing::size(&params, &what, &temps, reference),
-        Command::Calibrate { base, data } => calibration::calibrate(base.as_deref(), data.as_deref()),
+        Command::Calibrate {
+            base,
+            pressure_data,
+            displacement_data,
+            write_preset,
+            plot: figure,
+        } => {
+            let out = calibration::calibrate(&calibration::Options {
+                base,
+                pressure: pressure_data,
+                displacement: displacement_data,
+                write_preset,
+                plot: figure,
+            })?;
+            let mut stderr = std::io::stderr().lock();
+            for line in &out.notes {
+                let _ = writeln!(stderr, "calibrate: {line}");
+            }
+            Ok(out.table)
+        }
+        Command::Identify {
+            params,
+            data,
+            fit,
+            write_preset,
+            plot: figure,
+        } => {
+            let (table, notes) = compensator_cli::identify::identify(&compensator_cli::identify::Options {
+                params,
+                data,
+                fit: Some(fit),
+                write_preset,
+                plot: figure,
+            })?;
+            let mut stderr = std::io::stderr().lock();
+            for line in &notes {
+                let _ = writeln!(stderr, "identify: {line}");
+            }
+            Ok(table)
+        }
         Command::Paper { params, data } => paper::report(params.as_deref(), data.as_deref()),
         Command::Report { params, data, out, png } => report::report(&report::Options {
             params: params.as_deref(),

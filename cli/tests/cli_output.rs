@@ -8,7 +8,7 @@ use std::process::{Command, Stdio};
 mod common;
 use common::{cli, root, run, run_in};
 
-const COMMANDS: [&str; 15] = [
+const COMMANDS: [&str; 16] = [
     "equilibrium",
     "asymptotic",
     "sensitivity",
@@ -19,6 +19,7 @@ const COMMANDS: [&str; 15] = [
     "compensation",
     "size",
     "calibrate",
+    "identify",
     "paper",
     "report",
     "sweep",
@@ -60,13 +61,15 @@ fn calibrate_and_paper_work_from_any_directory() {
     assert_eq!(out, out_root, "the built-in copies are the repository's");
     let (code, out, err) = run_in(&dir, &["calibrate"], b"");
     assert_eq!(code, 0, "{err}");
-    assert!(out.contains("[fluid]"), "{out}");
+    assert!(out.contains("plunger.spring_rate"), "{out}");
     let (_, out_root, _) = run(&[
         "calibrate",
         "--base",
         "presets/model-example.toml",
-        "--data",
-        "data/paper",
+        "--pressure-data",
+        "data/calibration/paper-pressure.csv",
+        "--displacement-data",
+        "data/calibration/paper-displacement.csv",
     ]);
     assert_eq!(out, out_root);
     // The overrides still apply.
