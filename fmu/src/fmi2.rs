@@ -13,16 +13,24 @@ use std::ffi::{CStr, CString, c_char, c_int, c_uint, c_void};
 type Component = *mut c_void;
 type Env = *mut c_void;
 type ValueReference = c_uint;
-type Logger = unsafe extern "C" fn(Env, *const c_char, c_int, *const c_char, *const c_char, ...);
+/// `fmi2CallbackLogger`.
+pub type Logger = unsafe extern "C" fn(Env, *const c_char, c_int, *const c_char, *const c_char, ...);
 
-/// `fmi2CallbackFunctions`.
+/// `fmi2CallbackFunctions` (the memory functions are not used: the FMU
+/// declares `canNotUseMemoryManagementFunctions`).
 #[repr(C)]
 pub struct CallbackFunctions {
-    logger: Option<Logger>,
-    allocate_memory: Option<unsafe extern "C" fn(usize, usize) -> *mut c_void>,
-    free_memory: Option<unsafe extern "C" fn(*mut c_void)>,
-    step_finished: Option<unsafe extern "C" fn(Env, c_int)>,
-    component_environment: Env,
+    /// `fmi2CallbackLogger` (C-variadic; called with the message as the
+    /// format string, `%` doubled, and no further arguments).
+    pub logger: Option<Logger>,
+    /// `fmi2CallbackAllocateMemory`.
+    pub allocate_memory: Option<unsafe extern "C" fn(usize, usize) -> *mut c_void>,
+    /// `fmi2CallbackFreeMemory`.
+    pub free_memory: Option<unsafe extern "C" fn(*mut c_void)>,
+    /// `fmi2StepFinished`.
+    pub step_finished: Option<unsafe extern "C" fn(Env, c_int)>,
+    /// Passed back to the logger.
+    pub component_environment: Env,
 }
 
 /// What an instance keeps of the callbacks.

@@ -13,7 +13,8 @@ use std::ffi::{CStr, CString, c_char, c_int, c_void};
 
 type Inst = *mut c_void;
 type Env = *mut c_void;
-type LogMessage = unsafe extern "C" fn(Env, c_int, *const c_char, *const c_char);
+/// `fmi3LogMessageCallback`.
+pub type LogMessage = unsafe extern "C" fn(Env, c_int, *const c_char, *const c_char);
 
 /// What an instance keeps of the callbacks.
 #[derive(Clone, Copy)]

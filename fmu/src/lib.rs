@@ -27,8 +27,8 @@
 //! exporting one.
 
 pub mod description;
-mod fmi2;
-mod fmi3;
+pub mod fmi2;
+pub mod fmi3;
 pub mod instance;
 pub mod variables;
 
