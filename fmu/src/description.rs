@@ -66,7 +66,10 @@ fn fnv1a(bytes: &[u8], seed: u64) -> u64 {
 /// `(value reference, name, unit)` of every variable (FMI 3.0's `time`
 /// included).
 fn variable_list() -> Vec<(u32, String, Option<&'static str>)> {
-    let mut v = vec![(VR_TIME, "time".to_string(), Some("s")), (VR_T_OIL, "T_oil".into(), Some("degC"))];
+    let mut v = vec![
+        (VR_TIME, "time".to_string(), Some("s")),
+        (VR_T_OIL, "T_oil".into(), Some("degC")),
+    ];
     v.extend(
         OUTPUTS
             .iter()
@@ -185,7 +188,10 @@ pub fn model_description(version: FmiVersion, raw: &RawParams, config: &TwinConf
     x.push_str("    <Category name=\"logStatusError\" description=\"Refused calls: a parameter, a step, a state (the message names the field)\"/>\n");
     x.push_str("    <Category name=\"logStatusOk\" description=\"Information, with debug logging on (the twin's configuration)\"/>\n");
     x.push_str("  </LogCategories>\n");
-    let _ = writeln!(x, "  <DefaultExperiment startTime=\"0\" stopTime=\"1\" stepSize=\"{tick}\"/>");
+    let _ = writeln!(
+        x,
+        "  <DefaultExperiment startTime=\"0\" stopTime=\"1\" stepSize=\"{tick}\"/>"
+    );
     x.push_str("  <ModelVariables>\n");
     // (value reference, index in FMI 2.0's list) of each output.
     let mut outputs = Vec::new();
@@ -330,7 +336,11 @@ pub fn variables_markdown() -> String {
         "| `T_oil` | input | Float64 | degC | {VR_T_OIL} | | Oil temperature (start: middle of the validated range) |"
     );
     for (i, o) in OUTPUTS.iter().enumerate() {
-        let ty = if i == FLAGS_OUTPUT { "Int32 (FMI 2.0: Integer)" } else { "Float64" };
+        let ty = if i == FLAGS_OUTPUT {
+            "Int32 (FMI 2.0: Integer)"
+        } else {
+            "Float64"
+        };
         let _ = writeln!(
             s,
             "| `{}` | output | {ty} | {} | {} | | {} |",

@@ -212,7 +212,12 @@ pub unsafe extern "C" fn fmi2FreeInstance(c: Component) {
 }
 
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetDebugLogging(c: Component, on: c_int, _n: usize, _categories: *const *const c_char) -> c_int {
+pub unsafe extern "C" fn fmi2SetDebugLogging(
+    c: Component,
+    on: c_int,
+    _n: usize,
+    _categories: *const *const c_char,
+) -> c_int {
     // SAFETY: as `fmu`.
     match unsafe { fmu(c) } {
         Some(f) => {
@@ -258,10 +263,10 @@ pub unsafe extern "C" fn fmi2ExitInitializationMode(c: Component) -> c_int {
     // SAFETY: as `with`.
     let status = unsafe { with(c, Status::Error, Instance::exit_initialization) };
     // SAFETY: as `fmu`.
-    if let Some(f) = unsafe { fmu(c) } {
-        if let Some(note) = f.initialised_note() {
-            log_to(&f.logger, &f.name, Status::Ok, &note);
-        }
+    if let Some(f) = unsafe { fmu(c) }
+        && let Some(note) = f.initialised_note()
+    {
+        log_to(&f.logger, &f.name, Status::Ok, &note);
     }
     status
 }
@@ -334,11 +339,18 @@ pub unsafe extern "C" fn fmi2GetBoolean(c: Component, vr: *const ValueReference,
 }
 
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2GetString(c: Component, vr: *const ValueReference, n: usize, _v: *mut *const c_char) -> c_int {
+pub unsafe extern "C" fn fmi2GetString(
+    c: Component,
+    vr: *const ValueReference,
+    n: usize,
+    _v: *mut *const c_char,
+) -> c_int {
     // SAFETY: as `with`, `slice`.
     unsafe {
         with(c, Status::Error, |_| match slice(vr, n)?.first() {
-            Some(r) => Err(Failure::Refused(format!("value reference {r}: this FMU has no String variable"))),
+            Some(r) => Err(Failure::Refused(format!(
+                "value reference {r}: this FMU has no String variable"
+            ))),
             None => Ok(()),
         })
     }
@@ -369,7 +381,12 @@ pub unsafe extern "C" fn fmi2SetInteger(c: Component, vr: *const ValueReference,
 }
 
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetBoolean(c: Component, vr: *const ValueReference, n: usize, value: *const c_int) -> c_int {
+pub unsafe extern "C" fn fmi2SetBoolean(
+    c: Component,
+    vr: *const ValueReference,
+    n: usize,
+    value: *const c_int,
+) -> c_int {
     // SAFETY: as `with`, `slice`.
     unsafe {
         with(c, Status::Error, |i| {
@@ -382,11 +399,18 @@ pub unsafe extern "C" fn fmi2SetBoolean(c: Component, vr: *const ValueReference,
 }
 
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SetString(c: Component, vr: *const ValueReference, n: usize, _v: *const *const c_char) -> c_int {
+pub unsafe extern "C" fn fmi2SetString(
+    c: Component,
+    vr: *const ValueReference,
+    n: usize,
+    _v: *const *const c_char,
+) -> c_int {
     // SAFETY: as `with`, `slice`.
     unsafe {
         with(c, Status::Error, |_| match slice(vr, n)?.first() {
-            Some(r) => Err(Failure::Refused(format!("value reference {r}: this FMU has no String variable"))),
+            Some(r) => Err(Failure::Refused(format!(
+                "value reference {r}: this FMU has no String variable"
+            ))),
             None => Ok(()),
         })
     }
@@ -435,11 +459,11 @@ pub unsafe extern "C" fn fmi2FreeFMUstate(_c: Component, state: *mut *mut c_void
     // SAFETY: a state fmi2GetFMUstate or fmi2DeSerializeFMUstate made,
     // freed once (the caller's contract); the pointer is then cleared.
     unsafe {
-        if let Some(s) = state.as_mut() {
-            if !s.is_null() {
-                drop(Box::from_raw(*s as *mut State));
-                *s = std::ptr::null_mut();
-            }
+        if let Some(s) = state.as_mut()
+            && !s.is_null()
+        {
+            drop(Box::from_raw(*s as *mut State));
+            *s = std::ptr::null_mut();
         }
     }
     Status::Ok as c_int
@@ -462,7 +486,12 @@ pub unsafe extern "C" fn fmi2SerializedFMUstateSize(c: Component, state: *mut c_
 }
 
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi2SerializeFMUstate(c: Component, state: *mut c_void, bytes: *mut c_char, size: usize) -> c_int {
+pub unsafe extern "C" fn fmi2SerializeFMUstate(
+    c: Component,
+    state: *mut c_void,
+    bytes: *mut c_char,
+    size: usize,
+) -> c_int {
     // SAFETY: as `with`, `slice_mut`.
     unsafe {
         with(c, Status::Error, |_| {
@@ -560,7 +589,11 @@ pub unsafe extern "C" fn fmi2DoStep(c: Component, time: f64, h: f64, _no_set_pri
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn fmi2CancelStep(c: Component) -> c_int {
     // SAFETY: as `with`.
-    unsafe { with(c, Status::Error, |_| Err(unsupported("fmi2CancelStep (steps are synchronous)"))) }
+    unsafe {
+        with(c, Status::Error, |_| {
+            Err(unsupported("fmi2CancelStep (steps are synchronous)"))
+        })
+    }
 }
 
 #[unsafe(no_mangle)]

@@ -257,10 +257,10 @@ pub unsafe extern "C" fn fmi3ExitInitializationMode(c: Inst) -> c_int {
     // SAFETY: as `with`.
     let status = unsafe { with(c, Status::Error, Instance::exit_initialization) };
     // SAFETY: as `fmu`.
-    if let Some(f) = unsafe { fmu(c) } {
-        if let Some(note) = f.initialised_note() {
-            log_to(&f.logger, Status::Ok, &note);
-        }
+    if let Some(f) = unsafe { fmu(c) }
+        && let Some(note) = f.initialised_note()
+    {
+        log_to(&f.logger, Status::Ok, &note);
     }
     status
 }
@@ -304,7 +304,13 @@ pub unsafe extern "C" fn fmi3Reset(c: Inst) -> c_int {
 }
 
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3GetFloat64(c: Inst, vr: *const u32, nvr: usize, values: *mut f64, nvalues: usize) -> c_int {
+pub unsafe extern "C" fn fmi3GetFloat64(
+    c: Inst,
+    vr: *const u32,
+    nvr: usize,
+    values: *mut f64,
+    nvalues: usize,
+) -> c_int {
     // SAFETY: as `with`, `slice`.
     unsafe {
         with(c, Status::Error, |i| {
@@ -334,7 +340,13 @@ pub unsafe extern "C" fn fmi3GetInt32(c: Inst, vr: *const u32, nvr: usize, value
 }
 
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3GetBoolean(c: Inst, vr: *const u32, nvr: usize, values: *mut bool, nvalues: usize) -> c_int {
+pub unsafe extern "C" fn fmi3GetBoolean(
+    c: Inst,
+    vr: *const u32,
+    nvr: usize,
+    values: *mut bool,
+    nvalues: usize,
+) -> c_int {
     // SAFETY: as `with`, `slice`.
     unsafe {
         with(c, Status::Error, |i| {
@@ -349,7 +361,13 @@ pub unsafe extern "C" fn fmi3GetBoolean(c: Inst, vr: *const u32, nvr: usize, val
 }
 
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3SetFloat64(c: Inst, vr: *const u32, nvr: usize, values: *const f64, nvalues: usize) -> c_int {
+pub unsafe extern "C" fn fmi3SetFloat64(
+    c: Inst,
+    vr: *const u32,
+    nvr: usize,
+    values: *const f64,
+    nvalues: usize,
+) -> c_int {
     // SAFETY: as `with`, `slice`.
     unsafe {
         with(c, Status::Error, |i| {
@@ -363,7 +381,13 @@ pub unsafe extern "C" fn fmi3SetFloat64(c: Inst, vr: *const u32, nvr: usize, val
 }
 
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3SetBoolean(c: Inst, vr: *const u32, nvr: usize, values: *const bool, nvalues: usize) -> c_int {
+pub unsafe extern "C" fn fmi3SetBoolean(
+    c: Inst,
+    vr: *const u32,
+    nvr: usize,
+    values: *const bool,
+    nvalues: usize,
+) -> c_int {
     // SAFETY: as `with`, `slice`.
     unsafe {
         with(c, Status::Error, |i| {
@@ -418,11 +442,11 @@ pub unsafe extern "C" fn fmi3SetFMUState(c: Inst, state: *mut c_void) -> c_int {
 pub unsafe extern "C" fn fmi3FreeFMUState(_c: Inst, state: *mut *mut c_void) -> c_int {
     // SAFETY: a state this FMU made, freed once; the pointer is cleared.
     unsafe {
-        if let Some(s) = state.as_mut() {
-            if !s.is_null() {
-                drop(Box::from_raw(*s as *mut State));
-                *s = std::ptr::null_mut();
-            }
+        if let Some(s) = state.as_mut()
+            && !s.is_null()
+        {
+            drop(Box::from_raw(*s as *mut State));
+            *s = std::ptr::null_mut();
         }
     }
     Status::Ok as c_int
@@ -465,7 +489,12 @@ pub unsafe extern "C" fn fmi3SerializeFMUState(c: Inst, state: *mut c_void, byte
 }
 
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn fmi3DeserializeFMUState(c: Inst, bytes: *const u8, size: usize, state: *mut *mut c_void) -> c_int {
+pub unsafe extern "C" fn fmi3DeserializeFMUState(
+    c: Inst,
+    bytes: *const u8,
+    size: usize,
+    state: *mut *mut c_void,
+) -> c_int {
     // SAFETY: as `with`, `slice`.
     unsafe {
         with(c, Status::Error, |i| {

@@ -49,9 +49,14 @@ impl Phase {
         self as u8
     }
     fn from_code(c: u8) -> Option<Phase> {
-        [Phase::Instantiated, Phase::Initialization, Phase::Step, Phase::Terminated]
-            .get(c as usize)
-            .copied()
+        [
+            Phase::Instantiated,
+            Phase::Initialization,
+            Phase::Step,
+            Phase::Terminated,
+        ]
+        .get(c as usize)
+        .copied()
     }
 }
 
@@ -117,7 +122,9 @@ impl Setup {
     /// The validation's message, naming the field (`plunger.stroke: ...`).
     pub fn to_raw(&self) -> Result<RawParams, String> {
         RawParams::from_lookup(|section, key| {
-            let (i, _) = fields().enumerate().find(|(_, f)| f.section == section && f.key == key)?;
+            let (i, _) = fields()
+                .enumerate()
+                .find(|(_, f)| f.section == section && f.key == key)?;
             if section == MACHINE_FIELDS[0].section && !self.machine_present {
                 return None;
             }
@@ -163,7 +170,12 @@ fn model_error(what: &str, e: ModelError) -> String {
 }
 
 impl Sim {
-    fn new(setup: &Setup, t_oil: f64, start_time: f64, chosen: Option<(&RawParams, TwinConfig)>) -> Result<Sim, String> {
+    fn new(
+        setup: &Setup,
+        t_oil: f64,
+        start_time: f64,
+        chosen: Option<(&RawParams, TwinConfig)>,
+    ) -> Result<Sim, String> {
         let raw = setup.to_raw()?;
         let params = Params::<f32>::new(&raw).map_err(|e| e.to_string())?;
         let estimator = EstimatorConfig::new(&raw.estimator).map_err(|e| e.to_string())?;
@@ -232,7 +244,9 @@ impl Sim {
             flags: Flags::empty(),
             outputs: [f64::NAN; 10],
         };
-        sim.statics = sim.statics_at(t).map_err(|e| model_error(&format!("T_oil = {t_oil} degC"), e))?;
+        sim.statics = sim
+            .statics_at(t)
+            .map_err(|e| model_error(&format!("T_oil = {t_oil} degC"), e))?;
         let flags = sim.base_flags();
         sim.publish(flags);
         Ok(sim)
@@ -439,7 +453,9 @@ impl Instance {
             return Ok(());
         }
         let Some((i, field)) = field_of(vr) else {
-            return Err(Failure::Refused(format!("value reference {vr}: not a settable Float64")));
+            return Err(Failure::Refused(format!(
+                "value reference {vr}: not a settable Float64"
+            )));
         };
         self.settable(field.path)?;
         let v = field.check(value).map_err(|e| Failure::Refused(e.to_string()))?;
@@ -455,7 +471,9 @@ impl Instance {
     /// Another value reference, or a set after initialisation.
     pub fn set_boolean(&mut self, vr: u32, value: bool) -> Result<(), Failure> {
         if vr != VR_MACHINE_PRESENT {
-            return Err(Failure::Refused(format!("value reference {vr}: not a settable Boolean")));
+            return Err(Failure::Refused(format!(
+                "value reference {vr}: not a settable Boolean"
+            )));
         }
         self.settable("machine.present")?;
         self.setup.machine_present = value;
@@ -538,7 +556,9 @@ impl Instance {
     /// Not in the instantiated phase.
     pub fn enter_initialization(&mut self, start_time: f64) -> Result<(), Failure> {
         if self.phase != Phase::Instantiated {
-            return Err(Failure::Refused("enter initialization mode: only from the instantiated state".into()));
+            return Err(Failure::Refused(
+                "enter initialization mode: only from the instantiated state".into(),
+            ));
         }
         if !start_time.is_finite() {
             return Err(Failure::Refused(format!("start time {start_time} s is not finite")));
@@ -558,7 +578,9 @@ impl Instance {
     /// `T_oil` outside the oil model's range, or not in initialization mode.
     pub fn exit_initialization(&mut self) -> Result<(), Failure> {
         if self.phase != Phase::Initialization {
-            return Err(Failure::Refused("exit initialization mode: not in initialization mode".into()));
+            return Err(Failure::Refused(
+                "exit initialization mode: not in initialization mode".into(),
+            ));
         }
         self.ensure_sim()?;
         self.phase = Phase::Step;
@@ -575,10 +597,15 @@ impl Instance {
     /// time; `Broken` for a twin that cannot be restarted.
     pub fn do_step(&mut self, time: f64, h: f64) -> Result<(), Failure> {
         if self.phase != Phase::Step {
-            return Err(Failure::Broken("do step: only in step mode (after exit initialization)".into()));
+            return Err(Failure::Broken(
+                "do step: only in step mode (after exit initialization)".into(),
+            ));
         }
         let t_oil = self.t_oil;
-        let sim = self.sim.as_mut().ok_or_else(|| Failure::Broken("do step: not initialised".into()))?;
+        let sim = self
+            .sim
+            .as_mut()
+            .ok_or_else(|| Failure::Broken("do step: not initialised".into()))?;
         let tick = sim.tick();
         let n = (h / tick).round();
         if !(h.is_finite() && n >= 1.0 && (h - n * tick).abs() <= STEP_TOLERANCE * tick) {

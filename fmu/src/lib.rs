@@ -106,7 +106,9 @@ pub fn chosen_config(raw: &RawParams) -> Result<compensator::dynamics::TwinConfi
 pub(crate) fn guarded<T>(f: impl FnOnce() -> Result<T, Failure>) -> Result<T, Failure> {
     match std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)) {
         Ok(r) => r,
-        Err(_) => Err(Failure::Broken("internal error (a panic was caught at the FMI boundary)".into())),
+        Err(_) => Err(Failure::Broken(
+            "internal error (a panic was caught at the FMI boundary)".into(),
+        )),
     }
 }
 
@@ -145,7 +147,10 @@ mod tests {
 
     #[test]
     fn resource_locations_become_paths() {
-        assert_eq!(path_from_location("file:///tmp/a%20b/resources"), Some("/tmp/a b/resources".into()));
+        assert_eq!(
+            path_from_location("file:///tmp/a%20b/resources"),
+            Some("/tmp/a b/resources".into())
+        );
         assert_eq!(path_from_location("file:/tmp/x"), Some("/tmp/x".into()));
         assert_eq!(path_from_location("file://localhost/tmp/x"), Some("/tmp/x".into()));
         assert_eq!(path_from_location("/tmp/x/"), Some("/tmp/x/".into()));

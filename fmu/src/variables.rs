@@ -91,7 +91,10 @@ pub const FLAGS_OUTPUT: usize = 9;
 
 /// The parameter file's fields in file order: core, machine, estimator.
 pub fn fields() -> impl Iterator<Item = &'static Field> {
-    CORE_FIELDS.iter().chain(MACHINE_FIELDS.iter()).chain(ESTIMATOR_FIELDS.iter())
+    CORE_FIELDS
+        .iter()
+        .chain(MACHINE_FIELDS.iter())
+        .chain(ESTIMATOR_FIELDS.iter())
 }
 
 /// Number of parameter-file fields.
@@ -220,7 +223,7 @@ mod tests {
         vrs.sort_unstable();
         vrs.dedup();
         assert_eq!(vrs.len(), n);
-        assert_eq!(VR_FIRST_OUTPUT + OUTPUTS.len() as u32 <= VR_MACHINE_PRESENT, true);
+        assert!(VR_FIRST_OUTPUT + OUTPUTS.len() as u32 <= VR_MACHINE_PRESENT);
         for (i, f) in fields().enumerate() {
             assert_eq!(field_of(VR_FIRST_FIELD + i as u32), Some((i, f)));
         }

@@ -9,7 +9,7 @@ use compensator_fmu::description::token;
 use compensator_fmu::variables::{VR_FIRST_FIELD, VR_FIRST_OUTPUT, VR_T_OIL, VR_TIME, fields};
 use compensator_fmu::{chosen_config, fmi2, fmi3};
 use std::ffi::{CStr, CString, c_char, c_int, c_void};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 const OK: c_int = 0;
@@ -61,7 +61,7 @@ struct Fmu3 {
 }
 
 impl Fmu3 {
-    fn try_new(dir: &PathBuf, token: &str) -> (Option<Fmu3>, Vec<String>) {
+    fn try_new(dir: &Path, token: &str) -> (Option<Fmu3>, Vec<String>) {
         let log = Box::new(Log(Mutex::new(Vec::new())));
         let name = CString::new("inst").expect("name");
         let token = CString::new(token).expect("token");
@@ -91,7 +91,7 @@ impl Fmu3 {
         }
     }
 
-    fn new(dir: &PathBuf) -> Fmu3 {
+    fn new(dir: &Path) -> Fmu3 {
         Fmu3::try_new(dir, &token()).0.expect("instantiates")
     }
 
@@ -107,7 +107,12 @@ impl Fmu3 {
     fn get(&self, vr: u32) -> f64 {
         let mut v = f64::NAN;
         // SAFETY: as `set`.
-        assert_eq!(unsafe { fmi3::fmi3GetFloat64(self.inst, &vr, 1, &mut v, 1) }, OK, "{:?}", self.messages());
+        assert_eq!(
+            unsafe { fmi3::fmi3GetFloat64(self.inst, &vr, 1, &mut v, 1) },
+            OK,
+            "{:?}",
+            self.messages()
+        );
         v
     }
 
@@ -122,7 +127,10 @@ impl Fmu3 {
     fn init(&self, start: f64) -> c_int {
         // SAFETY: a live instance.
         unsafe {
-            assert_eq!(fmi3::fmi3EnterInitializationMode(self.inst, false, 0.0, start, false, 0.0), OK);
+            assert_eq!(
+                fmi3::fmi3EnterInitializationMode(self.inst, false, 0.0, start, false, 0.0),
+                OK
+            );
             fmi3::fmi3ExitInitializationMode(self.inst)
         }
     }
@@ -228,11 +236,19 @@ fn a_step_that_is_not_whole_ticks_is_discarded_and_logged() {
     assert_eq!(f.init(0.0), OK);
     let before = f.state();
     assert_eq!(f.step(0.0, 0.0015), DISCARD);
-    assert!(f.messages().iter().any(|m| m.contains("not a whole multiple")), "{:?}", f.messages());
+    assert!(
+        f.messages().iter().any(|m| m.contains("not a whole multiple")),
+        "{:?}",
+        f.messages()
+    );
     assert_eq!(f.get(VR_TIME), 0.0);
     assert_eq!(f.state(), before);
     assert_eq!(f.step(0.0, -0.001), DISCARD);
-    assert_eq!(f.step(0.5, 0.001), DISCARD, "a communication point not the instance's time");
+    assert_eq!(
+        f.step(0.5, 0.001),
+        DISCARD,
+        "a communication point not the instance's time"
+    );
     // It goes on.
     assert_eq!(f.step(0.0, 0.002), OK);
 }
@@ -242,7 +258,11 @@ fn a_bad_parameter_is_refused_naming_the_field() {
     let dir = paper_resources("bad");
     let f = Fmu3::new(&dir);
     assert_eq!(f.set(vr_of("plunger.stroke"), -1.0), ERROR);
-    assert!(f.messages().last().expect("logged").starts_with("plunger.stroke"), "{:?}", f.messages());
+    assert!(
+        f.messages().last().expect("logged").starts_with("plunger.stroke"),
+        "{:?}",
+        f.messages()
+    );
     assert_eq!(f.set(vr_of("fluid.walther_a"), f64::NAN), ERROR);
     assert!(f.messages().last().expect("logged").starts_with("fluid.walther_a"));
     // Each in its range, together against a rule: refused when
@@ -250,7 +270,11 @@ fn a_bad_parameter_is_refused_naming_the_field() {
     let stroke = f.get(vr_of("plunger.stroke"));
     assert_eq!(f.set(vr_of("plunger.preload"), 2.0 * stroke), OK);
     assert_eq!(f.init(0.0), ERROR);
-    assert!(f.messages().last().expect("logged").contains("plunger.preload"), "{:?}", f.messages());
+    assert!(
+        f.messages().last().expect("logged").contains("plunger.preload"),
+        "{:?}",
+        f.messages()
+    );
     // Parameters are fixed after initialisation.
     let g = Fmu3::new(&dir);
     assert_eq!(g.init(0.0), OK);
@@ -263,14 +287,26 @@ fn an_invalid_packaged_file_or_token_fails_instantiation_cleanly() {
     let text: String = std::fs::read_to_string(preset())
         .expect("preset")
         .lines()
-        .map(|l| if l.starts_with("spring_rate") { "spring_rate = -5.0\n".to_string() } else { format!("{l}\n") })
+        .map(|l| {
+            if l.starts_with("spring_rate") {
+                "spring_rate = -5.0\n".to_string()
+            } else {
+                format!("{l}\n")
+            }
+        })
         .collect();
     let dir = resources("invalid", &text);
     let (f, messages) = Fmu3::try_new(&dir, &token());
     assert!(f.is_none());
-    assert!(messages.iter().any(|m| m.contains("plunger.spring_rate")), "{messages:?}");
+    assert!(
+        messages.iter().any(|m| m.contains("plunger.spring_rate")),
+        "{messages:?}"
+    );
     let (f, messages) = Fmu3::try_new(&paper_resources("token"), "{not-the-token}");
-    assert!(f.is_none() && messages[0].contains("instantiation token"), "{messages:?}");
+    assert!(
+        f.is_none() && messages[0].contains("instantiation token"),
+        "{messages:?}"
+    );
 }
 
 #[test]
@@ -351,7 +387,10 @@ fn a_state_rolls_back_exactly_in_memory_and_serialised() {
     let mut restored = std::ptr::null_mut();
     // SAFETY: as above.
     unsafe {
-        assert_eq!(fmi3::fmi3DeserializeFMUState(g.inst, bytes.as_ptr(), size, &mut restored), OK);
+        assert_eq!(
+            fmi3::fmi3DeserializeFMUState(g.inst, bytes.as_ptr(), size, &mut restored),
+            OK
+        );
         assert_eq!(fmi3::fmi3SetFMUState(g.inst, restored), OK);
         assert_eq!(fmi3::fmi3FreeFMUState(g.inst, &mut restored), OK);
     }
@@ -359,7 +398,10 @@ fn a_state_rolls_back_exactly_in_memory_and_serialised() {
     // Bytes that are not a state are refused, and change nothing.
     let mut junk = std::ptr::null_mut();
     // SAFETY: as above.
-    assert_eq!(unsafe { fmi3::fmi3DeserializeFMUState(g.inst, bytes.as_ptr(), size - 1, &mut junk) }, ERROR);
+    assert_eq!(
+        unsafe { fmi3::fmi3DeserializeFMUState(g.inst, bytes.as_ptr(), size - 1, &mut junk) },
+        ERROR
+    );
     assert!(junk.is_null());
 }
 
@@ -385,7 +427,7 @@ fn an_unusable_temperature_is_flagged_not_used() {
 struct Fmu2(*mut c_void);
 
 impl Fmu2 {
-    fn new(dir: &PathBuf, guid: &str) -> Option<Fmu2> {
+    fn new(dir: &Path, guid: &str) -> Option<Fmu2> {
         let callbacks = fmi2::CallbackFunctions {
             logger: None,
             allocate_memory: None,

@@ -98,7 +98,11 @@ fn check(version: FmiVersion, raw: &RawParams) {
         assert_eq!(var.causality, "parameter");
         let start: f64 = var.start.as_deref().expect("start").parse().expect("number");
         assert_eq!(start, inst.get_real(var.vr).expect("readable"), "{}", var.name);
-        assert!(var.min.expect("min") <= start && start <= var.max.expect("max"), "{}", var.name);
+        assert!(
+            var.min.expect("min") <= start && start <= var.max.expect("max"),
+            "{}",
+            var.name
+        );
         assert_eq!(var.max, Some(field.max));
         assert_eq!(var.unit.is_none(), field.unit == "-", "{}", var.name);
     }
@@ -139,7 +143,10 @@ fn check(version: FmiVersion, raw: &RawParams) {
     let out_vrs: Vec<u32> = outputs.iter().map(|v| v.vr).collect();
     match version {
         FmiVersion::V2 => {
-            let outs = structure.children().find(|n| n.has_tag_name("Outputs")).expect("Outputs");
+            let outs = structure
+                .children()
+                .find(|n| n.has_tag_name("Outputs"))
+                .expect("Outputs");
             let init = structure
                 .children()
                 .find(|n| n.has_tag_name("InitialUnknowns"))
@@ -188,7 +195,9 @@ fn a_file_without_a_machine_starts_with_it_absent() {
     let mut raw = params("paper.toml");
     raw.machine = None;
     let xml = model_description(FmiVersion::V3, &raw, &chosen_config(&raw).expect("chosen"));
-    assert!(xml.contains("name=\"machine.present\" valueReference=\"100\" causality=\"parameter\" variability=\"fixed\" start=\"false\""));
+    assert!(xml.contains(
+        "name=\"machine.present\" valueReference=\"100\" causality=\"parameter\" variability=\"fixed\" start=\"false\""
+    ));
     check(FmiVersion::V2, &raw);
     check(FmiVersion::V3, &raw);
 }

@@ -6,7 +6,7 @@
 //!                                                build the board image, flash it with probe-rs
 //! cargo xtask test [--bless]                     everything CI checks (the test command)
 //! cargo xtask build [--params F]                 build every firmware image
-//! cargo xtask fmu [--params F] [--fmi-version 2|3] [--out DIR]
+//! cargo xtask fmu [--params F] [--fmi-version 2|3] [--out DIR] [--debug]
 //!                                                the twin as a co-simulation FMU (target/fmu/compensator.fmu)
 //! cargo xtask fmu-check                          the FMU checked by FMPy (part of `test`)
 //! cargo xtask bench [--params F] [--write]       cost (the twin as built for F), footprint and stack on the emulated MCUs
@@ -154,6 +154,10 @@ enum Command {
         /// [default: target/fmu]
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
+        /// Build the binary with the dev profile (quicker; debug assertions on;
+        /// the same f32 arithmetic) instead of release
+        #[arg(long)]
+        debug: bool,
     },
     /// The FMU (FMI 2.0 and 3.0) validated and simulated by FMPy in a venv (part of `test`)
     FmuCheck,
@@ -208,7 +212,8 @@ fn main() -> ExitCode {
             params,
             fmi_version,
             out,
-        } => cmd_fmu(&params, &fmi_version, out.as_deref()),
+            debug,
+        } => cmd_fmu(&params, &fmi_version, out.as_deref(), debug),
         Command::FmuCheck => cmd_fmu_check(),
         Command::Msrv => msrv::check(&root()).map(|_| 0).map_err(Failure::from),
         Command::Toolchain => toolchain::get(&root(), &firmware::TARGETS)
@@ -277,8 +282,8 @@ fn cmd_build(params: &ParamsArg) -> Outcome {
     Ok(0)
 }
 
-/// `cargo xtask fmu [--params F] [--fmi-version 2|3] [--out DIR]`.
-fn cmd_fmu(params: &ParamsArg, fmi_version: &str, out: Option<&Path>) -> Outcome {
+/// `cargo xtask fmu [--params F] [--fmi-version 2|3] [--out DIR] [--debug]`.
+fn cmd_fmu(params: &ParamsArg, fmi_version: &str, out: Option<&Path>, debug: bool) -> Outcome {
     let params = params_file(params)?;
     let version = match fmi_version {
         "3" => compensator_fmu::description::FmiVersion::V3,
@@ -289,7 +294,12 @@ fn cmd_fmu(params: &ParamsArg, fmi_version: &str, out: Option<&Path>) -> Outcome
         Some(o) => std::env::current_dir().map_err(|e| e.to_string())?.join(o),
         None => root.join("target/fmu"),
     };
-    let path = fmu::build(&root, params.as_deref(), version, &out)?;
+    let profile = if debug {
+        fmu::Profile::Dev
+    } else {
+        fmu::Profile::Release
+    };
+    let path = fmu::build(&root, params.as_deref(), version, profile, &out)?;
     println!("{}", path.display());
     Ok(0)
 }
@@ -592,14 +602,25 @@ mod tests {
                 params: params(None),
                 fmi_version: "2".into(),
                 out: None,
+                debug: false,
             })
         );
         assert_eq!(
-            parse(&["fmu", "--params", "f.toml", "--fmi-version", "3", "--out", "dist"]),
+            parse(&[
+                "fmu",
+                "--params",
+                "f.toml",
+                "--fmi-version",
+                "3",
+                "--out",
+                "dist",
+                "--debug"
+            ]),
             Ok(Command::Fmu {
                 params: params(Some("f.toml")),
                 fmi_version: "3".into(),
                 out: Some("dist".into()),
+                debug: true,
             })
         );
         assert_eq!(parse(&["fmu-check"]), Ok(Command::FmuCheck));
