@@ -391,6 +391,11 @@ pub struct Instance {
 /// Tolerance on a communication step's length, as a fraction of the tick.
 const STEP_TOLERANCE: f64 = 1e-6;
 
+/// Most ticks one communication step may take (10,000 s at 1 kHz, a few
+/// seconds of computing): a larger step is refused rather than left to
+/// run for hours.
+pub const MAX_TICKS_PER_STEP: f64 = 1e7;
+
 impl Instance {
     /// An instance with the values of `raw` (the packaged parameter file),
     /// the input at its start value.
@@ -593,8 +598,8 @@ impl Instance {
     /// # Errors
     ///
     /// `Refused` (nothing done: FMI `Discard`) for a step that is not a
-    /// whole, positive number of ticks or does not start at the instance's
-    /// time; `Broken` for a twin that cannot be restarted.
+    /// whole, positive number of ticks (at most [`MAX_TICKS_PER_STEP`]) or
+    /// does not start at the instance's time; `Broken` for a twin that cannot be restarted.
     pub fn do_step(&mut self, time: f64, h: f64) -> Result<(), Failure> {
         if self.phase != Phase::Step {
             return Err(Failure::Broken(
@@ -611,6 +616,11 @@ impl Instance {
         if !(h.is_finite() && n >= 1.0 && (h - n * tick).abs() <= STEP_TOLERANCE * tick) {
             return Err(Failure::Refused(format!(
                 "communication step {h} s is not a whole multiple of the twin's tick {tick} s (estimator.tick_hz)"
+            )));
+        }
+        if n > MAX_TICKS_PER_STEP {
+            return Err(Failure::Refused(format!(
+                "communication step {h} s is more than {MAX_TICKS_PER_STEP} ticks of {tick} s: take shorter steps"
             )));
         }
         let now = sim.time();
@@ -795,5 +805,67 @@ impl Reader<'_> {
     }
     fn f64(&mut self) -> Option<f64> {
         Some(f64::from_le_bytes(self.take(8)?.try_into().ok()?))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn preset(name: &str) -> RawParams {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../presets")
+            .join(name);
+        compensator_params::file::load(&path).expect("preset loads")
+    }
+
+    #[test]
+    fn the_values_of_a_file_give_the_file_back() {
+        for name in ["paper.toml", "model-example.toml"] {
+            let mut raw = preset(name);
+            assert_eq!(Setup::from_raw(&raw).to_raw(), Ok(raw));
+            raw.machine = None;
+            let setup = Setup::from_raw(&raw);
+            assert!(!setup.machine_present);
+            assert_eq!(setup.to_raw(), Ok(raw));
+        }
+    }
+
+    #[test]
+    fn every_damaged_state_is_refused_and_changes_nothing() {
+        let raw = preset("paper.toml");
+        let mut inst = Instance::new(&raw);
+        inst.set_real(VR_T_OIL, 35.0).expect("input");
+        inst.enter_initialization(0.0).expect("init");
+        inst.exit_initialization().expect("initialised");
+        inst.set_real(VR_T_OIL, 75.0).expect("input");
+        inst.do_step(0.0, 0.01).expect("steps");
+        let bytes = inst.serialize();
+        let x = inst.get_real(VR_FIRST_OUTPUT).expect("x");
+        for len in 0..bytes.len() {
+            assert!(inst.deserialize(&bytes[..len]).is_err(), "a state cut at {len} bytes");
+        }
+        let mut longer = bytes.clone();
+        longer.push(0);
+        assert!(inst.deserialize(&longer).is_err());
+        let mut other = bytes.clone();
+        other[4] ^= 1;
+        assert!(inst.deserialize(&other).is_err(), "another format version");
+        assert_eq!(inst.get_real(VR_FIRST_OUTPUT), Ok(x));
+        assert_eq!(inst.phase(), Phase::Step);
+        assert!(inst.deserialize(&bytes).is_ok());
+        assert_eq!(inst.serialize(), bytes);
+    }
+
+    #[test]
+    fn outputs_are_refused_before_initialization_mode() {
+        let mut inst = Instance::new(&preset("paper.toml"));
+        assert!(matches!(inst.get_real(VR_FIRST_OUTPUT), Err(Failure::Refused(m)) if m.starts_with("x:")));
+        assert!(inst.get_integer(VR_FIRST_OUTPUT + FLAGS_OUTPUT as u32).is_err());
+        assert!(inst.get_real(VR_MACHINE_PRESENT).is_err());
+        assert!(inst.do_step(0.0, 0.001).is_err());
+        inst.enter_initialization(0.0).expect("init");
+        // The twin at rest: no velocity.
+        assert_eq!(inst.get_real(VR_FIRST_OUTPUT + 1), Ok(0.0));
     }
 }
