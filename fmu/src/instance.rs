@@ -159,6 +159,10 @@ struct Sim {
     /// Temperature of the twin's coefficients [C].
     applied: f32,
     statics: Statics,
+    /// The last temperature-only results could not be computed at
+    /// `applied` (the previous ones stand, flagged `DEGRADED`, until they
+    /// can).
+    stale: bool,
     ticks: u64,
     start_time: f64,
     flags: Flags,
@@ -239,6 +243,7 @@ impl Sim {
                 stable: true,
                 losses: f32::NAN,
             },
+            stale: false,
             ticks: 0,
             start_time,
             flags: Flags::empty(),
@@ -343,10 +348,13 @@ impl Sim {
             // (held over this communication step, so once).
             match self.twin.set_temperature(t) {
                 Ok(()) => {
-                    if t != self.applied {
+                    if t != self.applied || self.stale {
                         match self.statics_at(t) {
-                            Ok(s) => self.statics = s,
-                            Err(_) => flags.insert(Flags::DEGRADED),
+                            Ok(s) => {
+                                self.statics = s;
+                                self.stale = false;
+                            }
+                            Err(_) => self.stale = true,
                         }
                         self.applied = t;
                     }
@@ -367,6 +375,9 @@ impl Sim {
                 flags.insert(Flags::DEGRADED);
             }
             self.ticks += 1;
+        }
+        if self.stale {
+            flags.insert(Flags::DEGRADED);
         }
         let mut all = self.base_flags();
         all.insert(flags);
@@ -738,9 +749,10 @@ impl Instance {
                     sim.twin
                         .set_temperature(applied)
                         .map_err(|e| Failure::Refused(model_error("FMU state: temperature", e)))?;
-                    sim.statics = sim
-                        .statics_at(applied)
-                        .map_err(|e| Failure::Refused(model_error("FMU state: temperature", e)))?;
+                    match sim.statics_at(applied) {
+                        Ok(st) => sim.statics = st,
+                        Err(_) => sim.stale = true,
+                    }
                     sim.applied = applied;
                 }
                 sim.twin.restore(&TwinMemory {
