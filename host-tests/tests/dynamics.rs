@@ -257,3 +257,31 @@ fn reduced_model_tracks_the_full_one_within_its_documented_error() {
         assert!((full.state[300].x - red.state[300].x).abs() <= 1e-9 * raw.core.stroke);
     }
 }
+
+/// `choose` answers for every positive tick, however coarse: a tick
+/// beyond MAX_PROBE / 20 (25 ms) once crossed the bounds of a `clamp` and
+/// panicked (the CLI's `step --dt 10`, an FMU at `tick_hz` below 40).
+#[test]
+fn the_chooser_answers_for_any_tick_without_panicking() {
+    use compensator::dynamics::config::choose;
+    use compensator::dynamics::twin::MAX_SUBSTEPS;
+    let mut rng = Rng::new(0x7eed);
+    let designs: Vec<compensator::RawParams> = std::iter::once(paper())
+        .chain((0..5).map(|_| physical_params(&mut rng)))
+        .collect();
+    for raw in &designs {
+        let p = Params::<f64>::new(raw).unwrap();
+        for tick in [1e-6, 1e-3, 0.025, 0.026, 0.1, 1.0, 10.0, 1e6] {
+            let r = std::panic::catch_unwind(|| choose(&p, tick, (30.0, 70.0)));
+            let choice = r.unwrap_or_else(|_| panic!("choose panicked at tick {tick} s"));
+            if let Ok(c) = choice {
+                assert_eq!(c.config.tick, tick);
+                assert!((1..=MAX_SUBSTEPS).contains(&c.config.substeps), "tick {tick}: {c:?}");
+                assert!(c.estimated_error_pct.is_finite(), "tick {tick}: {c:?}");
+            }
+        }
+        for bad in [0.0, -1e-3, f64::NAN, f64::INFINITY] {
+            assert!(choose(&p, bad, (30.0, 70.0)).is_err(), "tick {bad}");
+        }
+    }
+}

@@ -118,7 +118,10 @@ pub fn choose(params: &Params<f64>, tick: f64, valid: (f64, f64)) -> Result<Choi
         if params.oil.state(from).is_err() {
             continue;
         }
-        let duration = (5.0 / lin.dominant.re.abs()).clamp(20.0 * tick, MAX_PROBE);
+        // Five slow time constants, cut at MAX_PROBE, but at least 20
+        // ticks (a tick longer than MAX_PROBE / 20 wins over the cut: not
+        // `clamp`, which panics when its bounds cross).
+        let duration = (5.0 / lin.dominant.re.abs()).min(MAX_PROBE).max(20.0 * tick);
         let ticks = ((duration / tick) as usize).clamp(1, MAX_TICKS);
         let x = &mut fine[count][..=ticks];
         run(params, config(MAX_SUBSTEPS), from, to, x)?;
