@@ -40,8 +40,8 @@
 //!   the first, `stable` exactly when every real part is negative,
 //!   damping ratios in `[-1, 1]`, `on_stop` as the closed form's stop;
 //!   Routh-Hurwitz on the same Jacobian (the estimator's verdict) agrees
-//!   wherever no eigenvalue lies within `1e-6 |lambda|_max` of the
-//!   imaginary axis.
+//!   wherever no eigenvalue lies within `1e-4 |lambda|_max` of the
+//!   imaginary axis and its products do not overflow (finding F4).
 
 use crate::check;
 use crate::input::{SPECIAL_TEMPERATURES, byte, float, presets, temperature, word};
@@ -343,7 +343,9 @@ fn linear(p: &Params<f64>, t: f64, e: &Equilibrium<f64>, what: &dyn Fn() -> Stri
     );
     assert_eq!(lin.on_stop, e.stop != Stop::Free, "{}: on_stop vs {:?}", what(), e.stop);
     let largest = ev.iter().map(|l| l.abs()).fold(0.0, f64::max);
-    let clear = ev.iter().all(|l| l.re.abs() > 1e-6 * largest);
+    // Clear of the axis by 1e-4 of the spread: at 6e-6 the two verdicts
+    // were seen to differ on a design with dp = 1e30 Pa (finding F4).
+    let clear = ev.iter().all(|l| l.re.abs() > 1e-4 * largest);
     // Finding F4 (docs/fuzzing.md): `hurwitz_stable` forms products of
     // the characteristic polynomial's coefficients; where they overflow
     // (a spring of 1e-106 N/m under 4e93 Pa, accepted by validation) it

@@ -11,7 +11,8 @@
 //!   sanitizer: the core has no `unsafe` (it forbids `unsafe_op_in_unsafe_fn`
 //!   and has none), what is looked for is panics and broken promises.
 //! * The runs: `cargo fuzz run` per target with the committed seeds
-//!   (`fuzz/corpus/<target>`, read only) behind a working corpus under
+//!   (`fuzz/corpus/<target>`, read only) and the findings' inputs
+//!   (`fuzz/artifacts/<target>`, read only) behind a working corpus under
 //!   `target/fuzz/corpus/<target>` (where libFuzzer adds what it finds),
 //!   crash inputs under `target/fuzz/artifacts/<target>/`, libFuzzer's log
 //!   under `target/fuzz/logs/<target>.log`. A crash fails the command
@@ -171,8 +172,13 @@ fn run_target(cargo: &str, root: &Path, target: &str, opts: &Options) -> Result<
         .args(BUILD_FLAGS)
         .arg(target)
         .arg(&work)
-        .arg(root.join("fuzz/corpus").join(target))
-        .arg("--")
+        .arg(root.join("fuzz/corpus").join(target));
+    // The findings' inputs (docs/fuzzing.md), replayed as regressions.
+    let findings = root.join("fuzz/artifacts").join(target);
+    if findings.is_dir() {
+        cmd.arg(findings);
+    }
+    cmd.arg("--")
         .arg(format!("-artifact_prefix={}/", artifacts.display()))
         // One input running for a minute is a hang, reported as a crash.
         .arg("-timeout=60")
