@@ -38,6 +38,29 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
     exit(false)
 }
 
+/// The estimator's settings from the parameter file's `[estimator]`
+/// section with the twin configuration the build chose (`TWIN_SCHEME`,
+/// `TWIN_SUBSTEPS`); a refused section or configuration is logged (the
+/// field, or what is wrong) and ends the run with exit code 1.
+pub fn built_estimator_config(
+    raw: &compensator::params::RawEstimator,
+    scheme: &str,
+    substeps: u8,
+) -> compensator::estimator::EstimatorConfig {
+    let mut config = match compensator::estimator::EstimatorConfig::new(raw) {
+        Ok(c) => c,
+        Err(e) => {
+            defmt::error!("estimator settings rejected: {=str}", e.field);
+            exit(false)
+        }
+    };
+    if let Err(what) = crate::use_built_twin(&mut config, scheme, substeps) {
+        defmt::error!("twin configuration: {=str}", what);
+        exit(false)
+    }
+    config
+}
+
 /// Reports a HardFault (the stacked `pc`, `lr`, `xpsr` and the fault status
 /// registers) and ends the emulation with exit code 1.
 pub fn hard_fault(frame: &ExceptionFrame) -> ! {

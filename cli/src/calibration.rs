@@ -11,7 +11,7 @@
 
 use crate::error::CliError;
 use crate::lsq::{Fit, levenberg_marquardt};
-use crate::paper::tables::{Table1, Table2, invert_table1, table1_residuals, table2_residuals};
+use crate::paper::tables::{Table1, Table2, invert_table1, load_tables, table1_residuals, table2_residuals};
 use crate::params_file;
 use compensator::Params;
 use compensator::params::{RawCore, RawParams};
@@ -119,12 +119,18 @@ fn initial_walther(base: &RawParams, t1: &Table1, g: f64) -> Option<[f64; 2]> {
     (a.is_finite() && b.is_finite() && b > 0.0).then_some([a, b])
 }
 
-/// `calibrate`: fitted preset as TOML with its provenance in comments.
-pub fn calibrate(base_path: &Path, data: &Path) -> Result<String, CliError> {
-    let base = params_file::load(base_path)?;
-    let t1 = Table1::load(&data.join("table1.csv")).map_err(CliError::Input)?;
-    let t2 = Table2::load(&data.join("table2.csv")).map_err(CliError::Input)?;
+/// `calibrate`: fitted preset as TOML with its provenance in comments,
+/// from the base file `base_path` and the tables in `data` (without them:
+/// the built-in `presets/model-example.toml` and `data/paper/`).
+pub fn calibrate(base_path: Option<&Path>, data: Option<&Path>) -> Result<String, CliError> {
+    let base = match base_path {
+        Some(path) => crate::input::load_raw(path, "--base")?,
+        None => params_file::parse(crate::input::MODEL_EXAMPLE)?,
+    };
+    let (t1, t2) = load_tables(data).map_err(CliError::Input)?;
     let cal = fit(&base, &t1, &t2).map_err(CliError::Failed)?;
+    let base_path = base_path.unwrap_or(Path::new("presets/model-example.toml"));
+    let data = data.unwrap_or(Path::new("data/paper"));
     let mut out = String::new();
     let _ = writeln!(
         out,

@@ -75,3 +75,90 @@ pub fn parse(text: &str) -> Result<(Vec<String>, Vec<Vec<f64>>), String> {
     }
     Ok((header, rows))
 }
+
+/// Output format of a table: the CSV itself, JSON (an array of one object
+/// per row, keyed by the header), or aligned columns for a terminal.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum Format {
+    /// Comma-separated values with a header row.
+    #[default]
+    Csv,
+    /// A JSON array of objects, one per row, keyed by column name.
+    Json,
+    /// Right-aligned columns separated by two spaces.
+    Table,
+}
+
+/// Splits CSV text (as written by [`Table`]) into its header and rows of cells.
+fn cells(text: &str) -> (Vec<&str>, Vec<Vec<&str>>) {
+    let mut lines = text.lines().filter(|l| !l.is_empty());
+    let header = lines.next().map(|l| l.split(',').collect()).unwrap_or_default();
+    (header, lines.map(|l| l.split(',').collect()).collect())
+}
+
+/// A cell as a JSON value: a finite number, `true`/`false`, `null` for a
+/// non-finite number (JSON has none), else a string.
+fn json_value(cell: &str) -> serde_json::Value {
+    use serde_json::Value;
+    match cell {
+        "true" => Value::Bool(true),
+        "false" => Value::Bool(false),
+        _ if !cell.is_empty() && cell.bytes().all(|b| b.is_ascii_digit() || b == b'-') => {
+            cell.parse::<i64>().map_or_else(|_| json_value_f64(cell), Value::from)
+        }
+        _ => json_value_f64(cell),
+    }
+}
+
+/// A non-integer cell as a JSON number, `null` or string.
+fn json_value_f64(cell: &str) -> serde_json::Value {
+    use serde_json::Value;
+    match cell.parse::<f64>() {
+        Ok(v) => serde_json::Number::from_f64(v).map_or(Value::Null, Value::Number),
+        Err(_) => Value::String(cell.to_string()),
+    }
+}
+
+/// Renders CSV text with a header row in `format`.
+pub fn render(text: &str, format: Format) -> String {
+    match format {
+        Format::Csv => text.to_string(),
+        Format::Json => {
+            // Objects written by hand so that keys keep the header's order.
+            let (header, rows) = cells(text);
+            let key = |h: &str| serde_json::Value::String(h.to_string()).to_string();
+            let objects: Vec<String> = rows
+                .iter()
+                .map(|row| {
+                    let fields: Vec<String> = header
+                        .iter()
+                        .zip(row)
+                        .map(|(h, c)| format!("{}: {}", key(h), json_value(c)))
+                        .collect();
+                    format!("  {{{}}}", fields.join(", "))
+                })
+                .collect();
+            if objects.is_empty() {
+                "[]\n".to_string()
+            } else {
+                format!("[\n{}\n]\n", objects.join(",\n"))
+            }
+        }
+        Format::Table => {
+            let (header, rows) = cells(text);
+            let mut width: Vec<usize> = header.iter().map(|h| h.len()).collect();
+            for row in &rows {
+                for (w, c) in width.iter_mut().zip(row) {
+                    *w = (*w).max(c.len());
+                }
+            }
+            let mut out = String::new();
+            for row in std::iter::once(&header).chain(&rows) {
+                let line: Vec<String> = row.iter().zip(&width).map(|(c, w)| format!("{c:>w$}")).collect();
+                out.push_str(&line.join("  "));
+                out.push('\n');
+            }
+            out
+        }
+    }
+}

@@ -515,3 +515,36 @@ pub fn indicators(path: &Path, steps_spec: &str, dt: f64, t_end: f64) -> Result<
     }
     Ok(table.as_str().to_string())
 }
+
+/// Ticks per output row for `step --sample S` at tick `dt`: round(S / dt),
+/// at least one; without `--sample`, every tick.
+pub fn sample_every(sample: Option<f64>, dt: f64) -> Result<usize, CliError> {
+    let Some(s) = sample else { return Ok(1) };
+    if !(dt > 0.0 && dt.is_finite()) {
+        return Ok(1); // `step` names --dt
+    }
+    if !(s > 0.0 && s.is_finite()) {
+        return Err(CliError::Input(format!("--sample: {s} must be positive")));
+    }
+    let n = (s / dt).round();
+    if !(n >= 1.0 && n.is_finite()) {
+        return Err(CliError::Input(format!(
+            "--sample: {s} s is shorter than half a tick (--dt {dt} s)"
+        )));
+    }
+    Ok(n.min(usize::MAX as f64) as usize)
+}
+
+/// CSV text with its header and every `every`-th row from the first.
+pub fn every_nth_row(csv: &str, every: usize) -> String {
+    if every <= 1 {
+        return csv.to_string();
+    }
+    let mut lines = csv.lines();
+    let mut out = String::new();
+    for line in lines.next().into_iter().chain(lines.step_by(every)) {
+        out.push_str(line);
+        out.push('\n');
+    }
+    out
+}

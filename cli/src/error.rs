@@ -2,7 +2,7 @@
 //! every command uses to turn bad input into one: loading a parameter file
 //! and a model error at a listed temperature.
 
-use crate::params_file::{self, LoadError};
+use crate::params_file::LoadError;
 use crate::temps;
 use compensator::{Float, ModelError, Params, RawParams};
 use std::fmt;
@@ -48,9 +48,9 @@ impl From<temps::TempsError> for CliError {
     }
 }
 
-/// Loads a parameter file and converts it to `T`.
+/// Loads a parameter file (`-`: standard input) and converts it to `T`.
 pub fn load_params<T: Float>(path: &Path) -> Result<(RawParams, Params<T>), CliError> {
-    let raw = params_file::load(path)?;
+    let raw = crate::input::load_raw(path, "--params")?;
     let params = Params::<T>::new(&raw).map_err(|e| CliError::Input(e.to_string()))?;
     Ok((raw, params))
 }

@@ -6,7 +6,9 @@
 //!   (compensation, size), [`calibration`] (calibrate) and [`paper`] (the
 //!   paper report, with the paper's tables in [`paper::tables`]);
 //! * their plumbing: [`error`] (a command's failure and exit status,
-//!   parameter loading), [`temps`] (temperature lists), [`csv`] (output),
+//!   parameter loading), [`input`] (bounded reading of a parameter file,
+//!   the built-in presets and paper data), [`temps`] (temperature lists), [`csv`] (output),
+//!   [`plot`] (`--plot FILE.svg`: a command's output as a figure),
 //!   [`lsq`] (the least-squares solver of the calibration).
 //!
 //! Each command is a function returning its complete standard output; the
@@ -17,8 +19,10 @@ pub mod calibration;
 pub mod csv;
 pub mod dynamics;
 pub mod error;
+pub mod input;
 pub mod lsq;
 pub mod paper;
+pub mod plot;
 pub mod sizing;
 pub mod statics;
 pub mod temps;

@@ -177,6 +177,17 @@ pub fn compensation_table(path: &Path, temps_spec: &str) -> Result<String, CliEr
     Ok(table.as_str().to_string())
 }
 
+/// A fit whose result is not a finite number failed (exit status 1),
+/// naming the first such quantity.
+fn finite(quantities: &[(&str, f64)]) -> Result<(), CliError> {
+    match quantities.iter().find(|(_, v)| !v.is_finite()) {
+        Some((name, v)) => Err(CliError::Failed(format!(
+            "{name} is {v}: the fit has no finite result for these parameters"
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// `size`: the machine a compensator serves best, or the window a machine needs.
 pub fn size(path: &Path, what: &str, temps_spec: &str, reference: f64) -> Result<String, CliError> {
     let temps = temps::parse(temps_spec)?;
@@ -185,6 +196,13 @@ pub fn size(path: &Path, what: &str, temps_spec: &str, reference: f64) -> Result
     match what {
         "machine" => {
             let f = fit_machine(&p, &temps, reference).map_err(CliError::Input)?;
+            finite(&[
+                ("working_flow", f.working_flow),
+                ("leakage_reference", f.leakage_reference),
+                ("leakage_temperature", f.leakage_temperature),
+                ("compensation error RMS", f.rms_error),
+                ("compensation error max", f.max_error),
+            ])?;
             let _ = writeln!(o, "# The machine {} serves best over {temps_spec} C", path.display());
             let _ = writeln!(
                 o,
@@ -211,6 +229,11 @@ pub fn size(path: &Path, what: &str, temps_spec: &str, reference: f64) -> Result
         }
         "slot" => {
             let f = fit_slot(&p, &temps).map_err(CliError::Input)?;
+            finite(&[
+                ("slot diameter", f.slot_diameter),
+                ("compensation error RMS", f.rms_error),
+                ("compensation error max", f.max_error),
+            ])?;
             let _ = writeln!(
                 o,
                 "# The window diameter that serves the [machine] of {} best over {temps_spec} C",
@@ -236,4 +259,19 @@ pub fn size(path: &Path, what: &str, temps_spec: &str, reference: f64) -> Result
         }
     }
     Ok(o)
+}
+
+#[cfg(test)]
+mod finite_tests {
+    use super::finite;
+
+    #[test]
+    fn a_non_finite_result_is_a_failure_naming_the_quantity() {
+        assert!(finite(&[("slot diameter", 1e-3), ("compensation error RMS", 1e-6)]).is_ok());
+        for bad in [f64::INFINITY, f64::NAN, f64::NEG_INFINITY] {
+            let e = finite(&[("slot diameter", 1e-3), ("compensation error RMS", bad)]).unwrap_err();
+            assert_eq!(e.exit_code(), 1);
+            assert!(e.to_string().starts_with("compensation error RMS is"), "{e}");
+        }
+    }
 }

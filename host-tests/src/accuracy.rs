@@ -1,5 +1,5 @@
 //! Accuracy of the fixed-step twin against the adaptive reference solver:
-//! the metric of the dynamic issue, shared by the tests and `cargo xtask
+//! the trajectory metric of the accuracy goals, shared by the tests and `cargo xtask
 //! bench`'s accuracy table.
 
 use compensator::dynamics::TwinConfig;

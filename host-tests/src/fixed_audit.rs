@@ -1,4 +1,4 @@
-//! The fixed-point audit of issue 7: the range every quantity on the
+//! The fixed-point audit: the range every quantity on the
 //! twin's tick path spans, over designs and the whole oil range.
 //!
 //! * [`coefficients`]: the twin's coefficients, by name, at the oil range's

@@ -8,8 +8,10 @@
 pub mod accuracy;
 pub mod bench;
 pub mod fixed_audit;
+pub mod matrix;
 pub mod probe;
 pub mod random;
+pub mod soak;
 pub mod survey;
 pub use compensator_reference::statics as reference;
 

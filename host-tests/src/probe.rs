@@ -1,4 +1,4 @@
-//! An instrumented scalar for the fixed-point audit (issue 7): [`Probe<T>`]
+//! An instrumented scalar for the fixed-point audit: [`Probe<T>`]
 //! computes exactly as `T` does and records, for every arithmetic
 //! operation of the code it runs, the range of the values that operation
 //! produces, keyed by the operation's place in the source (`#[track_caller]`

@@ -1,5 +1,5 @@
 //! The FSI twin against the independent adaptive reference: the accuracy
-//! goals of the dynamic issue, the reference's own cross-check, the
+//! accuracy goals of `docs/dynamics.md`, the reference's own cross-check, the
 //! linearisation against nalgebra, and the reduced model.
 
 use compensator::Params;

@@ -24,7 +24,10 @@ use crate::fluid::{Derivatives, FluidPoint, FluidState};
 use crate::params::Params;
 use crate::scalar::Float;
 
-/// Where the plunger rests.
+/// Where the plunger rests against its end stops: in a quasi-static
+/// equilibrium ([`Equilibrium::stop`]), and in the dynamic models, which
+/// name the same type [`crate::dynamics::Contact`] (held by a stop during
+/// a step, [`crate::dynamics::stops`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Stop {

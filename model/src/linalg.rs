@@ -1,5 +1,6 @@
 //! Dense `N x N` linear algebra on the stack, generic over [`Real`]:
-//! LU factorisation with partial pivoting and the matching solve.
+//! LU factorisation with partial pivoting and the matching solve; and
+//! [`eigen`], the eigenvalues of a real 4x4 matrix (EISPACK's `hqr`).
 //!
 //! Cost for `N = 4`: 4 reciprocals, 18 multiply-adds for the factorisation,
 //! 16 for each solve. No iteration, no allocation; a singular pivot is
@@ -8,6 +9,8 @@
 // Matrix code indexes rows and columns explicitly, as the algorithms are
 // written (EISPACK, Hairer & Wanner); iterator chains would obscure them.
 #![allow(clippy::needless_range_loop)]
+
+pub mod eigen;
 
 use crate::scalar::Real;
 

@@ -141,6 +141,9 @@ pub trait Float: Real {
     fn nan() -> Self;
     /// `true` for NaN.
     fn is_nan(self) -> bool;
+    /// The magnitude of `self` with the sign of `sign` (IEEE 754
+    /// `copySign`: a bit operation, also for zeros and NaN).
+    fn copysign(self, sign: Self) -> Self;
     /// Conversion to another scalar type without a detour through `f64`
     /// where the source is `f32` (no soft-double code on a Cortex-M4F).
     fn to_real<T: Real>(self) -> T;
@@ -266,6 +269,10 @@ impl Float for f32 {
         f32::is_nan(self)
     }
     #[inline]
+    fn copysign(self, sign: Self) -> Self {
+        libm::copysignf(self, sign)
+    }
+    #[inline]
     fn to_real<T: Real>(self) -> T {
         T::from_f32(self)
     }
@@ -353,6 +360,10 @@ impl Float for f64 {
     #[inline]
     fn is_nan(self) -> bool {
         f64::is_nan(self)
+    }
+    #[inline]
+    fn copysign(self, sign: Self) -> Self {
+        libm::copysign(self, sign)
     }
     #[inline]
     fn to_real<T: Real>(self) -> T {

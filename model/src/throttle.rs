@@ -7,8 +7,10 @@
 //! * The window the plunger opens: area `pi d x`, orifice law with the
 //!   window's own discharge coefficient (Eq. 7).
 //!
-//! The dynamic model needs the orifice law to be C1 at zero flow; it uses
-//! [`regularised_root`], the `regRoot` form of Modelica, Hopsan and Simscape.
+//! [`FlowLaws`] holds the three at one oil state, one coefficient each (what
+//! the estimator evaluates every tick). The dynamic model needs the orifice
+//! law to be C1 at zero flow; it uses [`regularised_root`], the `regRoot`
+//! form of Modelica, Hopsan and Simscape.
 
 use crate::scalar::{Float, Real};
 
@@ -99,6 +101,69 @@ impl<T: Float> Slot<T> {
     #[inline]
     pub fn flow(&self, x: T, dp: T, density: T) -> T {
         self.window_factor(dp) * x.max(T::ZERO) / density.sqrt()
+    }
+}
+
+/// The three throttle laws at one oil state and the design's pressure
+/// drop, each reduced to one coefficient: what changes between evaluations
+/// (a chamber's pressure drop, the opening) then costs a multiply, and a
+/// root for the orifice. The estimator keeps one, refreshed with the oil's
+/// properties, and evaluates the flows from it every tick.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FlowLaws<T> {
+    /// Capillary conductance `1 / R_l` [m^3/(s Pa)].
+    pub capillary_conductance: T,
+    /// `C_d f sqrt(2 / rho)` of the orifice [m^3/(s sqrt(Pa))].
+    pub orifice_factor: T,
+    /// `eta pi d sqrt(2 dp / rho)` of the window [m^2/s].
+    pub window_factor: T,
+}
+
+impl<T: Float> FlowLaws<T> {
+    /// The laws of `capillary`, `orifice` and the window for oil of
+    /// `density` [kg/m^3] and `dynamic_viscosity` [Pa s]. The window enters
+    /// as its [`Slot::window_factor`] at the pressure drop across it, which
+    /// does not depend on the oil: a caller evaluating the laws at many oil
+    /// states computes it once.
+    #[inline]
+    pub fn new(
+        capillary: &Capillary<T>,
+        orifice: &Orifice<T>,
+        slot_window_factor: T,
+        density: T,
+        dynamic_viscosity: T,
+    ) -> Self {
+        let inv_sqrt_rho = T::ONE / density.sqrt();
+        FlowLaws {
+            capillary_conductance: T::ONE / capillary.resistance(dynamic_viscosity),
+            orifice_factor: orifice.discharge_coefficient
+                * orifice.area()
+                * T::from_f64(core::f64::consts::SQRT_2)
+                * inv_sqrt_rho,
+            window_factor: slot_window_factor * inv_sqrt_rho,
+        }
+    }
+
+    /// Flow through the capillary for the pressure drop `drop` [Pa] across
+    /// it: `drop / R_l` [m^3/s].
+    #[inline]
+    pub fn capillary_flow(&self, drop: T) -> T {
+        drop * self.capillary_conductance
+    }
+
+    /// Signed flow through the orifice for the pressure drop `drop` [Pa]
+    /// across it: `C_d f sqrt(2 |drop| / rho) sign(drop)` [m^3/s]
+    /// ([`Orifice::flow`] with the oil's density in the coefficient).
+    #[inline]
+    pub fn orifice_flow(&self, drop: T) -> T {
+        self.orifice_factor * drop.abs().sqrt().copysign(drop)
+    }
+
+    /// Flow through the window at the opening `x` [m] (zero when closed):
+    /// `eta pi d x sqrt(2 dp / rho)` [m^3/s] ([`Slot::flow`], Eq. 7).
+    #[inline]
+    pub fn window_flow(&self, x: T) -> T {
+        self.window_factor * x.max(T::ZERO)
     }
 }
 
@@ -194,6 +259,35 @@ mod tests {
                 ((s32 as f64) - s64).abs() <= 10.0 * f32::EPSILON as f64 * s64.abs(),
                 "slope at {u}"
             );
+        }
+    }
+
+    #[test]
+    fn flow_laws_agree_with_the_laws() {
+        let capillary = Capillary {
+            diameter: 1.2e-3f64,
+            length: 0.03,
+        };
+        let orifice = Orifice {
+            diameter: 0.7e-3f64,
+            discharge_coefficient: 0.61,
+        };
+        let slot = Slot {
+            diameter: 8e-3f64,
+            discharge_coefficient: 0.7,
+        };
+        let (dp, rho, mu) = (3.0e5, 870.0, 0.02);
+        let laws = FlowLaws::new(&capillary, &orifice, slot.window_factor(dp), rho, mu);
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-14 * b.abs();
+        for drop in [2.0e5, 1.0, 0.0, -3.5e4] {
+            assert!(
+                close(laws.capillary_flow(drop), drop / capillary.resistance(mu)),
+                "{drop}"
+            );
+            assert!(close(laws.orifice_flow(drop), orifice.flow(drop, rho)), "{drop}");
+        }
+        for x in [1e-3, 2e-5, 0.0, -1e-4] {
+            assert!(close(laws.window_flow(x), slot.flow(x, dp, rho)), "{x}");
         }
     }
 

@@ -7,15 +7,23 @@
 //! tools read files with [`file::parse`]; the firmware's build script turns a
 //! file into checked constants with the same reader, so a device is flashed
 //! only with a parameter set that passed the same validation.
+//!
+//! Every field carries its plausible range beside its unit and default
+//! ([`Field::min`], [`Field::max`], [`Field::kind`]); validation checks
+//! every field against its own range before any rule between fields, so
+//! that an error names the field that is wrong. `docs/parameters.md`
+//! tabulates the fields and the bad-input matrix.
 #![cfg_attr(not(any(feature = "toml", test)), no_std)]
 #![deny(missing_docs)]
 
 mod schema;
+mod text;
 
 #[cfg(feature = "toml")]
 pub mod file;
 
 pub use schema::*;
+pub use text::{Compact, ECHO_MAX, Echo};
 
 #[cfg(test)]
 mod tests;

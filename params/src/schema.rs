@@ -8,6 +8,7 @@
 //! value with that name `raw.named().spring_rate`. The tables
 //! (`CORE_FIELDS`, ...) are for going over every field in file order.
 
+use crate::text::Compact;
 use core::fmt;
 
 /// One numeric field of the parameter file.
@@ -24,10 +25,142 @@ pub struct Field {
     pub name: &'static str,
     /// Unit, for documentation and generated tables.
     pub unit: &'static str,
+    /// Lowest plausible value: generous, physical bounds (a plunger of a
+    /// milligram to a tonne), checked before any rule between fields, so
+    /// that a value no device has is refused under its own name.
+    pub min: f64,
+    /// Highest plausible value.
+    pub max: f64,
+    /// What else the value must be (a whole number, one of a few values).
+    pub kind: Kind,
     /// Value used when the key is absent; `None` means the key is required.
     pub default: Option<f64>,
     /// One-line description.
     pub doc: &'static str,
+}
+
+/// What a field's value must be besides lying in its plausible range.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Kind {
+    /// Any number in the range.
+    Real,
+    /// A whole number (a count).
+    Whole,
+    /// One of these values.
+    OneOf(&'static [f64]),
+    /// Zero (none: no damping, no preload, no telemetry), or a value in the
+    /// range: a subnormal damping is no damping, and would not survive `f32`.
+    OrZero,
+}
+
+impl Field {
+    /// Checks `value` against this field's own rule, without looking at any
+    /// other field: finite, within `[min, max]`, and whole or one of the
+    /// listed values where [`Field::kind`] says so.
+    ///
+    /// # Errors
+    ///
+    /// A [`ParamError`] naming this field: [`Problem::NotANumber`],
+    /// [`Problem::Infinite`], [`Problem::Implausible`] (with the range and
+    /// unit), [`Problem::NotWhole`] or [`Problem::NotOneOf`].
+    pub fn check(&self, value: f64) -> Result<f64, ParamError> {
+        self.rule().check(value)
+    }
+
+    /// What [`Field::check`] needs of the field, without its description
+    /// (built at compile time by the generated `check_fields`, so that a
+    /// firmware image validating its parameters links no field docs).
+    pub const fn rule(&self) -> Rule {
+        Rule {
+            path: self.path,
+            unit: self.unit,
+            min: self.min,
+            max: self.max,
+            kind: self.kind,
+        }
+    }
+
+    /// The plausible range as messages and tables show it: `[1e-6, 1000] kg`,
+    /// `0 or [1e-6, 1e6] N s/m` (no unit for dimensionless fields).
+    pub fn range(&self) -> Range {
+        Range {
+            min: self.min,
+            max: self.max,
+            unit: self.unit,
+            or_zero: self.kind == Kind::OrZero,
+        }
+    }
+}
+
+/// A field's rule: its name, plausible range and [`Kind`] ([`Field::rule`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rule {
+    /// `section.key`.
+    pub path: &'static str,
+    /// Unit.
+    pub unit: &'static str,
+    /// Lowest plausible value.
+    pub min: f64,
+    /// Highest plausible value.
+    pub max: f64,
+    /// What else the value must be.
+    pub kind: Kind,
+}
+
+impl Rule {
+    /// As [`Field::check`].
+    ///
+    /// # Errors
+    ///
+    /// As [`Field::check`].
+    pub fn check(&self, value: f64) -> Result<f64, ParamError> {
+        let n = Named { path: self.path, value };
+        let v = finite(n)?;
+        let zero = self.kind == Kind::OrZero && v == 0.0;
+        if !(zero || v >= self.min && v <= self.max) {
+            let range = Range {
+                min: self.min,
+                max: self.max,
+                unit: self.unit,
+                or_zero: self.kind == Kind::OrZero,
+            };
+            return Err(err(n, Problem::Implausible(range)));
+        }
+        match self.kind {
+            Kind::Real | Kind::OrZero => Ok(v),
+            // Exact for |v| < 2^63 (the saturating cast changes any fraction).
+            Kind::Whole if v as i64 as f64 == v => Ok(v),
+            Kind::Whole => Err(err(n, Problem::NotWhole)),
+            Kind::OneOf(values) if values.contains(&v) => Ok(v),
+            Kind::OneOf(values) => Err(err(n, Problem::NotOneOf(values))),
+        }
+    }
+}
+
+/// A plausible range with its unit; `Display` writes `[1e-6, 1000] kg`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Range {
+    /// Lowest plausible value.
+    pub min: f64,
+    /// Highest plausible value.
+    pub max: f64,
+    /// Unit (`"-"`: none).
+    pub unit: &'static str,
+    /// Zero is accepted too (below `min`).
+    pub or_zero: bool,
+}
+
+impl fmt::Display for Range {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.or_zero {
+            f.write_str("0 or ")?;
+        }
+        write!(f, "[{}, {}]", Compact(self.min), Compact(self.max))?;
+        if self.unit != "-" {
+            write!(f, " {}", self.unit)?;
+        }
+        Ok(())
+    }
 }
 
 /// A field's value together with its name: what a rule needs to check the
@@ -40,12 +173,24 @@ pub struct Named {
     pub value: f64,
 }
 
+/// A field's [`Kind`]: [`Kind::Real`] unless the list says otherwise.
+macro_rules! kind {
+    () => {
+        Kind::Real
+    };
+    ($kind:expr) => {
+        $kind
+    };
+}
+
 macro_rules! count {
     () => { 0usize };
     ($head:tt $($tail:tt)*) => { 1usize + count!($($tail)*) };
 }
 
-/// Declares one section group of the file from a single list of fields:
+/// Declares one section group of the file from a single list of fields,
+/// each with its unit, plausible range (`min ..= max`, and optionally a
+/// [`Kind`]), default and description:
 ///
 /// * the struct of values (`RawCore`, one `f64` per field);
 /// * a struct with the same field names over any `T` (`CoreFields<T>`):
@@ -62,12 +207,17 @@ macro_rules! schema {
     (
         $(#[$meta:meta])*
         struct $name:ident, fields $fields_ty:ident, const $fields:ident;
-        $( $field:ident : $section:literal . $key:literal [$unit:literal] = $default:expr, $doc:literal; )*
+        $( $field:ident : $section:literal . $key:literal
+            [$unit:literal, $min:literal ..= $max:literal $(, $kind:expr)?] = $default:expr, $doc:literal; )*
     ) => {
         $(#[$meta])*
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub struct $name {
-            $( #[doc = $doc] #[doc = concat!("Unit: ", $unit, ".")] pub $field: f64, )*
+            $(
+                #[doc = $doc]
+                #[doc = concat!("Unit: ", $unit, "; plausible range: ", stringify!($min), " ..= ", stringify!($max), ".")]
+                pub $field: f64,
+            )*
         }
 
         #[doc = concat!("One `T` per field of [`", stringify!($name), "`], under the same names: [`",
@@ -103,10 +253,26 @@ macro_rules! schema {
                     path: concat!($section, ".", $key),
                     name: stringify!($field),
                     unit: $unit,
+                    min: $min,
+                    max: $max,
+                    kind: kind!($($kind)?),
                     default: $default,
                     doc: $doc,
                 }, )*
             };
+
+            /// Checks every field against its own rule ([`Field::check`]:
+            /// finite, in its plausible range, whole or one of its values
+            /// where it must be), in file order, without looking at any
+            /// other field.
+            ///
+            /// # Errors
+            ///
+            /// The first field's [`Field::check`] error.
+            pub fn check_fields(&self) -> Result<(), ParamError> {
+                $( const { Self::FIELD.$field.rule() }.check(self.$field)?; )*
+                Ok(())
+            }
 
             /// Every value together with its field's `section.key`.
             pub const fn named(&self) -> $fields_ty<Named> {
@@ -148,30 +314,45 @@ macro_rules! schema {
     };
 }
 
+// The plausible ranges are generous: they hold every device the model is
+// meant for, the presets and the test suite's random designs (scattered by
+// up to 2x either way around the presets, `host-tests/src/survey.rs`) with
+// room to spare, and refuse only values no such device has (a plunger of a
+// picogram, a bulk modulus of 1 Pa, an outlet at 1e22 Pa). Inside them
+// every quantity the model derives stays far from overflow and underflow
+// in `f32` as well as `f64`. `docs/parameters.md` tabulates them.
 schema! {
     /// The compensator's physical parameters (all required).
     struct RawCore, fields CoreFields, const CORE_FIELDS;
-    walther_a: "fluid"."walther_a" ["-"] = None, "Walther constant a in log10(log10(nu_cSt + 0.7)) = a - b log10(T_K).";
-    walther_b: "fluid"."walther_b" ["-"] = None, "Walther slope b.";
-    density_15: "fluid"."density_15" ["kg/m^3"] = None, "Density at 15 C.";
-    expansion: "fluid"."expansion" ["1/K"] = None, "Volumetric thermal expansion coefficient.";
-    bulk_modulus: "fluid"."bulk_modulus" ["Pa"] = None, "Effective bulk modulus of oil and chamber walls.";
-    laminar_diameter: "laminar_throttle"."diameter" ["m"] = None, "Capillary bore.";
-    laminar_length: "laminar_throttle"."length" ["m"] = None, "Capillary length.";
-    turbulent_diameter: "turbulent_throttle"."diameter" ["m"] = None, "Orifice bore.";
-    turbulent_discharge: "turbulent_throttle"."discharge_coefficient" ["-"] = None, "Orifice discharge coefficient.";
-    plunger_diameter: "plunger"."diameter" ["m"] = None, "Plunger diameter D.";
-    mass: "plunger"."mass" ["kg"] = None, "Moving mass.";
-    damping: "plunger"."damping" ["N s/m"] = None, "Viscous (friction) damping b, without the hydraulic damping.";
-    spring_rate: "plunger"."spring_rate" ["N/m"] = None, "Spring rate c.";
-    preload: "plunger"."preload" ["m"] = None, "Initial spring compression x0.";
-    stroke: "plunger"."stroke" ["m"] = None, "Travel between the end stops, x_max.";
-    slot_diameter: "slot"."diameter" ["m"] = None, "Diameter d of the window opened by the plunger (area pi d x).";
-    slot_discharge: "slot"."discharge_coefficient" ["-"] = None, "Discharge coefficient eta of the window.";
-    volume_a: "chambers"."volume_a" ["m^3"] = None, "Volume of chamber (a) at x = 0.";
-    volume_b: "chambers"."volume_b" ["m^3"] = None, "Volume of chamber (b) at x = 0.";
-    pressure_drop: "operating"."pressure_drop" ["Pa"] = None, "Constant drop p_p - p_c (Eq. 10).";
-    outlet_pressure: "operating"."outlet_pressure" ["Pa"] = None, "Outlet pressure p_c.";
+    // Real oils have a = 8..11, b = 3..4.5; fitted and scattered oils reach
+    // a = 19, b = 7.5. Which (a, b) make an oil is a rule between the two
+    // (the viscosity at 40 C, `RawCore::validate`).
+    walther_a: "fluid"."walther_a" ["-", 0.5 ..= 40.0] = None, "Walther constant a in log10(log10(nu_cSt + 0.7)) = a - b log10(T_K).";
+    walther_b: "fluid"."walther_b" ["-", 0.5 ..= 15.0] = None, "Walther slope b.";
+    // Light hydrocarbons to heavy synthetic fluids.
+    density_15: "fluid"."density_15" ["kg/m^3", 500.0 ..= 2000.0] = None, "Density at 15 C.";
+    // rho = rho_15 / (1 + e (t - 15)) must stay positive and finite over
+    // any oil temperature; 1e-2/K is ten times any hydraulic oil's.
+    expansion: "fluid"."expansion" ["1/K", 1.0e-6 ..= 1.0e-2, Kind::OrZero] = None, "Volumetric thermal expansion coefficient.";
+    // Oil with entrained air and soft hoses (1e7) to five times the stiffest
+    // mineral oil (1e10).
+    bulk_modulus: "fluid"."bulk_modulus" ["Pa", 1.0e7 ..= 1.0e10] = None, "Effective bulk modulus of oil and chamber walls.";
+    laminar_diameter: "laminar_throttle"."diameter" ["m", 1.0e-5 ..= 0.1] = None, "Capillary bore.";
+    laminar_length: "laminar_throttle"."length" ["m", 1.0e-4 ..= 10.0] = None, "Capillary length.";
+    turbulent_diameter: "turbulent_throttle"."diameter" ["m", 1.0e-5 ..= 0.1] = None, "Orifice bore.";
+    turbulent_discharge: "turbulent_throttle"."discharge_coefficient" ["-", 0.1 ..= 1.0] = None, "Orifice discharge coefficient.";
+    plunger_diameter: "plunger"."diameter" ["m", 1.0e-4 ..= 1.0] = None, "Plunger diameter D.";
+    mass: "plunger"."mass" ["kg", 1.0e-6 ..= 1.0e3] = None, "Moving mass.";
+    damping: "plunger"."damping" ["N s/m", 1.0e-6 ..= 1.0e6, Kind::OrZero] = None, "Viscous (friction) damping b, without the hydraulic damping.";
+    spring_rate: "plunger"."spring_rate" ["N/m", 0.1 ..= 1.0e9] = None, "Spring rate c.";
+    preload: "plunger"."preload" ["m", 1.0e-9 ..= 1.0, Kind::OrZero] = None, "Initial spring compression x0 (at most the stroke).";
+    stroke: "plunger"."stroke" ["m", 1.0e-6 ..= 1.0] = None, "Travel between the end stops, x_max.";
+    slot_diameter: "slot"."diameter" ["m", 1.0e-5 ..= 1.0] = None, "Diameter d of the window opened by the plunger (area pi d x).";
+    slot_discharge: "slot"."discharge_coefficient" ["-", 0.1 ..= 1.0] = None, "Discharge coefficient eta of the window.";
+    volume_a: "chambers"."volume_a" ["m^3", 1.0e-10 ..= 1.0] = None, "Volume of chamber (a) at x = 0 (more than the plunger sweeps).";
+    volume_b: "chambers"."volume_b" ["m^3", 1.0e-10 ..= 1.0] = None, "Volume of chamber (b) at x = 0 (more than the plunger sweeps).";
+    pressure_drop: "operating"."pressure_drop" ["Pa", 1.0e3 ..= 1.0e8] = None, "Constant drop p_p - p_c (Eq. 10).";
+    outlet_pressure: "operating"."outlet_pressure" ["Pa", 1.0 ..= 1.0e8, Kind::OrZero] = None, "Outlet pressure p_c.";
 }
 
 schema! {
@@ -180,31 +361,35 @@ schema! {
     /// Its volumetric losses are laminar leakage, proportional to `1/mu`:
     /// `dQ_lost(t) = leakage_reference * mu(t_ref) / mu(t)`.
     struct RawMachine, fields MachineFields, const MACHINE_FIELDS;
-    working_flow: "machine"."working_flow" ["m^3/s"] = None, "Flow Q_work the driven motor needs.";
-    leakage_reference: "machine"."leakage_reference" ["m^3/s"] = None, "Volumetric loss at the reference temperature.";
-    leakage_temperature: "machine"."leakage_temperature" ["C"] = None, "Reference temperature of the loss.";
+    working_flow: "machine"."working_flow" ["m^3/s", 1.0e-12 ..= 1.0, Kind::OrZero] = None, "Flow Q_work the driven motor needs.";
+    leakage_reference: "machine"."leakage_reference" ["m^3/s", 1.0e-12 ..= 1.0, Kind::OrZero] = None, "Volumetric loss at the reference temperature.";
+    leakage_temperature: "machine"."leakage_temperature" ["C", -50.0 ..= 200.0] = None, "Reference temperature of the loss.";
 }
 
 schema! {
     /// Estimator and sensor settings (optional section `[estimator]`; every
     /// key has a default).
     struct RawEstimator, fields EstimatorFields, const ESTIMATOR_FIELDS;
-    tick_hz: "estimator"."tick_hz" ["Hz"] = Some(1000.0), "Estimator tick rate.";
-    filter_time_constant: "estimator"."filter_time_constant" ["s"] = Some(0.2), "First-order temperature filter time constant.";
-    spike_threshold: "estimator"."spike_threshold" ["C"] = Some(5.0), "A sample further than this from the filtered value is a spike.";
-    spike_limit: "estimator"."spike_limit" ["-"] = Some(5.0), "Consecutive agreeing out-of-band samples rejected before the next one is taken as a real step (a whole number, at most 65534).";
-    valid_min: "estimator"."valid_min" ["C"] = Some(26.0), "Lower end of the validated temperature range.";
-    valid_max: "estimator"."valid_max" ["C"] = Some(78.0), "Upper end of the validated temperature range.";
-    oil_min: "estimator"."oil_min" ["C"] = Some(-20.0), "Coldest temperature the fluid model accepts.";
-    oil_max: "estimator"."oil_max" ["C"] = Some(150.0), "Hottest temperature the fluid model accepts.";
-    telemetry_hz: "estimator"."telemetry_hz" ["Hz"] = Some(2.0), "Telemetry rate (0: none; at most tick_hz / 2).";
-    rtd_r0: "estimator"."rtd_r0" ["ohm"] = Some(100.0), "RTD resistance at 0 C (PT100).";
-    rtd_reference: "estimator"."rtd_reference" ["ohm"] = Some(430.0), "MAX31865 reference resistor (must exceed the RTD's resistance at oil_max, else the converter saturates).";
-    rtd_wires: "estimator"."rtd_wires" ["-"] = Some(3.0), "RTD connection: 2, 3 or 4 wires (MAX31865 configuration bit D4).";
-    mains_hz: "estimator"."mains_hz" ["Hz"] = Some(50.0), "Mains frequency the converter's notch filter rejects: 50 or 60 (conversion every 20 or 16.7 ms).";
-    rtd_a: "estimator"."rtd_a" ["1/C"] = Some(3.9083e-3), "Callendar-Van Dusen A of the RTD (IEC 60751 by default; a calibrated probe's own).";
-    rtd_b: "estimator"."rtd_b" ["1/C^2"] = Some(-5.775e-7), "Callendar-Van Dusen B (IEC 60751 by default).";
-    rtd_c: "estimator"."rtd_c" ["1/C^4"] = Some(-4.183e-12), "Callendar-Van Dusen C, below 0 C only (IEC 60751 by default).";
+    tick_hz: "estimator"."tick_hz" ["Hz", 1.0 ..= 100_000.0] = Some(1000.0), "Estimator tick rate.";
+    filter_time_constant: "estimator"."filter_time_constant" ["s", 1.0e-5 ..= 1.0e4] = Some(0.2), "First-order temperature filter time constant.";
+    spike_threshold: "estimator"."spike_threshold" ["C", 1.0e-3 ..= 1.0e3] = Some(5.0), "A sample further than this from the filtered value is a spike.";
+    // The counter must be able to exceed the limit in 16 bits.
+    spike_limit: "estimator"."spike_limit" ["-", 0.0 ..= 65_534.0, Kind::Whole] = Some(5.0), "Consecutive agreeing out-of-band samples rejected before the next one is taken as a real step (a whole number).";
+    valid_min: "estimator"."valid_min" ["C", -60.0 ..= 300.0] = Some(26.0), "Lower end of the validated temperature range (inside oil_min..oil_max).";
+    valid_max: "estimator"."valid_max" ["C", -60.0 ..= 300.0] = Some(78.0), "Upper end of the validated temperature range (above valid_min, inside oil_min..oil_max).";
+    oil_min: "estimator"."oil_min" ["C", -60.0 ..= 300.0] = Some(-20.0), "Coldest temperature the fluid model accepts.";
+    oil_max: "estimator"."oil_max" ["C", -60.0 ..= 300.0] = Some(150.0), "Hottest temperature the fluid model accepts (above oil_min).";
+    telemetry_hz: "estimator"."telemetry_hz" ["Hz", 1.0e-3 ..= 50_000.0, Kind::OrZero] = Some(2.0), "Telemetry rate (0: none; at most tick_hz / 2).";
+    // PT10 to PT10000 and beyond.
+    rtd_r0: "estimator"."rtd_r0" ["ohm", 1.0 ..= 1.0e5] = Some(100.0), "RTD resistance at 0 C (PT100).";
+    rtd_reference: "estimator"."rtd_reference" ["ohm", 1.0 ..= 1.0e6] = Some(430.0), "MAX31865 reference resistor (must exceed the RTD's resistance at oil_max, else the converter saturates).";
+    rtd_wires: "estimator"."rtd_wires" ["-", 2.0 ..= 4.0, Kind::Whole] = Some(3.0), "RTD connection: 2, 3 or 4 wires (MAX31865 configuration bit D4).";
+    mains_hz: "estimator"."mains_hz" ["Hz", 50.0 ..= 60.0, Kind::OneOf(&[50.0, 60.0])] = Some(50.0), "Mains frequency the converter's notch filter rejects: 50 or 60 (conversion every 20 or 16.7 ms).";
+    // Around IEC 60751's 3.9083e-3, -5.775e-7, -4.183e-12: a calibrated
+    // probe's coefficients differ in the third or fourth digit.
+    rtd_a: "estimator"."rtd_a" ["1/C", 1.0e-3 ..= 1.0e-2] = Some(3.9083e-3), "Callendar-Van Dusen A of the RTD (IEC 60751 by default; a calibrated probe's own).";
+    rtd_b: "estimator"."rtd_b" ["1/C^2", -1.0e-5 ..= 1.0e-5] = Some(-5.775e-7), "Callendar-Van Dusen B (IEC 60751 by default).";
+    rtd_c: "estimator"."rtd_c" ["1/C^4", -1.0e-9 ..= 1.0e-9] = Some(-4.183e-12), "Callendar-Van Dusen C, below 0 C only (IEC 60751 by default).";
 }
 
 /// A complete, unvalidated parameter set as read from a file.
@@ -229,14 +414,24 @@ pub enum Problem {
     Infinite,
     /// Zero or negative where physics needs a positive value.
     NotPositive,
-    /// Negative where zero is allowed.
-    Negative,
-    /// Outside `[min, max]`.
+    /// Outside the field's own plausible range ([`Field::range`]).
+    Implausible(Range),
+    /// A quantity computed from this field and others lies outside its
+    /// plausible range.
+    DerivedImplausible {
+        /// What the quantity is, naming the fields it comes from.
+        quantity: &'static str,
+        /// Its plausible range.
+        range: Range,
+    },
+    /// Outside `[min, max]`, bounds that come from other fields.
     OutOfRange {
         /// Lowest accepted value.
         min: f64,
         /// Highest accepted value.
         max: f64,
+        /// Where the bounds come from.
+        why: &'static str,
     },
     /// Inconsistent with another field; the text says which and why.
     Inconsistent(&'static str),
@@ -247,8 +442,8 @@ pub enum Problem {
         /// Where the bound comes from.
         why: &'static str,
     },
-    /// Not one of the accepted values (listed in the text).
-    NotOneOf(&'static str),
+    /// Not one of the accepted values.
+    NotOneOf(&'static [f64]),
     /// Representable in `f64` but not in the scalar type asked for.
     NotRepresentable(&'static str),
     /// A fraction where a count is needed.
@@ -256,6 +451,9 @@ pub enum Problem {
 }
 
 /// A rejected parameter: which field (`section.key`), its value, and why.
+///
+/// `Display` is one line of bounded length: numbers in their shortest
+/// form ([`Compact`]), every text from the schema.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ParamError {
     /// `section.key` of the offending field.
@@ -268,24 +466,43 @@ pub struct ParamError {
 
 impl fmt::Display for ParamError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (field, v) = (self.field, Compact(self.value));
         match self.problem {
-            Problem::Missing => write!(f, "{}: missing", self.field),
-            Problem::NotANumber => write!(f, "{}: is NaN", self.field),
-            Problem::Infinite => write!(f, "{} = {}: must be finite", self.field, self.value),
-            Problem::NotPositive => write!(f, "{} = {}: must be positive", self.field, self.value),
-            Problem::Negative => write!(f, "{} = {}: must not be negative", self.field, self.value),
-            Problem::OutOfRange { min, max } => {
-                write!(f, "{} = {}: must lie in [{}, {}]", self.field, self.value, min, max)
+            Problem::Missing => write!(f, "{field}: missing"),
+            Problem::NotANumber => write!(f, "{field}: is NaN"),
+            Problem::Infinite => write!(f, "{field} = {v}: must be finite"),
+            Problem::NotPositive => write!(f, "{field} = {v}: must be positive"),
+            Problem::Implausible(range) if range.or_zero => {
+                write!(f, "{field} = {v}: must be {range} (plausible range)")
             }
-            Problem::Inconsistent(why) => write!(f, "{} = {}: {}", self.field, self.value, why),
-            Problem::NotAbove { bound, why } => {
-                write!(f, "{} = {}: must exceed {} ({})", self.field, self.value, bound, why)
+            Problem::Implausible(range) => write!(f, "{field} = {v}: must lie in {range} (plausible range)"),
+            Problem::DerivedImplausible { quantity, range } => {
+                write!(f, "{field} = {v}: {quantity} must lie in {range} (plausible range)")
             }
-            Problem::NotOneOf(values) => write!(f, "{} = {}: must be {}", self.field, self.value, values),
-            Problem::NotRepresentable(ty) => {
-                write!(f, "{} = {}: not representable as {}", self.field, self.value, ty)
+            Problem::OutOfRange { min, max, why } => {
+                write!(
+                    f,
+                    "{field} = {v}: must lie in [{}, {}] ({why})",
+                    Compact(min),
+                    Compact(max)
+                )
             }
-            Problem::NotWhole => write!(f, "{} = {}: must be a whole number", self.field, self.value),
+            Problem::Inconsistent(why) => write!(f, "{field} = {v}: {why}"),
+            Problem::NotAbove { bound, why } => write!(f, "{field} = {v}: must exceed {} ({why})", Compact(bound)),
+            Problem::NotOneOf(values) => {
+                write!(f, "{field} = {v}: must be ")?;
+                for (i, x) in values.iter().enumerate() {
+                    match i {
+                        0 => {}
+                        i if i + 1 == values.len() => f.write_str(" or ")?,
+                        _ => f.write_str(", ")?,
+                    }
+                    write!(f, "{}", Compact(*x))?;
+                }
+                Ok(())
+            }
+            Problem::NotRepresentable(ty) => write!(f, "{field} = {v}: not representable as {ty}"),
+            Problem::NotWhole => write!(f, "{field} = {v}: must be a whole number"),
         }
     }
 }
@@ -312,122 +529,89 @@ fn finite(n: Named) -> Result<f64, ParamError> {
     }
 }
 
-fn positive(n: Named) -> Result<f64, ParamError> {
-    let v = finite(n)?;
-    if v > 0.0 {
-        Ok(v)
-    } else {
-        Err(err(n, Problem::NotPositive))
-    }
-}
+/// `log10(313.15)`: Walther's temperature term at 40 C.
+pub(crate) const LOG10_T40: f64 = 2.495752416037327;
 
-fn non_negative(n: Named) -> Result<f64, ParamError> {
-    let v = finite(n)?;
-    if v >= 0.0 {
-        Ok(v)
-    } else {
-        Err(err(n, Problem::Negative))
-    }
-}
+/// Plausible kinematic viscosity of the oil at 40 C [cSt] (the ISO 3448
+/// grades' reference temperature): from the thinnest oil Walther's law
+/// describes (2 cSt) to far beyond the heaviest gear oils (ISO VG 3200).
+pub const VISCOSITY_40C_CST: (f64, f64) = (2.0, 1.0e5);
 
-fn within(n: Named, min: f64, max: f64) -> Result<f64, ParamError> {
-    let v = finite(n)?;
-    if v >= min && v <= max {
-        Ok(v)
-    } else {
-        Err(err(n, Problem::OutOfRange { min, max }))
-    }
-}
+/// [`VISCOSITY_40C_CST`] as Walther's `log10(log10(nu_cSt + 0.7))` (the
+/// crate computes without `log10`: it is `no_std`; a test checks them).
+pub(crate) const WALTHER_40C: (f64, f64) = (-0.3651563397312923, 0.6989702683913901);
 
-/// A whole number (counts).
-fn whole(n: Named) -> Result<f64, ParamError> {
-    let v = finite(n)?;
-    // Exact for |v| < 2^63 (the saturating cast changes any fraction).
-    if v as i64 as f64 == v {
-        Ok(v)
-    } else {
-        Err(err(n, Problem::NotWhole))
+impl RawCore {
+    /// Checks every field against its own plausible range, in file order
+    /// ([`RawCore::check_fields`]), then the rules that tie fields together:
+    /// a field that is wrong on its own is named before any rule could
+    /// blame another field for it. The first violation is returned.
+    ///
+    /// # Errors
+    ///
+    /// The [`ParamError`] of the first field that breaks its own rule, else
+    /// of the first rule between fields that fails:
+    /// * `fluid.walther_a`, [`Problem::DerivedImplausible`]: the oil's
+    ///   viscosity at 40 C outside [`VISCOSITY_40C_CST`];
+    /// * `plunger.preload`, [`Problem::Inconsistent`]: beyond the stroke;
+    /// * `chambers.volume_a` / `volume_b`, [`Problem::NotAbove`]: not larger
+    ///   than the volume the plunger sweeps over its stroke.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        self.check_fields()?;
+        self.check_rules()
     }
-}
 
-/// Discharge coefficients live in (0, 1].
-fn discharge(n: Named) -> Result<f64, ParamError> {
-    let v = positive(n)?;
-    if v <= 1.0 {
-        Ok(v)
-    } else {
-        Err(err(n, Problem::OutOfRange { min: 0.0, max: 1.0 }))
+    /// The rules between fields (each field within its range).
+    fn check_rules(&self) -> Result<(), ParamError> {
+        let n = self.named();
+        let u40 = self.walther_a - self.walther_b * LOG10_T40;
+        if !(u40 >= WALTHER_40C.0 && u40 <= WALTHER_40C.1) {
+            return Err(err(
+                n.walther_a,
+                Problem::DerivedImplausible {
+                    quantity: "the oil's viscosity at 40 C (fluid.walther_a, fluid.walther_b)",
+                    range: Range {
+                        min: VISCOSITY_40C_CST.0,
+                        max: VISCOSITY_40C_CST.1,
+                        unit: "cSt",
+                        or_zero: false,
+                    },
+                },
+            ));
+        }
+        if self.preload > self.stroke {
+            return Err(err(n.preload, Problem::Inconsistent("beyond plunger.stroke")));
+        }
+        // Chamber (a) shrinks by the swept volume at full stroke, so it must
+        // be larger. Chamber (b) grows; the same rule is applied to it so
+        // that a mirrored design (and the file format) stays symmetric.
+        let swept = PI * self.plunger_diameter * self.plunger_diameter / 4.0 * self.stroke;
+        for volume in [n.volume_a, n.volume_b] {
+            if !(volume.value > swept) {
+                return Err(err(
+                    volume,
+                    Problem::NotAbove {
+                        bound: swept,
+                        why: "the volume the plunger sweeps, pi/4 plunger.diameter^2 plunger.stroke",
+                    },
+                ));
+            }
+        }
+        Ok(())
     }
 }
 
 const PI: f64 = core::f64::consts::PI;
 
-impl RawCore {
-    /// Checks every field against its physical rule, in file order, and the
-    /// rules that tie fields together. The first violation is returned.
-    pub fn validate(&self) -> Result<(), ParamError> {
-        let n = self.named();
-        positive(n.walther_a)?;
-        positive(n.walther_b)?;
-        positive(n.density_15)?;
-        // rho = rho_15 / (1 + e (t - 15)) must stay positive and finite over
-        // any oil temperature; 1e-2/K is ten times any hydraulic oil's.
-        within(n.expansion, 0.0, 1.0e-2)?;
-        positive(n.bulk_modulus)?;
-        positive(n.laminar_diameter)?;
-        positive(n.laminar_length)?;
-        positive(n.turbulent_diameter)?;
-        discharge(n.turbulent_discharge)?;
-        positive(n.plunger_diameter)?;
-        positive(n.mass)?;
-        non_negative(n.damping)?;
-        positive(n.spring_rate)?;
-        non_negative(n.preload)?;
-        positive(n.stroke)?;
-        positive(n.slot_diameter)?;
-        discharge(n.slot_discharge)?;
-        positive(n.volume_a)?;
-        positive(n.volume_b)?;
-        positive(n.pressure_drop)?;
-        non_negative(n.outlet_pressure)?;
-
-        if self.preload > self.stroke {
-            return Err(err(n.preload, Problem::Inconsistent("preload beyond the stroke")));
-        }
-        let swept = PI * self.plunger_diameter * self.plunger_diameter / 4.0 * self.stroke;
-        if !(swept.is_finite() && swept > 0.0) {
-            return Err(err(
-                n.stroke,
-                Problem::Inconsistent("swept volume A_p * stroke is not finite"),
-            ));
-        }
-        // Chamber (a) shrinks by the swept volume at full stroke, so it must
-        // be larger. Chamber (b) grows; the same rule is applied to it so
-        // that a mirrored design (and the file format) stays symmetric.
-        if self.volume_a <= swept {
-            return Err(err(
-                n.volume_a,
-                Problem::Inconsistent("not larger than the swept volume A_p * stroke"),
-            ));
-        }
-        if self.volume_b <= swept {
-            return Err(err(
-                n.volume_b,
-                Problem::Inconsistent("not larger than the swept volume A_p * stroke"),
-            ));
-        }
-        Ok(())
-    }
-}
-
 impl RawMachine {
-    /// Checks the machine section.
+    /// Checks the machine section: every field within its plausible range
+    /// (no rule ties them together).
+    ///
+    /// # Errors
+    ///
+    /// The first field's [`Field::check`] error.
     pub fn validate(&self) -> Result<(), ParamError> {
-        let n = self.named();
-        non_negative(n.working_flow)?;
-        non_negative(n.leakage_reference)?;
-        within(n.leakage_temperature, -50.0, 200.0)?;
-        Ok(())
+        self.check_fields()
     }
 }
 
@@ -435,40 +619,64 @@ impl RawEstimator {
     /// The defaults of the `[estimator]` section.
     pub const DEFAULT: RawEstimator = RawEstimator::WITH_DEFAULTS;
 
-    /// Checks the estimator section.
+    /// Checks the estimator section: every field against its own plausible
+    /// range first ([`RawEstimator::check_fields`]), then the rules between
+    /// fields.
+    ///
+    /// # Errors
+    ///
+    /// The [`ParamError`] of the first field that breaks its own rule, else
+    /// of the first rule between fields that fails:
+    /// * `estimator.oil_max` not above `oil_min`, `valid_max` not above
+    ///   `valid_min`, `oil_min` above `valid_min`, `oil_max` below
+    ///   `valid_max` ([`Problem::Inconsistent`]);
+    /// * `estimator.telemetry_hz` above half the tick rate
+    ///   ([`Problem::OutOfRange`]);
+    /// * `estimator.rtd_b`, [`Problem::Inconsistent`]: the RTD's resistance
+    ///   does not rise over the oil range;
+    /// * `estimator.rtd_reference`, [`Problem::NotAbove`]: not above the
+    ///   RTD's resistance at `oil_max` (the converter would saturate).
     pub fn validate(&self) -> Result<(), ParamError> {
+        self.check_fields()?;
+        self.check_rules()
+    }
+
+    /// The rules between fields (each field within its range).
+    fn check_rules(&self) -> Result<(), ParamError> {
         let n = self.named();
-        within(n.tick_hz, 1.0, 100_000.0)?;
-        positive(n.filter_time_constant)?;
-        positive(n.spike_threshold)?;
-        within(n.spike_limit, 0.0, 65_534.0)?;
-        whole(n.spike_limit)?;
-        within(n.oil_min, -60.0, 300.0)?;
-        within(n.oil_max, -60.0, 300.0)?;
         if self.oil_max <= self.oil_min {
             return Err(err(n.oil_max, Problem::Inconsistent("not above estimator.oil_min")));
         }
-        within(n.valid_min, self.oil_min, self.oil_max)?;
-        within(n.valid_max, self.oil_min, self.oil_max)?;
         if self.valid_max <= self.valid_min {
             return Err(err(n.valid_max, Problem::Inconsistent("not above estimator.valid_min")));
         }
+        // The oil range must hold the validated range. Each is a sound
+        // range by now; the oil range's end is blamed (the validated range
+        // is what the device promises; the oil model must cover it).
+        if self.oil_min > self.valid_min {
+            return Err(err(
+                n.oil_min,
+                Problem::Inconsistent("above estimator.valid_min: the oil range must hold the validated range"),
+            ));
+        }
+        if self.oil_max < self.valid_max {
+            return Err(err(
+                n.oil_max,
+                Problem::Inconsistent("below estimator.valid_max: the oil range must hold the validated range"),
+            ));
+        }
         // A telemetry tick runs none of the estimator's rotating jobs: at
         // most every second tick, so that they keep being refreshed.
-        within(n.telemetry_hz, 0.0, self.tick_hz / 2.0)?;
-        positive(n.rtd_r0)?;
-        positive(n.rtd_reference)?;
-        within(n.rtd_wires, 2.0, 4.0)?;
-        whole(n.rtd_wires)?;
-        let mains = finite(n.mains_hz)?;
-        if mains != 50.0 && mains != 60.0 {
-            return Err(err(n.mains_hz, Problem::NotOneOf("50 or 60")));
+        if self.telemetry_hz > self.tick_hz / 2.0 {
+            return Err(err(
+                n.telemetry_hz,
+                Problem::OutOfRange {
+                    min: 0.0,
+                    max: self.tick_hz / 2.0,
+                    why: "at most half of estimator.tick_hz",
+                },
+            ));
         }
-        // Around IEC 60751's 3.9083e-3, -5.775e-7, -4.183e-12: a calibrated
-        // probe's coefficients differ in the third or fourth digit.
-        within(n.rtd_a, 1.0e-3, 1.0e-2)?;
-        within(n.rtd_b, -1.0e-5, 1.0e-5)?;
-        within(n.rtd_c, -1.0e-9, 1.0e-9)?;
         // The converter inverts R(t): it must rise over the oil's range.
         let mut t = self.oil_min;
         for i in 0..=64 {
@@ -477,7 +685,7 @@ impl RawEstimator {
                 return Err(err(
                     n.rtd_b,
                     Problem::Inconsistent(
-                        "the RTD's resistance must rise with temperature over estimator.oil_min..oil_max",
+                        "the RTD's resistance (estimator.rtd_a, estimator.rtd_b, estimator.rtd_c) must rise with temperature over estimator.oil_min..estimator.oil_max",
                     ),
                 ));
             }
@@ -492,7 +700,7 @@ impl RawEstimator {
                 n.rtd_reference,
                 Problem::NotAbove {
                     bound,
-                    why: "the RTD's resistance at estimator.oil_max: the converter would saturate",
+                    why: "the resistance of the RTD (estimator.rtd_r0, estimator.rtd_a, estimator.rtd_b) at estimator.oil_max: the converter would saturate",
                 },
             ));
         }
@@ -521,13 +729,23 @@ impl RawEstimator {
 }
 
 impl RawParams {
-    /// Validates every section.
+    /// Validates every section: first every field of the file against its
+    /// own plausible range (core, machine, estimator, in file order), then
+    /// the rules between fields, so that the blame lands on the field that
+    /// is wrong rather than on one a rule compares it with.
+    ///
+    /// # Errors
+    ///
+    /// The first [`ParamError`] in that order (see [`RawCore::validate`]
+    /// and [`RawEstimator::validate`] for the rules).
     pub fn validate(&self) -> Result<(), ParamError> {
-        self.core.validate()?;
+        self.core.check_fields()?;
         if let Some(m) = &self.machine {
-            m.validate()?;
+            m.check_fields()?;
         }
-        self.estimator.validate()
+        self.estimator.check_fields()?;
+        self.core.check_rules()?;
+        self.estimator.check_rules()
     }
 
     /// Assembles a parameter set from a lookup `get(section, key)`, applying

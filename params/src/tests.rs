@@ -177,3 +177,167 @@ fn every_field_round_trips_through_the_file_by_name() {
         assert!(written.contains(&line), "{path}: no `{line}` in\n{written}");
     }
 }
+
+/// Every field of the schema, in file order.
+fn every_schema_field() -> impl Iterator<Item = &'static crate::Field> {
+    CORE_FIELDS
+        .iter()
+        .chain(MACHINE_FIELDS.iter())
+        .chain(ESTIMATOR_FIELDS.iter())
+}
+
+#[test]
+fn every_plausible_range_holds_its_default_and_the_tests_value() {
+    use crate::Kind;
+    for f in every_schema_field() {
+        assert!(f.min.is_finite() && f.max.is_finite() && f.min < f.max, "{}", f.path);
+        if let Some(d) = f.default {
+            assert_eq!(f.check(d), Ok(d), "{}: the default is refused", f.path);
+        }
+        let (_, v, _) = EVERY_FIELD.iter().find(|(p, _, _)| *p == f.path).unwrap();
+        assert_eq!(f.check(*v), Ok(*v), "{}", f.path);
+        if let Kind::OneOf(values) = f.kind {
+            assert!(values.iter().all(|x| (f.min..=f.max).contains(x)), "{}", f.path);
+        }
+        // Outside the range, on either side, by a hair: refused by name.
+        for out in [f.min - 1e-9 * f.min.abs().max(1e-300), f.max * (1.0 + 1e-9)] {
+            let e = f.check(out).unwrap_err();
+            assert_eq!(e.field, f.path);
+            assert!(matches!(e.problem, Problem::Implausible(_)), "{}: {e}", f.path);
+        }
+    }
+}
+
+#[test]
+fn the_walther_bounds_are_the_viscosity_bounds() {
+    let w = |nu: f64| (nu + 0.7).log10().log10();
+    let (lo, hi) = crate::VISCOSITY_40C_CST;
+    assert_eq!(crate::schema::WALTHER_40C, (w(lo), w(hi)));
+    assert_eq!(crate::schema::LOG10_T40, 313.15f64.log10());
+}
+
+#[test]
+fn out_of_range_values_name_the_field_the_range_and_the_unit() {
+    let e = read(Some(("plunger.mass", 1e-12))).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "plunger.mass = 1e-12: must lie in [1e-6, 1000] kg (plausible range)"
+    );
+    let e = read(Some(("fluid.bulk_modulus", 1e30))).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "fluid.bulk_modulus = 1e30: must lie in [1e7, 1e10] Pa (plausible range)"
+    );
+    // Dimensionless: no unit.
+    let e = read(Some(("slot.discharge_coefficient", 1.5))).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "slot.discharge_coefficient = 1.5: must lie in [0.1, 1] (plausible range)"
+    );
+    let e = read(Some(("estimator.mains_hz", 55.0))).unwrap_err();
+    assert_eq!(e.to_string(), "estimator.mains_hz = 55: must be 50 or 60");
+}
+
+#[test]
+fn a_field_out_of_its_range_is_blamed_before_any_rule_between_fields() {
+    // A plunger of 1e160 m would make chamber (a) too small: the diameter
+    // is named, not the chamber.
+    let e = read(Some(("plunger.diameter", 1e160))).unwrap_err();
+    assert_eq!(e.field, "plunger.diameter");
+    // An estimator field out of range comes before a core rule that fails.
+    let e = RawParams::from_lookup(|s, k| match (s, k) {
+        ("plunger", "preload") => Some(1.0),
+        ("estimator", "rtd_r0") => Some(1e-300),
+        _ => lookup(s, k, None),
+    })
+    .unwrap_err();
+    assert_eq!(e.field, "estimator.rtd_r0");
+    // Walther constants each in range but no oil together: blamed on a.
+    let e = read(Some(("fluid.walther_a", 20.0))).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "fluid.walther_a = 20: the oil's viscosity at 40 C (fluid.walther_a, fluid.walther_b) must lie in [2, 1e5] cSt (plausible range)"
+    );
+}
+
+#[test]
+fn numbers_are_printed_in_their_shortest_form() {
+    use crate::Compact;
+    for (v, text) in [
+        (1e300, "1e300"),
+        (5e-324, "5e-324"),
+        (0.0015, "0.0015"),
+        (1000.0, "1000"),
+        (10000.0, "1e4"),
+        (0.002, "0.002"),
+        (0.0001, "1e-4"),
+        (4e5, "4e5"),
+        (65534.0, "65534"),
+        (25000.5, "25000.5"),
+        (-1e-5, "-1e-5"),
+        (0.0, "0"),
+        (0.5, "0.5"),
+        (1.0344023879631311e-5, "1.0344023879631311e-5"),
+        (f64::NAN, "NaN"),
+        (f64::NEG_INFINITY, "-inf"),
+    ] {
+        assert_eq!(Compact(v).to_string(), text);
+    }
+    // Any bit pattern: at most 24 characters, read back exactly.
+    let mut x = 0x9E37_79B9_7F4A_7C15u64;
+    for _ in 0..100_000 {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        let v = f64::from_bits(x);
+        let s = Compact(v).to_string();
+        assert!(s.len() <= 24, "{s}");
+        if v.is_finite() {
+            assert_eq!(s.parse::<f64>().unwrap(), v, "{s}");
+        }
+    }
+}
+
+#[test]
+fn echoed_input_stays_on_one_short_line() {
+    use crate::{ECHO_MAX, Echo};
+    let long = "k".repeat(1_000_000);
+    let s = Echo::head(&long).to_string();
+    assert_eq!(s.chars().count(), ECHO_MAX);
+    assert!(s.ends_with('…'));
+    let s = Echo::tail(&format!("{long}/paper.toml")).to_string();
+    assert!(s.starts_with('…') && s.ends_with("/paper.toml"), "{s}");
+    assert_eq!(Echo::head("ma\nss").to_string(), "ma\\nss");
+    assert_eq!(Echo::head("plunger.mass").to_string(), "plunger.mass");
+}
+
+#[cfg(feature = "toml")]
+#[test]
+fn file_errors_are_one_bounded_line_naming_the_key() {
+    use crate::file::{LoadError, parse};
+    let one_line = |text: &str| {
+        let e = parse(text).unwrap_err().to_string();
+        assert_eq!(e.lines().count(), 1, "{e:?}");
+        assert!(e.len() <= 300, "{} bytes", e.len());
+        e
+    };
+    assert_eq!(
+        one_line("[plunger]\nmass = 0.01\nmass = 0.02\n"),
+        "line 3: duplicate key plunger.mass"
+    );
+    assert_eq!(
+        one_line("[plunger]\nmass = 0.01\n[plunger]\n"),
+        "line 3: duplicate table [plunger]"
+    );
+    let huge = format!("[plunger]\n{} = 1\n", "k".repeat(10_000_000));
+    assert!(one_line(&huge).ends_with("…: unknown key"));
+    assert_eq!(one_line("[plunger]\n\"ma\\nss\" = 1\n"), "plunger.ma\\nss: unknown key");
+    assert_eq!(
+        one_line("plunger = 1\n"),
+        "plunger: expected a section [plunger], not a value"
+    );
+    let e = parse("[plunger]\nmass = [1.0]\n").unwrap_err();
+    assert_eq!(e.field(), Some("plunger.mass"));
+    assert_eq!(e.to_string(), "plunger.mass: expected a number, found a TOML array");
+    assert!(matches!(e, LoadError::NotANumber { found: "array", .. }));
+}

@@ -173,10 +173,10 @@ fn main() -> ! {
         }
     }
     let start = match initial {
-        Some(t) if t >= config.oil.0 && t <= config.oil.1 => t,
+        Some(t) if config.oil.contains(t) => t,
         _ => {
             warn!("no valid first sample; starting at the validated range's lower end");
-            config.valid.0
+            config.valid.min
         }
     };
     let mut estimator = match Estimator::new(&params, config, start) {

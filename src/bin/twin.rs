@@ -96,17 +96,7 @@ fn main() -> ! {
             exit(false)
         }
     };
-    let mut config = match EstimatorConfig::new(&RAW_PARAMS.estimator) {
-        Ok(c) => c,
-        Err(e) => {
-            error!("estimator settings rejected: {=str}", e.field);
-            exit(false)
-        }
-    };
-    if let Err(what) = compensator_firmware::use_built_twin(&mut config, TWIN_SCHEME, TWIN_SUBSTEPS) {
-        error!("twin configuration: {=str}", what);
-        exit(false)
-    }
+    let config = compensator_firmware::qemu::built_estimator_config(&RAW_PARAMS.estimator, TWIN_SCHEME, TWIN_SUBSTEPS);
     info!(
         "compensator twin on the emulated Cortex-M4F; parameters {=str}",
         PARAMS_SOURCE

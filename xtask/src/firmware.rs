@@ -55,8 +55,15 @@ impl Image {
         target: M4,
         features: "qemu",
     };
+    /// The soak on QEMU: a seeded temperature walk with injected sensor
+    /// faults through the estimator, every tick checked (`docs/soak.md`).
+    pub const SOAK: Image = Image {
+        bin: "soak",
+        target: M4,
+        features: "qemu",
+    };
     /// The images a parameter file goes into.
-    pub const ALL: [Image; 4] = [Image::TWIN, Image::BENCH_M4, Image::BENCH_M3, Image::BOARD];
+    pub const ALL: [Image; 5] = [Image::TWIN, Image::BENCH_M4, Image::BENCH_M3, Image::BOARD, Image::SOAK];
 }
 
 /// Where firmware builds go (separate from host builds, which use another

@@ -356,7 +356,7 @@ fn host_cargo(root: &Path, args: &[&str], timeout: Duration) -> Result<(), Strin
 }
 
 /// A parameter file for a device with wide ranges: the paper's preset with
-/// the validated range 20-95 C (the file that made `build.rs`
+/// the validated range 20-95 C (the reported file that made `build.rs`
 /// panic), written under `target/`.
 fn wide_device_file(root: &Path) -> Result<PathBuf, String> {
     let text = std::fs::read_to_string(root.join("presets/paper.toml")).map_err(|e| e.to_string())?;
@@ -478,6 +478,30 @@ fn cmd_test(bless: bool) -> Outcome {
     let raw = compensator_params::file::load(&root.join("presets/paper.toml")).map_err(|e| e.to_string())?;
     let host = replica::run(&raw, &schedule)?;
     eprintln!("xtask: {}: {}", csv_path.display(), replica::compare(&decoded, &host)?);
+    step("QEMU: the soak (1e6 ticks of a seeded walk with injected sensor faults, every tick checked)");
+    let soak = &elfs
+        .iter()
+        .find(|(i, _)| *i == firmware::Image::SOAK)
+        .ok_or("no soak image")?
+        .1;
+    let started = std::time::Instant::now();
+    let soak_run = qemu::run(soak, qemu::NETDUINO, false, minutes(3), qemu::Show::Quiet)?;
+    if soak_run.code != 0 {
+        for l in &soak_run.lines {
+            eprintln!("{l}");
+        }
+        return Err(format!("the soak exited with {} (124: past its deadline)", soak_run.code).into());
+    }
+    eprintln!(
+        "xtask: {} ({:.0} s)",
+        soak_run
+            .lines
+            .iter()
+            .rev()
+            .find(|l| l.contains("soak:"))
+            .map_or("", String::as_str),
+        started.elapsed().as_secs_f64()
+    );
     step("QEMU: a HardFault reports and exits 1 at once");
     let fault = firmware::build(&tc, &root, &firmware::Image::FAULT, None)?;
     flash::check_fault_report(&fault)?;
@@ -583,7 +607,7 @@ mod tests {
 
     #[test]
     fn misspelt_or_unknown_arguments_are_errors() {
-        // The case: `test --bles` used to run the tests without blessing.
+        // The reported case: `test --bles` used to run the tests without blessing.
         assert_eq!(parse(&["test", "--bles"]), Err(ErrorKind::UnknownArgument));
         assert_eq!(parse(&["bench", "--wrte"]), Err(ErrorKind::UnknownArgument));
         assert_eq!(parse(&["run", "extra"]), Err(ErrorKind::UnknownArgument));

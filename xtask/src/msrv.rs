@@ -111,7 +111,7 @@ mod tests {
             pkg("fixed", Some("1.93"), false),
             pkg("libm", None, false),
         ];
-        // The claim: 1.85 against fixed's 1.93.
+        // The reported claim: 1.85 against fixed's 1.93.
         let e = verdict(Version(1, 85, 0), &locked).unwrap_err();
         assert!(e.contains("fixed") && e.contains("1.93.0"), "{e}");
         assert!(verdict(Version(1, 93, 0), &locked).unwrap().contains("fixed"));

@@ -8,7 +8,7 @@
 
 use crate::telemetry::{self, Record};
 use compensator::Params;
-use compensator::estimator::{Estimator, EstimatorConfig, Flags, StateEstimate};
+use compensator::estimator::{Estimator, EstimatorConfig, StateEstimate};
 use compensator::params::RawParams;
 use compensator::sensor::TemperatureSource;
 use compensator::sensor::max31865::{Max31865, Settings, fault};
@@ -79,12 +79,7 @@ impl Schedule {
 /// The telemetry line the firmware prints for `e` at `ms` (defmt and Rust
 /// print an `f32` in the same shortest round-trip form).
 fn line(ms: u32, e: &StateEstimate) -> String {
-    let flags: Vec<&str> = Flags::NAMES
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| e.flags.0 & (1 << i) != 0)
-        .map(|(_, n)| *n)
-        .collect();
+    let flags: Vec<&str> = e.flags.names().collect();
     let flags = if flags.is_empty() {
         "-".to_string()
     } else {

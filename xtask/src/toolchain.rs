@@ -510,7 +510,7 @@ mod tests {
 
     #[test]
     fn stale_lists_are_refreshed_and_the_fresh_candidate_taken() {
-        // The machine: months-old lists offer 1.85; after an update, 1.96.
+        // The reported machine: months-old lists offer 1.85; after an update, 1.96.
         let mut apt = FakeApt {
             lists: bookworm("1.85.0"),
             fresh: bookworm("1.96.0"),

@@ -18,7 +18,7 @@ use compensator::asymptotic::{Expansion, Reading, monotonicity};
 use compensator::equilibrium::equilibrium;
 use std::fmt::Write as _;
 use std::path::Path;
-use tables::{BAR, Table1, Table2, invert_table1, table1_residuals, table2_residuals};
+use tables::{BAR, Table2, invert_table1, load_tables, table1_residuals, table2_residuals};
 
 /// One candidate of [`asymptotic_search`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -111,13 +111,22 @@ pub fn chamber_gradient(params: &Params<f64>, dp: f64, lo: f64, hi: f64) -> Resu
     Ok((sum_a / n as f64, max_a, sum_b / n as f64))
 }
 
-/// `paper`: the findings of the README, recomputed.
-pub fn report(path: &Path, data: &Path) -> Result<String, CliError> {
-    let (raw, p) = load_params::<f64>(path)?;
-    let t1 = Table1::load(&data.join("table1.csv")).map_err(CliError::Input)?;
-    let t2 = Table2::load(&data.join("table2.csv")).map_err(CliError::Input)?;
+/// `paper`: the findings of the README, recomputed, with the parameter
+/// file `path` and the tables in `data` (without them: the built-in
+/// `presets/paper.toml` and `data/paper/`).
+pub fn report(path: Option<&Path>, data: Option<&Path>) -> Result<String, CliError> {
+    let (raw, p) = match path {
+        Some(path) => load_params::<f64>(path)?,
+        None => {
+            let raw = crate::params_file::parse(crate::input::PAPER_PRESET)?;
+            let p = Params::<f64>::new(&raw).map_err(|e| CliError::Input(e.to_string()))?;
+            (raw, p)
+        }
+    };
+    let (t1, t2) = load_tables(data).map_err(CliError::Input)?;
     let mut o = String::new();
-    let _ = writeln!(o, "# Paper reproduction with {}", path.display());
+    let shown = path.map_or("presets/paper.toml".into(), |p| p.display().to_string());
+    let _ = writeln!(o, "# Paper reproduction with {shown}");
 
     let inv = invert_table1(&t1);
     let _ = writeln!(o, "\n## Table 1 inverted for A(t) [sqrt(Pa)], column by column");

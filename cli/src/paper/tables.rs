@@ -34,11 +34,15 @@ pub struct Table2 {
     pub x_asym_mm: Vec<f64>,
 }
 
+/// The text of a data file.
+fn read_file(path: &Path) -> Result<String, String> {
+    std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))
+}
+
 /// A table of finite numbers whose first column is `t_c`, with at least two
 /// rows (the fits and the Walther start need two temperatures).
-fn read(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let (header, rows) = csv::parse(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+fn read(path: &Path, text: &str) -> Result<(Vec<String>, Vec<Vec<f64>>), String> {
+    let (header, rows) = csv::parse(text).map_err(|e| format!("{}: {e}", path.display()))?;
     if header.first().map(String::as_str) != Some("t_c") {
         return Err(format!("{}: the first column must be t_c", path.display()));
     }
@@ -58,7 +62,12 @@ fn read(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), String> {
 impl Table1 {
     /// Reads `t_c,dp_ab_<N>bar,...`.
     pub fn load(path: &Path) -> Result<Self, String> {
-        let (header, rows) = read(path)?;
+        Self::parse(path, &read_file(path)?)
+    }
+
+    /// As [`Self::load`], from the text of the file `path`.
+    pub fn parse(path: &Path, text: &str) -> Result<Self, String> {
+        let (header, rows) = read(path, text)?;
         if header.len() < 2 {
             return Err(format!("{}: no dp_ab_<N>bar column", path.display()));
         }
@@ -92,7 +101,12 @@ impl Table1 {
 impl Table2 {
     /// Reads `t_c,x_qs_mm,x_asym_mm,...`.
     pub fn load(path: &Path) -> Result<Self, String> {
-        let (header, rows) = read(path)?;
+        Self::parse(path, &read_file(path)?)
+    }
+
+    /// As [`Self::load`], from the text of the file `path`.
+    pub fn parse(path: &Path, text: &str) -> Result<Self, String> {
+        let (header, rows) = read(path, text)?;
         let col = |name: &str| {
             header
                 .iter()
@@ -179,4 +193,19 @@ pub fn table2_residuals(params: &Params<f64>, t2: &Table2) -> Vec<f64> {
             Err(_) => f64::INFINITY,
         })
         .collect()
+}
+
+/// Tables 1 and 2 from `data`'s `table1.csv` and `table2.csv`, or the
+/// copies built into the binary (`data/paper/`) without `data`.
+pub fn load_tables(data: Option<&Path>) -> Result<(Table1, Table2), String> {
+    match data {
+        Some(dir) => Ok((
+            Table1::load(&dir.join("table1.csv"))?,
+            Table2::load(&dir.join("table2.csv"))?,
+        )),
+        None => Ok((
+            Table1::parse(Path::new("data/paper/table1.csv"), crate::input::TABLE1_CSV)?,
+            Table2::parse(Path::new("data/paper/table2.csv"), crate::input::TABLE2_CSV)?,
+        )),
+    }
 }

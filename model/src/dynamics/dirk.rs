@@ -61,7 +61,8 @@
 // Tableau code indexes stages explicitly, as the methods are written.
 #![allow(clippy::needless_range_loop)]
 
-use super::fsi::{Coefficients, Contact};
+use super::coefficients::Coefficients;
+use super::stops::Contact;
 use crate::scalar::Real;
 
 /// Newton iterations of a step's first stage: its starting velocity is the
@@ -184,7 +185,7 @@ fn root<T: Real>(k: T, q: T, c: T) -> (T, T) {
 /// leaving it out of the derivative changes no survey figure).
 #[inline]
 fn chamber<T: Real>(c: &Coefficients<T>, tau: T, hg: T, u_z: T, w: T) -> Chamber<T> {
-    let e = c.g_l - c.sigma * w;
+    let e = c.drive(w);
     // du/dw = -D n sigma, n = 1 (k-form) or beta.
     let (u, d, n) = if tau <= hg {
         let k = tau / hg;
@@ -352,11 +353,8 @@ impl<T: Real> Dirk<T> {
 /// `xi` limited to the stroke (the volumes at the stops).
 #[inline]
 fn time_constants<T: Real>(c: &Coefficients<T>, xi: T) -> (T, T) {
-    let x = xi.clamp_to(T::ZERO, T::ONE);
-    (
-        (T::ONE - c.eps_a * x) * c.inv_omega_a0,
-        (T::ONE + c.eps_b * x) * c.inv_omega_b0,
-    )
+    let (va, vb) = c.relative_volumes(xi.clamp_to(T::ZERO, T::ONE));
+    (va * c.inv_omega_a0, vb * c.inv_omega_b0)
 }
 
 #[cfg(test)]

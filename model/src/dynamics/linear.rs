@@ -2,10 +2,10 @@
 //! Jacobian of the FSI model, its eigenvalues, natural frequencies, damping
 //! ratios and a stability verdict.
 //!
-//! * [`eigenvalues`]: all four eigenvalues of a real 4x4 matrix by balancing,
-//!   reduction to Hessenberg form and the shifted (Francis double-step) QR
-//!   algorithm of EISPACK's `hqr`. Bounded cost: at most 30 QR sweeps per
-//!   eigenvalue (120 in all), else [`ModelError::NoConvergence`].
+//! * [`linearise`]: the eigenvalues of that Jacobian by
+//!   [`crate::linalg::eigen`] (EISPACK's balancing, Hessenberg reduction
+//!   and `hqr`; bounded cost, else [`ModelError::NoConvergence`]), with
+//!   natural frequencies, damping ratios and the plunger's damping ratio.
 //! * [`hurwitz_stable`]: the same stability verdict from the characteristic
 //!   polynomial's Routh-Hurwitz conditions, ~100 multiplications, no
 //!   iteration: what the estimator evaluates (one of its rotating jobs).
@@ -18,336 +18,15 @@
 // written (EISPACK, Hairer & Wanner); iterator chains would obscure them.
 #![allow(clippy::needless_range_loop)]
 
-use super::fsi::{Contact, Fsi, Model};
+use super::coefficients::Model;
+use super::fsi::Fsi;
 use super::schemes::OdeSystem;
+use super::stops::Contact;
 use crate::equilibrium::{Stop, equilibrium};
-use crate::error::{ModelError, finite};
+use crate::error::ModelError;
+pub use crate::linalg::eigen::{Complex, eigenvalues};
 use crate::params::Params;
 use crate::scalar::{Float, Real};
-
-/// A complex number.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Complex<T> {
-    /// Real part.
-    pub re: T,
-    /// Imaginary part.
-    pub im: T,
-}
-
-impl<T: Float> Complex<T> {
-    /// Modulus.
-    pub fn abs(self) -> T {
-        (self.re * self.re + self.im * self.im).sqrt()
-    }
-}
-
-/// `|a|` with the sign of `b` (Fortran's SIGN).
-#[inline]
-fn sign<T: Real>(a: T, b: T) -> T {
-    if b >= T::ZERO { a.abs() } else { -a.abs() }
-}
-
-/// Eigenvalues of a real 4x4 matrix, sorted by real part, largest first
-/// (ties: larger imaginary part first).
-///
-/// # Errors
-///
-/// `NonFinite("Jacobian")` when an entry of `m` is not finite;
-/// `NoConvergence("eigenvalues")` when the QR iteration needs more than 30
-/// sweeps for one eigenvalue.
-pub fn eigenvalues<T: Float>(m: &[[T; 4]; 4]) -> Result<[Complex<T>; 4], ModelError> {
-    const N: usize = 4;
-    // 1-based working copy, as in EISPACK.
-    let mut a = [[T::ZERO; N + 1]; N + 1];
-    for i in 0..N {
-        for j in 0..N {
-            a[i + 1][j + 1] = finite(m[i][j], "Jacobian")?;
-        }
-    }
-    balance(&mut a);
-    hessenberg(&mut a);
-    let mut wr = [T::ZERO; N + 1];
-    let mut wi = [T::ZERO; N + 1];
-    hqr(&mut a, &mut wr, &mut wi)?;
-    let mut out = [Complex {
-        re: T::ZERO,
-        im: T::ZERO,
-    }; N];
-    for i in 0..N {
-        out[i] = Complex {
-            re: wr[i + 1],
-            im: wi[i + 1],
-        };
-    }
-    // Insertion sort: real part descending, then imaginary descending.
-    for i in 1..N {
-        let mut j = i;
-        while j > 0 && (out[j].re > out[j - 1].re || (out[j].re == out[j - 1].re && out[j].im > out[j - 1].im)) {
-            out.swap(j, j - 1);
-            j -= 1;
-        }
-    }
-    Ok(out)
-}
-
-/// Parlett-Reinsch balancing by powers of two (at most 16 sweeps).
-fn balance<T: Float>(a: &mut [[T; 5]; 5]) {
-    let n = 4;
-    let radix = T::from_f64(2.0);
-    let sqrdx = radix * radix;
-    for _ in 0..16 {
-        let mut done = true;
-        for i in 1..=n {
-            let (mut r, mut c) = (T::ZERO, T::ZERO);
-            for j in 1..=n {
-                if j != i {
-                    c += a[j][i].abs();
-                    r += a[i][j].abs();
-                }
-            }
-            if c > T::ZERO && r > T::ZERO {
-                let mut g = r / radix;
-                let mut f = T::ONE;
-                let s = c + r;
-                let mut guard = 0;
-                while c < g && guard < 64 {
-                    f *= radix;
-                    c *= sqrdx;
-                    guard += 1;
-                }
-                g = r * radix;
-                while c > g && guard < 128 {
-                    f = f / radix;
-                    c = c / sqrdx;
-                    guard += 1;
-                }
-                if (c + r) / f < T::from_f64(0.95) * s {
-                    done = false;
-                    let g = T::ONE / f;
-                    for j in 1..=n {
-                        a[i][j] *= g;
-                    }
-                    for j in 1..=n {
-                        a[j][i] *= f;
-                    }
-                }
-            }
-        }
-        if done {
-            break;
-        }
-    }
-}
-
-/// Reduction to upper Hessenberg form by stabilised elementary similarity
-/// transformations (EISPACK `elmhes`).
-fn hessenberg<T: Float>(a: &mut [[T; 5]; 5]) {
-    let n = 4;
-    for m in 2..n {
-        let mut x = T::ZERO;
-        let mut i = m;
-        for j in m..=n {
-            if a[j][m - 1].abs() > x.abs() {
-                x = a[j][m - 1];
-                i = j;
-            }
-        }
-        if i != m {
-            for j in (m - 1)..=n {
-                let t = a[i][j];
-                a[i][j] = a[m][j];
-                a[m][j] = t;
-            }
-            for row in a.iter_mut().skip(1) {
-                row.swap(i, m);
-            }
-        }
-        if x != T::ZERO {
-            for i in (m + 1)..=n {
-                let mut y = a[i][m - 1];
-                if y != T::ZERO {
-                    y = y / x;
-                    a[i][m - 1] = y;
-                    for j in m..=n {
-                        let t = a[m][j];
-                        a[i][j] -= y * t;
-                    }
-                    for row in a.iter_mut().skip(1) {
-                        let t = row[i];
-                        row[m] += y * t;
-                    }
-                }
-            }
-        }
-    }
-}
-
-/// Eigenvalues of an upper Hessenberg matrix (EISPACK `hqr`).
-fn hqr<T: Float>(a: &mut [[T; 5]; 5], wr: &mut [T; 5], wi: &mut [T; 5]) -> Result<(), ModelError> {
-    let n: usize = 4;
-    let mut anorm = T::ZERO;
-    for i in 1..=n {
-        for j in (if i > 1 { i - 1 } else { 1 })..=n {
-            anorm += a[i][j].abs();
-        }
-    }
-    let (c075, c04375, half) = (T::from_f64(0.75), T::from_f64(-0.4375), T::from_f64(0.5));
-    let mut nn = n;
-    let mut t = T::ZERO;
-    while nn >= 1 {
-        let mut its = 0;
-        loop {
-            // Look for a single small subdiagonal element.
-            let mut l = nn;
-            while l >= 2 {
-                let mut s = a[l - 1][l - 1].abs() + a[l][l].abs();
-                if s == T::ZERO {
-                    s = anorm;
-                }
-                if a[l][l - 1].abs() + s == s {
-                    a[l][l - 1] = T::ZERO;
-                    break;
-                }
-                l -= 1;
-            }
-            let mut x = a[nn][nn];
-            if l == nn {
-                // One root found.
-                wr[nn] = x + t;
-                wi[nn] = T::ZERO;
-                nn -= 1;
-                break;
-            }
-            let mut y = a[nn - 1][nn - 1];
-            let mut w = a[nn][nn - 1] * a[nn - 1][nn];
-            if l == nn - 1 {
-                // Two roots found.
-                let p = half * (y - x);
-                let q = p * p + w;
-                let z = q.abs().sqrt();
-                x += t;
-                if q >= T::ZERO {
-                    let z = p + sign(z, p);
-                    wr[nn - 1] = x + z;
-                    wr[nn] = if z != T::ZERO { x - w / z } else { x + z };
-                    wi[nn - 1] = T::ZERO;
-                    wi[nn] = T::ZERO;
-                } else {
-                    wr[nn - 1] = x + p;
-                    wr[nn] = x + p;
-                    wi[nn - 1] = -z;
-                    wi[nn] = z;
-                }
-                nn -= 2;
-                break;
-            }
-            if its == 30 {
-                return Err(ModelError::NoConvergence("eigenvalues"));
-            }
-            if its == 10 || its == 20 {
-                // Exceptional shift.
-                t += x;
-                for i in 1..=nn {
-                    a[i][i] -= x;
-                }
-                let s = a[nn][nn - 1].abs() + a[nn - 1][nn - 2].abs();
-                x = c075 * s;
-                y = x;
-                w = c04375 * s * s;
-            }
-            its += 1;
-            // Form the shift and look for two consecutive small subdiagonals.
-            let mut m = nn - 2;
-            let (mut p, mut q, mut r);
-            loop {
-                let z = a[m][m];
-                let r1 = x - z;
-                let s1 = y - z;
-                p = (r1 * s1 - w) / a[m + 1][m] + a[m][m + 1];
-                q = a[m + 1][m + 1] - z - r1 - s1;
-                r = a[m + 2][m + 1];
-                let s = p.abs() + q.abs() + r.abs();
-                p = p / s;
-                q = q / s;
-                r = r / s;
-                if m == l {
-                    break;
-                }
-                let u = a[m][m - 1].abs() * (q.abs() + r.abs());
-                let v = p.abs() * (a[m - 1][m - 1].abs() + z.abs() + a[m + 1][m + 1].abs());
-                if u + v == v {
-                    break;
-                }
-                m -= 1;
-            }
-            for i in (m + 2)..=nn {
-                a[i][i - 2] = T::ZERO;
-                if i != m + 2 {
-                    a[i][i - 3] = T::ZERO;
-                }
-            }
-            // Double QR step on rows l..nn and columns m..nn.
-            let mut k = m;
-            while k < nn {
-                if k != m {
-                    p = a[k][k - 1];
-                    q = a[k + 1][k - 1];
-                    r = if k != nn - 1 { a[k + 2][k - 1] } else { T::ZERO };
-                    x = p.abs() + q.abs() + r.abs();
-                    if x != T::ZERO {
-                        p = p / x;
-                        q = q / x;
-                        r = r / x;
-                    }
-                }
-                let s = sign((p * p + q * q + r * r).sqrt(), p);
-                if s != T::ZERO {
-                    if k == m {
-                        if l != m {
-                            a[k][k - 1] = -a[k][k - 1];
-                        }
-                    } else {
-                        a[k][k - 1] = -s * x;
-                    }
-                    p += s;
-                    x = p / s;
-                    y = q / s;
-                    let z = r / s;
-                    q = q / p;
-                    r = r / p;
-                    for j in k..=nn {
-                        let mut pp = a[k][j] + q * a[k + 1][j];
-                        if k != nn - 1 {
-                            pp += r * a[k + 2][j];
-                            a[k + 2][j] -= pp * z;
-                        }
-                        a[k + 1][j] -= pp * y;
-                        a[k][j] -= pp * x;
-                    }
-                    let mmin = if nn < k + 3 { nn } else { k + 3 };
-                    for i in l..=mmin {
-                        let mut pp = x * a[i][k] + y * a[i][k + 1];
-                        if k != nn - 1 {
-                            pp += z * a[i][k + 2];
-                            a[i][k + 2] -= pp * r;
-                        }
-                        a[i][k + 1] -= pp * q;
-                        a[i][k] -= pp;
-                    }
-                }
-                k += 1;
-            }
-            if l >= nn - 1 {
-                break;
-            }
-        }
-    }
-    for i in 1..=n {
-        finite(wr[i], "eigenvalue")?;
-        finite(wi[i], "eigenvalue")?;
-    }
-    Ok(())
-}
 
 /// Coefficients `(a3, a2, a1, a0)` of `det(s I - M) = s^4 + a3 s^3 + a2 s^2 + a1 s + a0`.
 pub fn characteristic_polynomial<T: Real>(m: &[[T; 4]; 4]) -> [T; 4] {
@@ -446,7 +125,7 @@ pub fn linearise<F: Float>(params: &Params<F>, t: F) -> Result<Linearisation<F>,
     }
     let eq = equilibrium(params, t)?;
     let c = model.coefficients::<F>(&eq.fluid)?;
-    let (s, ds) = super::reduced::quasi_steady(&c, F::ZERO);
+    let (s, ds) = c.quasi_steady(F::ZERO);
     // w' = ... - (2 zeta - 4 s ds phi / a_x) w: the plunger's total damping.
     let two_zeta_total = c.two_zeta - F::from_f64(4.0) * s * ds * c.phi_over_a_x;
     Ok(Linearisation {
@@ -466,7 +145,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn companion_matrix_roots() {
+    fn companion_matrix_polynomial_and_stability() {
         // (s + 1)(s + 2)(s^2 + 2 s + 5): roots -1, -2, -1 +- 2i.
         // Expanded: s^4 + 5 s^3 + 13 s^2 + 19 s + 10.
         let m = [
@@ -475,11 +154,6 @@ mod tests {
             [0.0, 1.0, 0.0, 0.0],
             [0.0, 0.0, 1.0, 0.0],
         ];
-        let ev = eigenvalues(&m).unwrap();
-        let expect = [(-1.0, 2.0), (-1.0, 0.0), (-1.0, -2.0), (-2.0, 0.0)];
-        for (e, (re, im)) in ev.iter().zip(expect) {
-            assert!((e.re - re).abs() < 1e-12 && (e.im - im).abs() < 1e-12, "{ev:?}");
-        }
         assert_eq!(characteristic_polynomial(&m), [5.0, 13.0, 19.0, 10.0]);
         assert!(hurwitz_stable(&m));
         let unstable = [
@@ -489,6 +163,5 @@ mod tests {
             [0.0, 0.0, 1.0, 0.0],
         ];
         assert!(!hurwitz_stable(&unstable));
-        assert!(eigenvalues(&[[f64::NAN; 4]; 4]).is_err());
     }
 }

@@ -1,24 +1,38 @@
 //! The reduced-order fluid-structure model (paper section 4, Eqs. 33-37)
 //! and its fixed-step integration.
 //!
-//! * [`fsi`]: the model, nondimensionalised (units chosen for fixed point).
+//! * [`units`]: the model's units (chosen for fixed point) and SI states.
+//! * [`coefficients`]: the model's coefficients for a parameter set and an
+//!   oil temperature, and the formulas every integrator shares (static
+//!   force, chamber volumes, net inflows, quasi-steady root).
+//! * [`stops`]: the inelastic end stops ([`Contact`], the equilibrium's
+//!   [`crate::equilibrium::Stop`]).
+//! * [`fsi`]: the model's right-hand side, Jacobian and structured
+//!   factorisation (what the generic schemes integrate).
+//! * [`dirk`]: the SDIRK steps with the pressures eliminated exactly (the
+//!   shipped scheme); [`config`]: choosing a configuration for a design.
 //! * [`schemes`]: Rosenbrock and Runge-Kutta one-step schemes.
 //! * [`twin`]: the fixed-cost integrator the firmware ticks.
 //! * [`reduced`]: the singular-perturbation limit (pressures quasi-steady).
 //! * [`linear`]: linearisation at an equilibrium (Eq. 37): eigenvalues,
 //!   natural frequencies, damping ratios, stability.
 
+pub mod coefficients;
 pub mod config;
 pub mod dirk;
 pub mod fsi;
 pub mod linear;
 pub mod reduced;
 pub mod schemes;
+pub mod stops;
 pub mod twin;
+pub mod units;
 
-pub use fsi::{Contact, DynamicState, Model};
+pub use coefficients::Model;
 pub use schemes::{Scheme, StepError};
+pub use stops::Contact;
 pub use twin::{TickReport, Twin, TwinConfig};
+pub use units::DynamicState;
 
 use crate::error::ModelError;
 use crate::scalar::Float;

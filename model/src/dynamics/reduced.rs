@@ -14,30 +14,20 @@
 //! so the reduced model is two states `(xi, w)` whose pressure force
 //! carries the hydraulic damping `d(2 s^2 - 1)/dw = -4 s sigma / (2 g_l s + q_t)`.
 //! It is valid while `sigma w < g_l` (the plunger does not outrun the
-//! capillaries' flow); beyond, `s` is held at zero.
+//! capillaries' flow); beyond, `s` is held at zero. The root is
+//! [`Coefficients::quasi_steady`], the one the full model's
+//! [`Coefficients::quasi_steady_force`] takes at rest.
 
 use super::TwinConfig;
-use super::fsi::{Coefficients, Contact, DynamicState, Model, apply_stops, contact_for};
+use super::coefficients::{Coefficients, Model};
 use super::schemes::{OdeSystem, StepError, Stepper, dense_linearisation};
+use super::stops::{Contact, apply_stops, contact_for};
+use super::units::DynamicState;
 use crate::equilibrium::equilibrium;
 use crate::error::ModelError;
 use crate::linalg::Lu;
 use crate::params::Params;
 use crate::scalar::{Float, Real};
-
-/// Quasi-steady `s = sqrt(1 - pi_a) = sqrt(pi_b)` and `ds/dw` for velocity `w`.
-pub fn quasi_steady<T: Real>(c: &Coefficients<T>, w: T) -> (T, T) {
-    let two = T::ONE + T::ONE;
-    let drive = (c.g_l - c.sigma * w).max(T::ZERO);
-    let root = (c.q_t * c.q_t + two * two * c.g_l * drive).sqrt();
-    let s = two * drive / (c.q_t + root);
-    let ds = if drive > T::ZERO {
-        -(c.sigma / (two * c.g_l * s + c.q_t))
-    } else {
-        T::ZERO
-    };
-    (s, ds)
-}
 
 /// The reduced model in one contact state.
 #[derive(Clone, Copy, Debug)]
@@ -67,7 +57,7 @@ impl<T: Real> OdeSystem<T, 2> for ReducedFsi<'_, T> {
             return [T::ZERO; 2];
         }
         let c = self.coefficients;
-        let (s, _) = quasi_steady(c, y[1]);
+        let (s, _) = c.quasi_steady(y[1]);
         let force = c.phi_over_a_x * (s * s + s * s - T::ONE) - (c.xi0 + y[0]) * c.inv_a_x;
         [c.a_x * y[1], force - c.two_zeta * y[1]]
     }
@@ -77,7 +67,7 @@ impl<T: Real> OdeSystem<T, 2> for ReducedFsi<'_, T> {
             return [[T::ZERO; 2]; 2];
         }
         let c = self.coefficients;
-        let (s, ds) = quasi_steady(c, y[1]);
+        let (s, ds) = c.quasi_steady(y[1]);
         let four = T::from_f64(4.0);
         [
             [T::ZERO, c.a_x],
@@ -163,7 +153,7 @@ impl<F: Float, T: Real> ReducedTwin<F, T> {
 
     /// The state in SI units, with the quasi-steady pressures.
     pub fn state(&self) -> DynamicState<F> {
-        let (s, _) = quasi_steady(&self.coefficients, self.state[1]);
+        let (s, _) = self.coefficients.quasi_steady(self.state[1]);
         let pb = s * s;
         self.model
             .scales

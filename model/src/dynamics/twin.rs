@@ -19,9 +19,12 @@
 //! fluid properties at the sensor rate) and the integration scalar `T`
 //! (`f32`, `f64` or fixed point).
 
+use super::coefficients::{Coefficients, Model};
 use super::dirk::Dirk;
-use super::fsi::{Coefficients, Contact, DynamicState, Fsi, Model};
+use super::fsi::Fsi;
 use super::schemes::{Scheme, StepError, Stepper};
+use super::stops::{Contact, away_from};
+use super::units::DynamicState;
 use crate::equilibrium::equilibrium;
 use crate::error::ModelError;
 use crate::fluid::FluidState;
@@ -130,16 +133,6 @@ pub const ABRUPT_CHANGE: f64 = 0.01;
 /// one waits for the next substep (an impact then ends on the stop at the
 /// substep's end, a release at its start).
 pub const EVENTS_PER_SUBSTEP: u8 = 1;
-
-/// The static force on a plunger held at `held`'s stop, positive when it
-/// pulls the plunger off the stop.
-#[inline]
-fn away_from<T: Real>(c: &Coefficients<T>, held: Contact, y: &[T; 4]) -> T {
-    match held {
-        Contact::Open => -c.static_force(y),
-        _ => c.static_force(y),
-    }
-}
 
 /// The integrator behind a twin.
 #[derive(Clone, Copy, Debug)]
@@ -253,7 +246,7 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// As [`Twin::set_temperature`] from an already evaluated fluid state.
     /// A change of the capillary conductance by more than
     /// [`ABRUPT_CHANGE`] (relative), or of the flow unit
-    /// ([`super::fsi::flow_shift`]), makes the next tick start graded.
+    /// ([`super::coefficients::flow_shift`]), makes the next tick start graded.
     ///
     /// # Errors
     ///

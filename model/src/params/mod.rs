@@ -10,8 +10,8 @@
 //! function of the core may divide by its positive fields.
 
 pub use compensator_params::{
-    CORE_FIELDS, CoreFields, ESTIMATOR_FIELDS, EstimatorFields, Field, MACHINE_FIELDS, MachineFields, Named,
-    ParamError, Problem, RawCore, RawEstimator, RawMachine, RawParams,
+    CORE_FIELDS, Compact, CoreFields, ECHO_MAX, ESTIMATOR_FIELDS, Echo, EstimatorFields, Field, Kind, MACHINE_FIELDS,
+    MachineFields, Named, ParamError, Problem, Range, RawCore, RawEstimator, RawMachine, RawParams, VISCOSITY_40C_CST,
 };
 
 use crate::fluid::Oil;
@@ -61,7 +61,15 @@ pub struct Machine<T> {
     pub leakage_temperature: T,
 }
 
-/// A validated parameter set in scalar type `T`.
+/// A parameter set in scalar type `T` (SI units).
+///
+/// [`Params::new`] builds it from a [`RawParams`] it validates first (every
+/// field in its plausible range, the rules between fields). The fields are
+/// public, so that sizing tools and tests can vary one (a chamber's bulk
+/// modulus beyond any oil, say): a set changed by hand carries no such
+/// guarantee, and the model's functions do not assume one. They return a
+/// `ModelError` naming the quantity that came out not finite or out of
+/// range instead.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Params<T> {
     /// The oil.
@@ -104,15 +112,32 @@ fn conv<T: Float>(n: Named) -> Result<T, ParamError> {
     }
 }
 
+/// Converts a validated temperature [C] to `T`: a value that underflows is
+/// 0 C there, harmless (temperatures are never divided by; the plausible
+/// range keeps them finite).
+fn conv_temperature<T: Float>(n: Named) -> Result<T, ParamError> {
+    let t = T::from_f64(n.value);
+    if t.is_finite() {
+        Ok(t)
+    } else {
+        Err(ParamError {
+            field: n.path,
+            value: n.value,
+            problem: Problem::NotRepresentable(T::NAME),
+        })
+    }
+}
+
 impl<T: Float> Params<T> {
     /// Validates `raw` and converts it to `T`.
     ///
     /// Errors name the offending field (`section.key`).
     pub fn new(raw: &RawParams) -> Result<Self, ParamError> {
-        // `from_core` validates the core and machine sections.
-        let params = Self::from_core(&raw.core, raw.machine.as_ref())?;
-        raw.estimator.validate()?;
-        Ok(params)
+        // Every field's own range first, in every section, then the rules
+        // between fields (`RawParams::validate`): the blame lands on the
+        // field that is wrong.
+        raw.validate()?;
+        Self::from_core(&raw.core, raw.machine.as_ref())
     }
 
     /// As [`Params::new`], from the sections separately.
@@ -164,7 +189,7 @@ impl<T: Float> Params<T> {
                     Some(Machine {
                         working_flow: conv(n.working_flow)?,
                         leakage_reference: conv(n.leakage_reference)?,
-                        leakage_temperature: conv(n.leakage_temperature)?,
+                        leakage_temperature: conv_temperature(n.leakage_temperature)?,
                     })
                 }
             },
@@ -333,28 +358,51 @@ mod tests {
         );
     }
 
-    /// A value `f32` loses (to zero or infinity) is reported under the name
-    /// of the field it was in.
+    /// Every value the schema's plausible ranges admit fits `f32`, the
+    /// derived quantities too: each field at either end of its range (the
+    /// others as in [`CORE`]), where the rules between fields accept it,
+    /// converts.
     #[test]
-    fn a_value_f32_cannot_hold_names_its_own_field() {
+    fn every_plausible_value_fits_f32() {
         for field in CORE_FIELDS.iter().chain(MACHINE_FIELDS.iter()) {
-            let mut checked = false;
-            for lost in [1e-60, 1e60] {
-                let with = |n: Named| if n.path == field.path { lost } else { n.value };
+            for end in [field.min, field.max] {
+                let with = |n: Named| if n.path == field.path { end } else { n.value };
                 let (core, machine) = (CORE.map(with), MACHINE.map(with));
                 if core.validate().and(machine.validate()).is_err() {
                     continue;
                 }
-                let e = Params::<f32>::from_core(&core, Some(&machine)).unwrap_err();
+                let p = Params::<f32>::from_core(&core, Some(&machine));
+                assert!(p.is_ok(), "{} = {end}: {p:?}", field.path);
+            }
+        }
+    }
+
+    /// A value `f32` loses (to zero or infinity) is reported under the name
+    /// of the field it was in (the ranges keep file values clear of it;
+    /// the conversion checks anyway).
+    #[test]
+    fn a_value_f32_cannot_hold_names_its_own_field() {
+        for field in CORE_FIELDS.iter().chain(MACHINE_FIELDS.iter()) {
+            for lost in [1e-60, 1e60] {
+                let e = conv::<f32>(Named {
+                    path: field.path,
+                    value: lost,
+                })
+                .unwrap_err();
                 assert_eq!(
                     (e.field, e.value, e.problem),
                     (field.path, lost, Problem::NotRepresentable("f32"))
                 );
-                checked = true;
             }
-            assert!(checked, "{}: no valid value that f32 loses", field.path);
         }
         // The same values in `f64` are fine.
+        assert_eq!(
+            conv::<f64>(Named {
+                path: "x",
+                value: 1e-60
+            }),
+            Ok(1e-60)
+        );
         assert!(Params::<f64>::from_core(&CORE, Some(&MACHINE)).is_ok());
     }
 }

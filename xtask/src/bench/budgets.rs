@@ -1,11 +1,11 @@
-//! The firmware issue's budgets and the check of the measurements against
+//! The firmware's budgets and the check of the measurements against
 //! them (`cargo xtask bench`, and `cargo xtask test` through
 //! [`super::check`]).
 
 use super::Firmware;
 use super::measure::Built;
 
-/// The budgets of the firmware issue.
+/// The firmware's budgets.
 pub const BUDGET_INSTRUCTIONS: f64 = 3000.0;
 /// The twin's plain tick on the paper preset (the configuration its build
 /// chooses) [instructions].
@@ -17,7 +17,7 @@ pub const BUDGET_RAM: u64 = 8 * 1024;
 /// Peak stack budget [bytes]. The peak is reached once, at start: `main`
 /// (the replay's state, the estimator) calling `Estimator::new` calling
 /// `Twin::new`, which builds the 512-byte twin on its own frame before it
-/// moves in (4.3-4.6 KiB since the twin carries its graded-piece scheme,
+/// moves in (4.3-4.8 KiB since the twin carries its graded-piece scheme,
 /// its flow unit and the stop events; frames in the disassembly: `main`
 /// 3.0 KiB, `Twin::new` 1.1 KiB, a twin tick's about 0.5 KiB).
 /// The board's stack has the 64 KiB CCM to itself (`link/memory-board.x`),

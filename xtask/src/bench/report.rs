@@ -83,7 +83,7 @@ pub fn document(fw: &Firmware, budget: &Budget, accuracy: &[Accuracy]) -> String
         m4.per_count
     );
     let _ = writeln!(t, "{:.3} on netduino2).\n", m3.per_count);
-    let _ = writeln!(t, "## Budget (firmware issue)\n");
+    let _ = writeln!(t, "## Budget\n");
     t.push_str(&budget_table(fw, budget));
 
     let _ = writeln!(t, "\n## Estimator pieces (Cortex-M4F, f32, one call each)\n");

@@ -1,0 +1,67 @@
+//! What the commands read: a parameter file (a path, or `-` for standard
+//! input, bounded in size) and the paper's data and presets built into the
+//! binary, so that `calibrate` and `paper` work from any directory.
+
+use crate::error::CliError;
+use crate::params_file;
+use compensator::RawParams;
+use std::io::Read;
+use std::path::Path;
+
+/// Largest parameter file read [bytes]: 1 MiB.
+pub const MAX_PARAMS_BYTES: u64 = 1 << 20;
+
+/// `presets/paper.toml`, built in.
+pub const PAPER_PRESET: &str = include_str!("../../presets/paper.toml");
+/// `presets/model-example.toml`, built in.
+pub const MODEL_EXAMPLE: &str = include_str!("../../presets/model-example.toml");
+/// `data/paper/table1.csv`, built in.
+pub const TABLE1_CSV: &str = include_str!("../../data/paper/table1.csv");
+/// `data/paper/table2.csv`, built in.
+pub const TABLE2_CSV: &str = include_str!("../../data/paper/table2.csv");
+
+/// Reads at most `MAX_PARAMS_BYTES` from `r`; more is bad input of `flag`.
+fn read_bounded(r: impl Read, flag: &str, what: &str) -> Result<String, CliError> {
+    let mut buf = Vec::new();
+    r.take(MAX_PARAMS_BYTES + 1)
+        .read_to_end(&mut buf)
+        .map_err(|e| CliError::Input(format!("{flag}: {what}: {e}")))?;
+    if buf.len() as u64 > MAX_PARAMS_BYTES {
+        return Err(CliError::Input(format!(
+            "{flag}: {what}: larger than the limit of {MAX_PARAMS_BYTES} bytes"
+        )));
+    }
+    String::from_utf8(buf).map_err(|_| CliError::Input(format!("{flag}: {what}: not UTF-8 text")))
+}
+
+/// The text of a parameter file given to `flag`: `-` reads standard input;
+/// a path must be a regular file of at most [`MAX_PARAMS_BYTES`] (checked
+/// before opening, so that `/dev/zero` or a FIFO without a writer is
+/// refused rather than read without end or waited on).
+pub fn params_text(path: &Path, flag: &str) -> Result<String, CliError> {
+    if path.as_os_str() == "-" {
+        return read_bounded(std::io::stdin().lock(), flag, "standard input");
+    }
+    let shown = path.display();
+    let meta = match std::fs::metadata(path) {
+        Ok(m) => m,
+        // The loader's own message for a file that cannot be read.
+        Err(e) => return Err(params_file::LoadError::Io(shown.to_string(), e).into()),
+    };
+    if !meta.is_file() {
+        return Err(CliError::Input(format!("{flag}: {shown}: not a regular file")));
+    }
+    if meta.len() > MAX_PARAMS_BYTES {
+        return Err(CliError::Input(format!(
+            "{flag}: {shown}: {} bytes, larger than the limit of {MAX_PARAMS_BYTES} bytes",
+            meta.len()
+        )));
+    }
+    let file = std::fs::File::open(path).map_err(|e| params_file::LoadError::Io(shown.to_string(), e))?;
+    read_bounded(file, flag, &shown.to_string())
+}
+
+/// Reads and validates the parameter file given to `flag` (see [`params_text`]).
+pub fn load_raw(path: &Path, flag: &str) -> Result<RawParams, CliError> {
+    Ok(params_file::parse(&params_text(path, flag)?)?)
+}

@@ -1,0 +1,429 @@
+//! The bad-input matrix of the parameter file: every field of the schema
+//! (its field tables, in file order) against every kind of bad value, each
+//! case written into `presets/paper.toml` and read by the file reader the
+//! CLI and the firmware's build script use; accepted cases go on through
+//! the model ([`Params::new`] and the equilibrium at the middle of the
+//! validated range, in `f64` and `f32`).
+//!
+//! A case is right when it is refused naming its own field (the error's
+//! field is that field), or accepted with finite results. A value inside
+//! the plausible range (the range's ends) may also be refused by a rule
+//! between fields, if the message names the field.
+//!
+//! `docs/parameters.md` holds the field table and the matrix this module
+//! writes (`cargo run -p host-tests --example bad_input_matrix -- --write`);
+//! `host-tests/tests/bad_input_matrix.rs` checks that every case is right
+//! and that the document is current.
+
+use compensator::equilibrium::equilibrium;
+use compensator::params::{CORE_FIELDS, Compact, ESTIMATOR_FIELDS, Field, Kind, MACHINE_FIELDS, Problem, RawParams};
+use compensator::{Float, Params};
+use compensator_cli::params_file::{self, LoadError, fmt_float};
+use std::fmt::Write as _;
+
+/// Every field of the file, in file order.
+pub fn fields() -> impl Iterator<Item = &'static Field> {
+    CORE_FIELDS
+        .iter()
+        .chain(MACHINE_FIELDS.iter())
+        .chain(ESTIMATOR_FIELDS.iter())
+}
+
+/// One kind of input tried on every field.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Case {
+    /// The key left out.
+    Missing,
+    /// `-1`.
+    Negative,
+    /// `0`.
+    Zero,
+    /// `nan`.
+    Nan,
+    /// `inf`.
+    Inf,
+    /// A string.
+    Text,
+    /// An array.
+    Array,
+    /// `1e300`.
+    Huge,
+    /// `5e-324`, the smallest subnormal.
+    Tiny,
+    /// Just below the plausible range (by a millionth of it).
+    Below,
+    /// The range's lower end.
+    AtMin,
+    /// The range's upper end.
+    AtMax,
+    /// Just above the plausible range.
+    Above,
+}
+
+impl Case {
+    /// Every case, in the matrix's column order.
+    pub const ALL: [Case; 13] = [
+        Case::Missing,
+        Case::Negative,
+        Case::Zero,
+        Case::Nan,
+        Case::Inf,
+        Case::Text,
+        Case::Array,
+        Case::Huge,
+        Case::Tiny,
+        Case::Below,
+        Case::AtMin,
+        Case::AtMax,
+        Case::Above,
+    ];
+
+    /// Column header.
+    pub fn header(self) -> &'static str {
+        match self {
+            Case::Missing => "missing",
+            Case::Negative => "-1",
+            Case::Zero => "0",
+            Case::Nan => "nan",
+            Case::Inf => "inf",
+            Case::Text => "\"x\"",
+            Case::Array => "[1.0]",
+            Case::Huge => "1e300",
+            Case::Tiny => "5e-324",
+            Case::Below => "below",
+            Case::AtMin => "min",
+            Case::AtMax => "max",
+            Case::Above => "above",
+        }
+    }
+
+    /// Inside the plausible range: a rule between fields may refuse it.
+    fn in_range(self) -> bool {
+        matches!(self, Case::AtMin | Case::AtMax)
+    }
+
+    /// The TOML value written for `field` (`None`: the key left out).
+    pub fn value(self, field: &Field) -> Option<String> {
+        let below = if field.min == 0.0 {
+            -1e-6 * field.max
+        } else {
+            field.min - 1e-6 * field.min.abs()
+        };
+        Some(match self {
+            Case::Missing => return None,
+            Case::Negative => "-1.0".into(),
+            Case::Zero => "0.0".into(),
+            Case::Nan => "nan".into(),
+            Case::Inf => "inf".into(),
+            Case::Text => "\"x\"".into(),
+            Case::Array => "[1.0]".into(),
+            Case::Huge => "1e300".into(),
+            Case::Tiny => "5e-324".into(),
+            Case::Below => fmt_float(below),
+            Case::AtMin => fmt_float(field.min),
+            Case::AtMax => fmt_float(field.max),
+            Case::Above => fmt_float(field.max + 1e-6 * field.max.abs()),
+        })
+    }
+}
+
+/// The preset every case edits: `presets/paper.toml` (it has a `[machine]`
+/// section; `[estimator]` keys are appended).
+pub fn base_text() -> String {
+    std::fs::read_to_string(crate::repo_root().join("presets/paper.toml")).expect("presets/paper.toml")
+}
+
+/// `text` with `field` set to `value` (its line replaced, or appended in
+/// an `[estimator]` section), or left out when `value` is `None`.
+pub fn edited(text: &str, field: &Field, value: Option<&str>) -> String {
+    let mut out = String::new();
+    let mut current = String::new();
+    let mut hit = false;
+    for line in text.lines() {
+        let trimmed = line.trim();
+        if trimmed.starts_with('[') {
+            current = trimmed.trim_matches(|c| c == '[' || c == ']').to_string();
+        }
+        let key = trimmed.split('=').next().map(str::trim);
+        if current == field.section && key == Some(field.key) && !trimmed.starts_with('#') {
+            hit = true;
+            if let Some(v) = value {
+                let _ = writeln!(out, "{} = {v}", field.key);
+            }
+            continue;
+        }
+        out.push_str(line);
+        out.push('\n');
+    }
+    if !hit && let Some(v) = value {
+        let _ = write!(out, "\n[{}]\n{} = {v}\n", field.section, field.key);
+    }
+    out
+}
+
+/// What became of one case.
+#[derive(Debug)]
+pub enum Outcome {
+    /// Read, validated and converted; the equilibrium at `t` [C] is finite
+    /// in `f64` and `f32`, or not.
+    Accepted {
+        /// The temperature evaluated (middle of the validated range).
+        t: f64,
+        /// Whether every result was finite in both types.
+        finite: bool,
+        /// What failed, if anything did.
+        failure: Option<String>,
+    },
+    /// Refused by the reader, the validation or the conversion.
+    Refused(Refusal),
+}
+
+/// A refusal: the field the error names (if any), what kind of rule, and
+/// the message.
+#[derive(Debug)]
+pub struct Refusal {
+    /// The field the error is about.
+    pub field: Option<&'static str>,
+    /// Short name of the rule (`range`, `NaN`, `type`, `rule`, ...).
+    pub rule: &'static str,
+    /// The one-line message.
+    pub message: String,
+}
+
+impl Refusal {
+    fn of_load(e: &LoadError) -> Self {
+        let rule = match e {
+            LoadError::NotANumber { .. } => "type",
+            LoadError::Param(p) => rule_of(p.problem),
+            LoadError::Syntax(_) => "syntax",
+            _ => "other",
+        };
+        Refusal {
+            field: e.field(),
+            rule,
+            message: e.to_string(),
+        }
+    }
+}
+
+fn rule_of(problem: Problem) -> &'static str {
+    match problem {
+        Problem::Missing => "missing",
+        Problem::NotANumber => "NaN",
+        Problem::Infinite => "inf",
+        Problem::Implausible(_) => "range",
+        Problem::NotWhole => "whole",
+        Problem::NotOneOf(_) => "choice",
+        Problem::NotRepresentable(_) => "type",
+        _ => "rule",
+    }
+}
+
+/// Runs one case of `field`.
+pub fn run(base: &str, field: &Field, case: Case) -> Outcome {
+    let text = edited(base, field, case.value(field).as_deref());
+    let raw = match params_file::parse(&text) {
+        Ok(raw) => raw,
+        Err(e) => return Outcome::Refused(Refusal::of_load(&e)),
+    };
+    if let Err(e) = Params::<f64>::new(&raw) {
+        // Refused by the conversion (not expected: the reader validates).
+        return Outcome::Refused(Refusal {
+            field: Some(e.field),
+            rule: rule_of(e.problem),
+            message: e.to_string(),
+        });
+    }
+    let t = 0.5 * (raw.estimator.valid_min + raw.estimator.valid_max);
+    let failure = evaluate::<f64>(&raw, t)
+        .err()
+        .or_else(|| evaluate::<f32>(&raw, t).err());
+    Outcome::Accepted {
+        t,
+        finite: failure.is_none(),
+        failure,
+    }
+}
+
+/// The model on an accepted set: conversion, then the equilibrium at `t`,
+/// every result finite.
+fn evaluate<T: Float>(raw: &RawParams, t: f64) -> Result<(), String> {
+    let p = Params::<T>::new(raw).map_err(|e| format!("{}: {e}", T::NAME))?;
+    let e = equilibrium(&p, T::from_f64(t)).map_err(|e| format!("{} at {t} C: {e}", T::NAME))?;
+    let all = [e.a, e.p_a, e.p_b, e.dp_ab, e.x, e.q_branch, e.q_throt, e.q_total];
+    if all.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(format!("{} at {t} C: not finite: {e:?}", T::NAME))
+    }
+}
+
+/// One cell of the matrix.
+#[derive(Debug)]
+pub struct Cell {
+    /// The field.
+    pub field: &'static Field,
+    /// The case.
+    pub case: Case,
+    /// What became of it.
+    pub outcome: Outcome,
+}
+
+impl Cell {
+    /// Whether the outcome is right: refused naming the field (a value
+    /// inside the range may be refused by a rule that names it in its
+    /// message), or accepted with finite results.
+    pub fn is_right(&self) -> bool {
+        match &self.outcome {
+            Outcome::Accepted { finite, .. } => *finite,
+            Outcome::Refused(r) => {
+                r.field == Some(self.field.path) || (self.case.in_range() && r.message.contains(self.field.path))
+            }
+        }
+    }
+
+    /// The cell's text in the table.
+    pub fn label(&self) -> String {
+        let text = match &self.outcome {
+            Outcome::Accepted { .. } if self.case == Case::Missing => "default".to_string(),
+            Outcome::Accepted { .. } => "ok".to_string(),
+            Outcome::Refused(r) if r.field == Some(self.field.path) => r.rule.to_string(),
+            Outcome::Refused(r) => format!("{}: {}", r.rule, r.field.unwrap_or("-")),
+        };
+        if self.is_right() {
+            text
+        } else {
+            format!("**WRONG** {text}")
+        }
+    }
+}
+
+/// Every field against every case.
+pub fn matrix() -> Vec<Cell> {
+    let base = base_text();
+    fields()
+        .flat_map(|field| {
+            let base = &base;
+            Case::ALL.iter().map(move |&case| Cell {
+                field,
+                case,
+                outcome: run(base, field, case),
+            })
+        })
+        .collect()
+}
+
+fn escape(text: &str) -> String {
+    text.replace('|', "\\|")
+}
+
+/// The field table of `docs/parameters.md`: every field with its unit,
+/// plausible range, default and description, from the schema.
+pub fn field_table() -> String {
+    let mut s = String::new();
+    s += "| field | unit | plausible range | default | also | description |\n";
+    s += "|---|---|---|---|---|---|\n";
+    for f in fields() {
+        let default = match f.default {
+            Some(d) => Compact(d).to_string(),
+            None if f.section == "machine" => "required in `[machine]`".into(),
+            None => "required".into(),
+        };
+        let also = match f.kind {
+            Kind::Real | Kind::OrZero => String::new(),
+            Kind::Whole => "whole number".into(),
+            Kind::OneOf(values) => {
+                let v: Vec<String> = values.iter().map(|x| Compact(*x).to_string()).collect();
+                format!("one of {}", v.join(", "))
+            }
+        };
+        let range = format!("[{}, {}]", Compact(f.min), Compact(f.max));
+        let range = if f.kind == Kind::OrZero {
+            format!("0 or {range}")
+        } else {
+            range
+        };
+        let _ = writeln!(
+            s,
+            "| `{}` | {} | {} | {} | {} | {} |",
+            f.path,
+            escape(f.unit),
+            range,
+            default,
+            also,
+            escape(f.doc)
+        );
+    }
+    s
+}
+
+/// The matrix of `docs/parameters.md`: one row per field, one column per
+/// case, and a summary line.
+pub fn matrix_table(cells: &[Cell]) -> String {
+    let mut s = String::new();
+    s += "| field | range |";
+    for case in Case::ALL {
+        let _ = write!(s, " {} |", escape(case.header()));
+    }
+    s += "\n|---|---|";
+    s += &"---|".repeat(Case::ALL.len());
+    s += "\n";
+    for row in cells.chunks(Case::ALL.len()) {
+        let f = row[0].field;
+        let _ = write!(s, "| `{}` | {} |", f.path, escape(&f.range().to_string()));
+        for cell in row {
+            let _ = write!(s, " {} |", escape(&cell.label()));
+        }
+        s += "\n";
+    }
+    s += "\n";
+    s += &summary(cells);
+    s += "\n";
+    s
+}
+
+/// Counts of the matrix: cases, accepted, refused naming the field,
+/// in-range values refused by a rule naming the field, wrong.
+pub fn summary(cells: &[Cell]) -> String {
+    let accepted = cells
+        .iter()
+        .filter(|c| matches!(c.outcome, Outcome::Accepted { .. }) && c.is_right())
+        .count();
+    let own = cells
+        .iter()
+        .filter(|c| matches!(&c.outcome, Outcome::Refused(r) if r.field == Some(c.field.path)))
+        .count();
+    let by_rule = cells
+        .iter()
+        .filter(|c| matches!(&c.outcome, Outcome::Refused(r) if r.field != Some(c.field.path)) && c.is_right())
+        .count();
+    let wrong = cells.iter().filter(|c| !c.is_right()).count();
+    format!(
+        "{} cases ({} fields x {} inputs): {accepted} accepted with finite results (f64 and f32), \
+         {own} refused naming their field, {by_rule} in-range values refused by a rule that names \
+         the field in its message, {wrong} wrong.",
+        cells.len(),
+        cells.len() / Case::ALL.len(),
+        Case::ALL.len()
+    )
+}
+
+/// The generated blocks of `docs/parameters.md`: `(marker, content)`.
+pub fn generated_blocks() -> [(&'static str, String); 2] {
+    [("fields", field_table()), ("matrix", matrix_table(&matrix()))]
+}
+
+/// `doc` with the content between `<!-- BEGIN GENERATED: name -->` and
+/// `<!-- END GENERATED: name -->` replaced for every block, or `None` if a
+/// marker is missing.
+pub fn with_blocks(doc: &str, blocks: &[(&str, String)]) -> Option<String> {
+    let mut out = doc.to_string();
+    for (name, content) in blocks {
+        let begin = format!("<!-- BEGIN GENERATED: {name} -->\n");
+        let end = format!("<!-- END GENERATED: {name} -->");
+        let a = out.find(&begin)? + begin.len();
+        let b = a + out[a..].find(&end)?;
+        out.replace_range(a..b, content);
+    }
+    Some(out)
+}

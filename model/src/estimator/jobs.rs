@@ -1,0 +1,230 @@
+//! The temperature-only jobs and the results they keep: one job per tick
+//! that is neither a telemetry tick nor an eventful one, in turn (the
+//! rotation is the estimator's, in the parent module).
+
+use super::stability::{quartic_hurwitz, slowest_decay_rate};
+use super::{MIN_SETTLE_TICKS, SETTLE_TIME_CONSTANTS, TWIN_SLEW};
+use crate::asymptotic;
+use crate::compensation;
+use crate::dynamics::Twin;
+use crate::dynamics::fsi::{Contact, Fsi};
+use crate::dynamics::linear::characteristic_polynomial;
+use crate::dynamics::schemes::OdeSystem;
+use crate::equilibrium::{a_parameter, equilibrium_for};
+use crate::error::ModelError;
+use crate::fluid::FluidPoint;
+use crate::params::Params;
+use crate::throttle::FlowLaws;
+
+/// The temperature-only jobs, one per tick in turn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Job {
+    /// Oil properties (one Walther evaluation) for the twin and the flows:
+    /// the requirement "fluid properties at the sensor rate", here every four
+    /// non-telemetry ticks (4 ms at the defaults), five times the
+    /// MAX31865's 50 Hz.
+    Fluid,
+    /// Closed-form equilibrium and `dx/dt` (Eqs. 5, 31), then the twin's
+    /// consistency check against it once the temperature is steady.
+    Equilibrium,
+    /// Routh-Hurwitz stability of the linearisation at the equilibrium, and
+    /// the decay rate of its slowest mode (the settling window).
+    Stability,
+    /// The machine's losses (compensation error).
+    Losses,
+}
+
+impl Job {
+    /// Every job, in rotation order.
+    pub(super) const ALL: [Job; 4] = [Job::Fluid, Job::Equilibrium, Job::Stability, Job::Losses];
+
+    /// The job after this one in the rotation.
+    pub(super) fn next(self) -> Job {
+        match self {
+            Job::Fluid => Job::Equilibrium,
+            Job::Equilibrium => Job::Stability,
+            Job::Stability => Job::Losses,
+            Job::Losses => Job::Fluid,
+        }
+    }
+
+    /// This job's bit in `Estimator::failed_jobs`.
+    pub(super) fn bit(self) -> u8 {
+        1 << (self as u8)
+    }
+}
+
+/// What the jobs need of the design besides its parameters, computed once
+/// (the window's factor is a root and a few products the Fluid job would
+/// otherwise repeat).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Design {
+    /// The window's `eta pi d sqrt(2 dp)` at the design's `dp`
+    /// ([`Slot::window_factor`](crate::throttle::Slot::window_factor)):
+    /// the oil-independent part of its law.
+    slot_window_factor: f32,
+    /// Dynamic viscosity at the machine's reference temperature [Pa s]
+    /// (NaN, and never read, without a `[machine]`).
+    machine_mu_ref: f32,
+}
+
+impl Design {
+    /// For the design `p`, with the oil's dynamic viscosity at the
+    /// machine's reference temperature `machine_mu_ref` [Pa s] (NaN without
+    /// a `[machine]`).
+    // Out of line: inlined (with `Estimator::new`) into the QEMU twin's
+    // `main`, it grew main's frame, which is the peak stack, by 16 bytes.
+    #[inline(never)]
+    pub(super) fn new(p: &Params<f32>, machine_mu_ref: f32) -> Self {
+        Design {
+            slot_window_factor: p.slot.window_factor(p.pressure_drop),
+            machine_mu_ref,
+        }
+    }
+}
+
+/// Results that depend on the temperature only. Each tick that is not a
+/// telemetry tick refreshes one of them, so each is refreshed every four
+/// such ticks (telemetry is at most every second tick, validated), while
+/// the oil's temperature changes over seconds, and the cost of a tick stays
+/// bounded by the twin plus the largest single job.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Statics {
+    /// Oil state and derivatives at `temperature`.
+    pub(super) point: FluidPoint<f32>,
+    /// The throttle laws at that oil state.
+    pub(super) flows: FlowLaws<f32>,
+    pub(super) x_equilibrium: f32,
+    pub(super) dx_dt: f32,
+    /// The equilibrium in the twin's model units `(x / L, v / V,
+    /// (p_a - p_c) / dp, (p_b - p_c) / dp)` (for the linearisation and the
+    /// consistency check).
+    pub(super) y_equilibrium: [f32; 4],
+    pub(super) stable: bool,
+    /// `SETTLE_TIME_CONSTANTS / tick` [1/s] (constant).
+    settle_per_second: f32,
+    /// Lower bound of the slowest decay rate of the linearisation, in the
+    /// twin's time unit (0: none, not stable); the next search's hint.
+    slowest_rate: f32,
+    /// Time constant of the slowest mode of the linearisation [s].
+    pub(super) slowest_time_constant: f32,
+    /// Steady ticks before the consistency check: [`SETTLE_TIME_CONSTANTS`]
+    /// of the slowest time constant, at least [`MIN_SETTLE_TICKS`];
+    /// `u32::MAX` (never) while the linearisation is not stable.
+    pub(super) settle_ticks: u32,
+    /// Machine losses at the last refreshed temperature [m^3/s].
+    pub(super) losses: f32,
+    /// The last Fluid job moved the twin's oil by its whole slew limit
+    /// ([`TWIN_SLEW`]): the twin is still on its way to the filtered
+    /// temperature, and the next job is the Fluid job again.
+    pub(super) slewing: bool,
+}
+
+impl Statics {
+    /// Before any job: the oil at `point`, nothing else computed yet, for
+    /// an estimator ticking every `tick` [s].
+    pub(super) fn new(point: FluidPoint<f32>, tick: f32) -> Self {
+        Statics {
+            point,
+            flows: FlowLaws {
+                capillary_conductance: 0.0,
+                orifice_factor: 0.0,
+                window_factor: 0.0,
+            },
+            x_equilibrium: f32::NAN,
+            dx_dt: f32::NAN,
+            y_equilibrium: [0.0; 4],
+            stable: true,
+            settle_per_second: SETTLE_TIME_CONSTANTS / tick,
+            slowest_rate: 0.0,
+            slowest_time_constant: f32::INFINITY,
+            settle_ticks: u32::MAX,
+            losses: f32::NAN,
+            slewing: false,
+        }
+    }
+}
+
+/// Runs `job` at the filtered temperature `t` [C], updating `statics`. On
+/// an error the job's previous results stay in force.
+pub(super) fn run(
+    job: Job,
+    p: &Params<f32>,
+    twin: &mut Twin<f32, f32>,
+    design: Design,
+    t: f32,
+    statics: &mut Statics,
+) -> Result<(), ModelError> {
+    match job {
+        Job::Fluid => {
+            // The twin's oil moves towards `t` by at most what changes
+            // its capillary conductance (~ 1 / mu) by TWIN_SLEW: a step
+            // the spike filter takes as real reaches the twin as a
+            // fast ramp, never as an abrupt change (which the twin
+            // would grade, at several substeps' cost: `Twin::tick`).
+            let prev = &statics.point;
+            let now = prev.state.temperature;
+            let dln_mu = libm::fabsf(prev.viscosity.d1 / prev.viscosity.value + prev.density.d1 / prev.density.value);
+            let max_step = if dln_mu > 0.0 {
+                TWIN_SLEW / dln_mu
+            } else {
+                f32::INFINITY
+            };
+            // max/min, not `f32::clamp`: its assertion formats f32 with
+            // core::fmt, 17 KiB of flash on the controller.
+            let step = (t - now).max(-max_step).min(max_step);
+            let point = p.oil.point(now + step)?;
+            statics.slewing = step != t - now;
+            twin.set_fluid(&point.state)?;
+            statics.point = point;
+            statics.flows = FlowLaws::new(
+                &p.capillary,
+                &p.orifice,
+                design.slot_window_factor,
+                point.state.density,
+                point.state.dynamic_viscosity,
+            );
+        }
+        Job::Equilibrium => {
+            let point = &statics.point;
+            let eq = equilibrium_for(p, point.state, a_parameter(p, &point.state))?;
+            statics.dx_dt = asymptotic::sensitivity_at(p, point)?.dx_dt;
+            statics.x_equilibrium = eq.x;
+            statics.y_equilibrium = twin.model().equilibrium_state(&eq);
+        }
+        Job::Stability => {
+            let sys = Fsi {
+                coefficients: twin.coefficients(),
+                contact: Contact::Free,
+            };
+            let poly = characteristic_polynomial(&sys.jacobian(&statics.y_equilibrium));
+            statics.stable = quartic_hurwitz(&poly);
+            let sigma = if statics.stable {
+                slowest_decay_rate(&poly, statics.slowest_rate)
+            } else {
+                0.0
+            };
+            statics.slowest_rate = sigma;
+            if sigma > 0.0 {
+                statics.slowest_time_constant = twin.model().scales.time / sigma;
+                let ticks = statics.slowest_time_constant * statics.settle_per_second;
+                // Saturating conversion; NaN is impossible here (sigma > 0).
+                statics.settle_ticks = if ticks < u32::MAX as f32 {
+                    (ticks as u32).saturating_add(1).max(MIN_SETTLE_TICKS)
+                } else {
+                    u32::MAX
+                };
+            } else {
+                statics.slowest_time_constant = f32::INFINITY;
+                statics.settle_ticks = u32::MAX;
+            }
+        }
+        Job::Losses => {
+            statics.losses = match &p.machine {
+                Some(m) => compensation::losses_for(m, design.machine_mu_ref, statics.point.state.dynamic_viscosity)?,
+                None => f32::NAN,
+            };
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,432 @@
+//! The state estimator the firmware runs every tick: temperature sample ->
+//! filtered temperature -> fluid properties -> FSI twin step ->
+//! closed-form equilibrium, sensitivity and stability -> [`StateEstimate`].
+//!
+//! Per tick, in this order:
+//! 1. the latest sample (if any) is checked: not finite or outside the oil's
+//!    range is a fault; further than `spike_threshold` from the filtered
+//!    value is a spike and rejected, unless it is the `spike_limit + 1`-th
+//!    consecutive out-of-band sample agreeing (within the threshold) with
+//!    the one before: then it is a real step and the filter jumps to it;
+//! 2. a first-order filter (time constant `filter_time_constant`) follows
+//!    the last accepted sample;
+//! 3. the twin advances one tick (its coefficients from the last Fluid
+//!    job);
+//! 4. one temperature-only job runs, in turn: the oil's properties (one
+//!    Walther evaluation, handed to the twin and the flow laws) at the
+//!    filtered temperature, reached at a bounded slew ([`TWIN_SLEW`]: the
+//!    twin never sees an abrupt change, and while it is on its way every
+//!    job is this one); the closed-form equilibrium with `dx/dt` (Eq. 31);
+//!    the Routh-Hurwitz stability of the linearisation at that equilibrium;
+//!    the machine's losses. None runs on a telemetry tick (at most every
+//!    second tick), nor on a tick where the twin had an event (an impact, a
+//!    release: a few steps more), which also moves a due telemetry record
+//!    to the next tick. Each result is thus refreshed every four job ticks
+//!    (4 ms at the default 1 kHz and 2 Hz telemetry: fluid properties five
+//!    times the MAX31865's 50 Hz rate), while the oil's temperature changes
+//!    over seconds. A job the model refuses keeps its previous results and
+//!    flags the estimate `DEGRADED` until it succeeds again;
+//! 5. flows and the compensation error follow from the twin's state.
+//!
+//! The pieces, one concept per file: [`EstimatorConfig`] and its
+//! [`TemperatureRange`]s (`config`); the spike filter and low-pass of steps
+//! 1-2 ([`TemperatureFilter`], [`FilterSettings`], `filter`); the jobs of
+//! step 4 and the results they keep (`jobs`); the stability test and
+//! decay-rate bound of the Stability job ([`quartic_hurwitz`],
+//! [`slowest_decay_rate`], `stability`); the flags ([`Flags`], `flags`);
+//! the estimate and its telemetry record ([`StateEstimate`], `estimate`).
+//! The flows of step 5 are the throttle laws'
+//! ([`FlowLaws`](crate::throttle::FlowLaws)). This module runs the tick:
+//! the sequence above, the rotation of the jobs and the consistency check.
+//!
+//! A consistency check catches a twin that settled where the physics does
+//! not: once the twin's temperature has stayed within [`STEADY_BAND`] for
+//! [`SETTLE_TIME_CONSTANTS`] of the twin's slowest time constants (the
+//! decay rate of the slowest mode of the linearisation, found by the
+//! Stability job), every Equilibrium job compares the twin's state with the
+//! closed-form equilibrium it just computed (clamped to the stops). A twin
+//! further than [`X_TOLERANCE`] of the stroke or [`P_TOLERANCE`] of `dp`
+//! away is re-seated on the equilibrium, counted
+//! ([`StateEstimate::reseats`]) and flagged [`Flags::TWIN_RESEATED`]. The
+//! thresholds and their reasons are in the project's `docs/firmware.md`.
+//!
+//! The cost of a tick is bounded by the twin's step, the fluid properties
+//! and the larger of one job or the telemetry packing: what the firmware's
+//! budget measures. Nothing here allocates or panics; every failure becomes
+//! a flag.
+
+mod config;
+mod estimate;
+mod filter;
+mod flags;
+mod jobs;
+mod stability;
+
+pub use config::{EstimatorConfig, TemperatureRange};
+pub use estimate::StateEstimate;
+pub use filter::{FilterSettings, TemperatureFilter, Verdict};
+pub use flags::Flags;
+pub use stability::{quartic_hurwitz, slowest_decay_rate};
+
+use crate::asymptotic;
+use crate::dynamics::Twin;
+use crate::error::ModelError;
+use crate::params::Params;
+use crate::sensor::SensorFault;
+use jobs::{Design, Job, Statics};
+
+/// Largest relative change of the twin's capillary conductance (~ 1 / mu)
+/// per Fluid job: below the twin's `ABRUPT_CHANGE` (1 %), so that the twin
+/// never grades a tick in the estimator (`Twin::tick`: a graded tick costs
+/// several substeps). While the twin's oil is on its way, every job tick is
+/// a Fluid job: the paper preset's oil (2.6 %/K of viscosity at 80 C,
+/// 11 %/K at 0 C) then follows a step at 70 C/s (0 C) to 300 C/s (80 C).
+pub const TWIN_SLEW: f32 = 0.008;
+
+/// Band [C] the filtered temperature must stay within to count as steady
+/// for the consistency check. Over the band the closed form moves by
+/// `|dx/dt| * 0.05 K`: 0.12 % of the stroke on the paper preset (37 um/K,
+/// 1.5 mm), below 1 % on designs whose free displacement changes by up to
+/// 2.5 strokes over 30-80 C; the pressures by at most 0.05 % of `dp`. It is
+/// wider than the filter's response to one code of the MAX31865 (0.034 C),
+/// so sensor noise does not keep the temperature unsteady.
+pub const STEADY_BAND: f32 = 0.05;
+
+/// Time constants of the twin's slowest mode the temperature must have been
+/// steady before the twin is compared with the closed form. A linear mode
+/// decays by `exp(-10) = 4.5e-5` over them: a full-stroke or full-`dp`
+/// transient ends 200 times inside the tolerances, leaving room for the
+/// nonlinear orifice law and the travel onto a stop.
+pub const SETTLE_TIME_CONSTANTS: f32 = 10.0;
+
+/// Fewest steady ticks before the check (three rounds of the four jobs, so
+/// that the twin's fluid properties and the equilibrium it is compared with
+/// belong to the steady temperature).
+pub const MIN_SETTLE_TICKS: u32 = 16;
+
+/// Agreement required of a settled twin: displacement, as a fraction of the
+/// stroke. Ten times the twin's accuracy goal at steady state (1e-3), so a
+/// correct twin never trips it; a false equilibrium sits tens of percent
+/// away (the paper preset's 40 -> 0 C step: 54 % of `dp`).
+pub const X_TOLERANCE: f32 = 1e-2;
+
+/// Agreement required of a settled twin: each chamber pressure, as a
+/// fraction of `dp` (as [`X_TOLERANCE`]).
+pub const P_TOLERANCE: f32 = 1e-2;
+
+/// The estimator.
+#[derive(Clone, Copy, Debug)]
+pub struct Estimator {
+    params: Params<f32>,
+    config: EstimatorConfig,
+    twin: Twin<f32, f32>,
+    /// The sample filter (steps 1-2 of the tick).
+    filter: TemperatureFilter,
+    /// Jobs whose last run failed, one bit per [`Job`] (the oil model
+    /// refused the temperature: the previous results stay in force). The
+    /// estimate is degraded until each of them succeeds again.
+    failed_jobs: u8,
+    /// Ticks since the last accepted sample.
+    since_sample: u32,
+    tick: u32,
+    monotonic: bool,
+    /// Constants of the design the jobs need.
+    design: Design,
+    /// Temperature-only results, refreshed in rotation (see [`Job`]).
+    statics: Statics,
+    /// The job of the next tick that is not a telemetry tick.
+    next_job: Job,
+    last: Option<StateEstimate>,
+    /// Filtered temperature at the start of the current steady stretch [C].
+    steady_anchor: f32,
+    /// Ticks that ran a job while the filtered temperature stayed within
+    /// [`STEADY_BAND`] of `steady_anchor` (or since the last re-seat).
+    steady_ticks: u32,
+    /// Re-seats of the twin so far (saturating).
+    reseats: u32,
+    /// Consistency checks run so far (saturating).
+    checks: u32,
+    /// The last check re-seated the twin (raises `TWIN_RESEATED` until a
+    /// check finds it in agreement).
+    reseated: bool,
+    /// This tick's estimate is to be published ([`Estimator::telemetry_due`]).
+    publish: bool,
+    /// A publication was due on a tick the twin spent on an event: the
+    /// next tick publishes.
+    telemetry_pending: bool,
+}
+
+impl Estimator {
+    /// An estimator at rest in the equilibrium of `initial` [C], which must
+    /// be a temperature the oil model accepts. Eq. (32) is checked once here
+    /// over the validated range (201 samples; a range the oil model refuses
+    /// in part is not an error, it raises `NOT_UNIQUE`).
+    ///
+    /// # Errors
+    ///
+    /// * the twin cannot be built at `initial` ([`Twin::new`]: the oil
+    ///   model refuses the temperature, or the parameters' model);
+    /// * the oil model refuses `initial` or the machine's reference
+    ///   temperature ([`crate::fluid::Oil::state`]);
+    /// * a temperature-only job fails at `initial` (the equilibrium, its
+    ///   sensitivity or the machine's losses not finite).
+    pub fn new(params: &Params<f32>, config: EstimatorConfig, initial: f32) -> Result<Self, ModelError> {
+        let monotonic = asymptotic::monotonicity(params, config.valid.min, config.valid.max, 201)
+            .map(|m| m.monotonic)
+            .unwrap_or(false);
+        let twin = Twin::new(params, config.twin, initial)?;
+        let machine_mu_ref = match &params.machine {
+            Some(m) => params.oil.state(m.leakage_temperature)?.dynamic_viscosity,
+            None => f32::NAN,
+        };
+        let point = params.oil.point(initial)?;
+        let design = Design::new(params, machine_mu_ref);
+        let mut statics = Statics::new(point, config.tick());
+        let mut twin = twin;
+        for job in Job::ALL {
+            jobs::run(job, params, &mut twin, design, initial, &mut statics)?;
+        }
+        Ok(Estimator {
+            params: *params,
+            config,
+            twin,
+            filter: TemperatureFilter::new(initial),
+            failed_jobs: 0,
+            since_sample: 0,
+            tick: 0,
+            monotonic,
+            design,
+            statics,
+            next_job: Job::Fluid,
+            last: None,
+            steady_anchor: initial,
+            steady_ticks: 0,
+            reseats: 0,
+            checks: 0,
+            reseated: false,
+            publish: false,
+            telemetry_pending: false,
+        })
+    }
+
+    /// The time constant of the twin's slowest mode at the last Stability
+    /// job [s]: `1 / sigma`, with `sigma` a lower bound (within 25 %) of the
+    /// smallest decay rate `-Re(lambda)` of the linearisation at the
+    /// equilibrium. Infinite while the linearisation is not stable.
+    pub fn slowest_time_constant(&self) -> f32 {
+        self.statics.slowest_time_constant
+    }
+
+    /// Consistency checks run since start (saturating): each compared the
+    /// settled twin with the closed form, and re-seated it or not.
+    pub fn consistency_checks(&self) -> u32 {
+        self.checks
+    }
+
+    /// Steady ticks the consistency check waits for at the last Stability
+    /// job (`u32::MAX`: it does not run, the linearisation is not stable).
+    pub fn settle_ticks(&self) -> u32 {
+        self.statics.settle_ticks
+    }
+
+    /// The settings.
+    pub fn config(&self) -> &EstimatorConfig {
+        &self.config
+    }
+
+    /// The twin.
+    pub fn twin(&self) -> &Twin<f32, f32> {
+        &self.twin
+    }
+
+    /// The twin, mutable: to inject a fault (a wrong state, with
+    /// [`Twin::set_state`]) and watch the consistency check undo it.
+    pub fn twin_mut(&mut self) -> &mut Twin<f32, f32> {
+        &mut self.twin
+    }
+
+    /// One tick with this tick's sample (see the module docs).
+    pub fn tick(&mut self, sample: Result<Option<f32>, SensorFault>) -> StateEstimate {
+        let mut flags = Flags::empty();
+        if !self.monotonic {
+            flags.insert(Flags::NOT_UNIQUE);
+        }
+        self.tick = self.tick.wrapping_add(1);
+        self.since_sample = self.since_sample.saturating_add(1);
+        match sample {
+            Ok(Some(t)) if t.is_finite() && self.config.oil.contains(t) => {
+                match self.filter.offer(&self.config.filter(), t) {
+                    Verdict::Accepted | Verdict::Step => self.since_sample = 0,
+                    Verdict::Spike => flags.insert(Flags::SPIKE),
+                }
+            }
+            Ok(Some(_)) | Err(_) => flags.insert(Flags::SENSOR_FAULT),
+            Ok(None) => {}
+        }
+        if self.since_sample > self.config.stale_after {
+            flags.insert(Flags::DEGRADED);
+        }
+        let t = self.filter.advance(&self.config.filter());
+        if !self.config.valid.contains(t) {
+            flags.insert(Flags::OUT_OF_RANGE);
+        }
+        match self.update(t, &mut flags) {
+            Ok(e) => {
+                self.last = Some(e);
+                e
+            }
+            Err(_) => {
+                // The model cannot evaluate this temperature: keep the last
+                // estimate's physics, flagged.
+                flags.insert(Flags::DEGRADED);
+                let mut e = self
+                    .last
+                    .unwrap_or(StateEstimate::without_physics(0, t, self.reseats, flags));
+                e.tick = self.tick;
+                e.temperature = t;
+                e.reseats = self.reseats;
+                e.flags = flags;
+                e
+            }
+        }
+    }
+
+    fn update(&mut self, t: f32, flags: &mut Flags) -> Result<StateEstimate, ModelError> {
+        // The twin first: its events (an impact, a release) cost it a few
+        // steps more, and the tick then runs neither a job nor telemetry
+        // (both wait for the next tick), so that the worst tick stays the
+        // twin's plain tick plus the larger of one job or the telemetry.
+        let p = &self.params;
+        let eventful = match self.twin.tick() {
+            Ok(report) => report.eventful(),
+            Err(_) => {
+                // A failed step (never seen with valid parameters): restart
+                // from the equilibrium rather than continue from garbage.
+                self.twin = Twin::new(p, self.twin.config(), self.statics.point.state.temperature)?;
+                flags.insert(Flags::DEGRADED);
+                true
+            }
+        };
+        let due = self.telemetry_pending
+            || (self.config.telemetry_every > 0 && self.tick.is_multiple_of(self.config.telemetry_every));
+        self.publish = due && !eventful;
+        self.telemetry_pending = due && eventful;
+        if !due && !eventful {
+            // The steady stretch, counted in ticks that run a job (a
+            // telemetry tick only publishes): the window in time is at
+            // least as long, and the telemetry tick, the costliest, is
+            // spared. A drift out of the band shows at the next job tick.
+            // The twin's temperature (it follows the filter at most at
+            // its slew rate): steady once it has arrived and stays.
+            let tw = self.statics.point.state.temperature;
+            if libm::fabsf(tw - self.steady_anchor) <= STEADY_BAND {
+                self.steady_ticks = self.steady_ticks.saturating_add(1);
+            } else {
+                self.steady_anchor = tw;
+                self.steady_ticks = 0;
+            }
+            // While the twin's oil is on its way to a new temperature, every
+            // job tick moves it on (the other jobs' results wait: the
+            // temperature they belong to is moving).
+            let job = if self.statics.slewing {
+                Job::Fluid
+            } else {
+                let job = self.next_job;
+                self.next_job = job.next();
+                job
+            };
+            // A temperature the model refuses leaves the job's previous
+            // results in force; the estimate goes on, flagged, until the
+            // job succeeds again.
+            match jobs::run(job, &self.params, &mut self.twin, self.design, t, &mut self.statics) {
+                Ok(()) => {
+                    self.failed_jobs &= !job.bit();
+                    if job == Job::Equilibrium {
+                        self.check_twin();
+                    }
+                }
+                Err(_) => self.failed_jobs |= job.bit(),
+            }
+        }
+        if self.failed_jobs != 0 {
+            flags.insert(Flags::DEGRADED);
+        }
+        if self.reseated {
+            flags.insert(Flags::TWIN_RESEATED);
+        }
+        let p = &self.params;
+        if !self.statics.stable {
+            flags.insert(Flags::UNSTABLE);
+        }
+        let s = self.twin.state();
+        let [xi, ..] = self.twin.raw_state();
+        if xi <= 0.0 || xi >= 1.0 {
+            flags.insert(Flags::AT_STOP);
+        }
+        let st = &self.statics;
+        let q_a = st.flows.capillary_flow(s.p_a - p.outlet_pressure);
+        let q_b = st.flows.orifice_flow(s.p_b - p.outlet_pressure);
+        let q_throt = st.flows.window_flow(s.x);
+        let q_total = q_a + q_b + q_throt;
+        let compensation_error = match &p.machine {
+            Some(m) => q_total - (m.working_flow + st.losses),
+            None => f32::NAN,
+        };
+        Ok(StateEstimate {
+            tick: self.tick,
+            temperature: t,
+            x: s.x,
+            v: s.v,
+            p_a: s.p_a,
+            p_b: s.p_b,
+            q_a,
+            q_b,
+            q_throt,
+            q_total,
+            compensation_error,
+            x_equilibrium: st.x_equilibrium,
+            dx_dt: st.dx_dt,
+            reseats: self.reseats,
+            flags: *flags,
+        })
+    }
+
+    /// The consistency check, right after a successful Equilibrium job:
+    /// once the temperature has been steady for the settling window, the
+    /// twin must sit within [`X_TOLERANCE`] of the stroke and
+    /// [`P_TOLERANCE`] of `dp` of the closed-form equilibrium (clamped to
+    /// the stops, in the twin's model units, where both are fractions
+    /// already). Otherwise it is put there at rest, counted, flagged, and
+    /// given a new window before the next check. Skipped while any job's
+    /// results are stale (the equilibrium may not be the twin's) or the
+    /// linearisation is unstable (no attracting equilibrium to agree with).
+    fn check_twin(&mut self) {
+        let st = &self.statics;
+        if self.failed_jobs != 0 || !st.stable || self.steady_ticks < st.settle_ticks {
+            return;
+        }
+        self.checks = self.checks.saturating_add(1);
+        let [xi, _, pi_a, pi_b] = self.twin.raw_state();
+        let [xi_eq, _, pi_a_eq, pi_b_eq] = st.y_equilibrium;
+        // Written so that a NaN state fails the check too.
+        let agrees = libm::fabsf(xi - xi_eq) <= X_TOLERANCE
+            && libm::fabsf(pi_a - pi_a_eq) <= P_TOLERANCE
+            && libm::fabsf(pi_b - pi_b_eq) <= P_TOLERANCE;
+        if agrees {
+            self.reseated = false;
+        } else {
+            let at_rest = self.twin.model().scales.to_si(&st.y_equilibrium);
+            self.twin.set_state(&at_rest);
+            self.reseats = self.reseats.saturating_add(1);
+            self.reseated = true;
+            self.steady_ticks = 0;
+        }
+    }
+
+    /// `true` when this tick's estimate should be published: every
+    /// `telemetry_every` ticks, a tick later when the twin had an event on
+    /// the scheduled one.
+    pub fn telemetry_due(&self) -> bool {
+        self.publish
+    }
+}
