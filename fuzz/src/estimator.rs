@@ -172,7 +172,7 @@ pub fn run(data: &[u8]) {
         // Inside the oil's range by half a degree: the converter's fault
         // band is that range, and its code's resolution (0.03 C) would
         // put a reading at either end on the wrong side of it.
-        let (lo, hi) = run.cfg.oil;
+        let compensator::estimator::TemperatureRange { min: lo, max: hi } = run.cfg.oil;
         let target = last.unwrap_or(start).max(lo + 0.5).min(hi - 0.5);
         if !run.in_oil(target) {
             return;
@@ -253,7 +253,7 @@ struct Run {
 impl Run {
     /// A sample the estimator takes as a temperature (finite, in the oil's range).
     fn in_oil(&self, t: f32) -> bool {
-        let (lo, hi) = self.cfg.oil;
+        let compensator::estimator::TemperatureRange { min: lo, max: hi } = self.cfg.oil;
         t.is_finite() && t >= lo && t <= hi
     }
 
@@ -281,7 +281,7 @@ impl Run {
             p_b: e.p_b,
         };
         check::si_state(&s, p, PRESSURE_MARGIN, what);
-        let (lo, hi) = self.cfg.oil;
+        let compensator::estimator::TemperatureRange { min: lo, max: hi } = self.cfg.oil;
         let (lo, hi) = (lo.min(self.start), hi.max(self.start));
         let slack = 1e-5 * (lo.abs().max(hi.abs()) + 1.0);
         assert!(
@@ -290,7 +290,7 @@ impl Run {
             what(),
             e.temperature
         );
-        let (vlo, vhi) = self.cfg.valid;
+        let compensator::estimator::TemperatureRange { min: vlo, max: vhi } = self.cfg.valid;
         assert_eq!(
             e.flags.contains(Flags::OUT_OF_RANGE),
             !(e.temperature >= vlo && e.temperature <= vhi),

@@ -48,7 +48,9 @@ pub struct Options {
     /// Go on after a crash (libFuzzer `-ignore_crashes=1`, in fork mode),
     /// collecting every crash input; the command still fails at the end.
     pub keep_going: bool,
-    /// The targets (all of [`TARGETS`] when empty).
+    /// The targets, in the order they run (all of [`TARGETS`] when
+    /// empty), each `T` or `T=N`: `N` executions of `T` instead of `runs`
+    /// (the long run weights the fast targets this way).
     pub targets: Vec<String>,
 }
 
@@ -111,14 +113,14 @@ fn cargo_fuzz(cargo: &str, root: &Path) -> Command {
 /// Builds every target, then runs those of `opts`; the summary per target.
 pub fn run(root: &Path, opts: &Options) -> Result<Vec<Summary>, String> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let targets: Vec<String> = if opts.targets.is_empty() {
-        TARGETS.iter().map(|t| t.to_string()).collect()
+    let targets: Vec<(String, Option<u64>)> = if opts.targets.is_empty() {
+        TARGETS.iter().map(|t| (t.to_string(), opts.runs)).collect()
     } else {
-        opts.targets.clone()
+        opts.targets
+            .iter()
+            .map(|t| parse_target(t, opts.runs))
+            .collect::<Result<_, _>>()?
     };
-    if let Some(t) = targets.iter().find(|t| !TARGETS.contains(&t.as_str())) {
-        return Err(format!("no fuzz target {t:?} (the targets: {})", TARGETS.join(", ")));
-    }
     ensure_cargo_fuzz(&cargo)?;
     let t0 = Instant::now();
     let built = process::run(
@@ -131,8 +133,8 @@ pub fn run(root: &Path, opts: &Options) -> Result<Vec<Summary>, String> {
     eprintln!("xtask: fuzz targets built in {:.0} s", t0.elapsed().as_secs_f64());
     let mut summaries = Vec::new();
     let mut failures = Vec::new();
-    for t in &targets {
-        let s = run_target(&cargo, root, t, opts)?;
+    for (t, runs) in &targets {
+        let s = run_target(&cargo, root, t, &Options { runs: *runs, ..opts.clone() })?;
         eprintln!(
             "xtask: {t}: {} executions in {:.0} s, cov {} ft {}, corpus {}, {} crash input(s)",
             s.runs,
@@ -153,6 +155,24 @@ pub fn run(root: &Path, opts: &Options) -> Result<Vec<Summary>, String> {
     } else {
         Err(failures.join("\n"))
     }
+}
+
+/// `T` or `T=N` (`N` executions of target `T`; `runs` otherwise).
+fn parse_target(spec: &str, runs: Option<u64>) -> Result<(String, Option<u64>), String> {
+    let (name, runs) = match spec.split_once('=') {
+        Some((name, n)) => (
+            name,
+            Some(
+                n.parse::<u64>()
+                    .map_err(|_| format!("--target {spec}: {n:?} is not a number of executions"))?,
+            ),
+        ),
+        None => (spec, runs),
+    };
+    if !TARGETS.contains(&name) {
+        return Err(format!("no fuzz target {name:?} (the targets: {})", TARGETS.join(", ")));
+    }
+    Ok((name.to_string(), runs))
 }
 
 /// One target's libFuzzer run.
@@ -338,6 +358,14 @@ pub fn table(summaries: &[Summary]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn targets_take_their_own_executions() {
+        assert_eq!(parse_target("twin", Some(5)), Ok(("twin".into(), Some(5))));
+        assert_eq!(parse_target("twin=150000", None), Ok(("twin".into(), Some(150_000))));
+        assert!(parse_target("twin=many", None).unwrap_err().contains("twin=many"));
+        assert!(parse_target("tw1n", None).unwrap_err().contains("tw1n"));
+    }
 
     #[test]
     fn libfuzzer_logs_give_the_figures() {

@@ -174,7 +174,8 @@ enum Command {
         /// Go on after a crash, collecting every crash input (fails at the end)
         #[arg(long)]
         keep_going: bool,
-        /// Only this target (repeatable) [default: all]
+        /// Only this target, T or T=N for N executions of it (repeatable, run
+        /// in this order) [default: all]
         #[arg(long = "target", value_name = "T")]
         targets: Vec<String>,
     },
@@ -224,7 +225,12 @@ fn main() -> ExitCode {
             targets,
         } => {
             let opts = fuzz::Options {
-                seconds: seconds.or(if runs.is_none() { Some(30) } else { None }),
+                // 30 s unless executions bound the run (--runs or T=N).
+                seconds: seconds.or(if runs.is_none() && !targets.iter().any(|t| t.contains('=')) {
+                    Some(30)
+                } else {
+                    None
+                }),
                 runs,
                 jobs,
                 keep_going,
