@@ -134,7 +134,15 @@ pub fn run(root: &Path, opts: &Options) -> Result<Vec<Summary>, String> {
     let mut summaries = Vec::new();
     let mut failures = Vec::new();
     for (t, runs) in &targets {
-        let s = run_target(&cargo, root, t, &Options { runs: *runs, ..opts.clone() })?;
+        let s = run_target(
+            &cargo,
+            root,
+            t,
+            &Options {
+                runs: *runs,
+                ..opts.clone()
+            },
+        )?;
         eprintln!(
             "xtask: {t}: {} executions in {:.0} s, cov {} ft {}, corpus {}, {} crash input(s)",
             s.runs,

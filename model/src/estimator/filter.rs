@@ -21,6 +21,8 @@
 //! the_low_pass_reaches_its_input_over_the_allowed_settings`). Cost: three
 //! `f32` additions and one word of state per tick.
 
+use crate::scalar::Real;
+
 /// What the filter made of a sample ([`TemperatureFilter::offer`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Verdict {
@@ -63,8 +65,9 @@ pub struct TemperatureFilter {
     /// Filtered value [C].
     filtered: f32,
     /// The low-pass's rounding error carried to the next tick [C]: what
-    /// the last additions to `filtered` lost (Kahan's compensation; the
-    /// filtered value is `filtered - carry` to within rounding).
+    /// the last additions to `filtered` lost (Kahan's compensation,
+    /// [`Real::mul_add_compensated`]; the filtered value is `filtered +
+    /// carry` to within rounding).
     carry: f32,
     /// Last accepted sample [C] (the low-pass's input).
     held: f32,
@@ -125,12 +128,9 @@ impl TemperatureFilter {
     /// temperature still add up (module docs).
     #[inline]
     pub fn advance(&mut self, settings: &FilterSettings) -> f32 {
-        let increment = settings.gain * (self.held - self.filtered) - self.carry;
-        let sum = self.filtered + increment;
-        // What the addition lost (exactly, by Dekker's Fast2Sum, whenever
-        // |filtered| >= |increment|: near the input, where it matters).
-        self.carry = (sum - self.filtered) - increment;
-        self.filtered = sum;
+        self.filtered = self
+            .filtered
+            .mul_add_compensated(settings.gain, self.held - self.filtered, &mut self.carry);
         self.filtered
     }
 
