@@ -349,14 +349,9 @@ impl Run {
         let cap = spikes + filter + slew + 20.0 * tau + 0.05;
         let max_ticks = (cap / tick).ceil() as u32;
         let resting = ((3.0 * tau / tick).ceil() as u32).max(20);
-        // Finding F2 (docs/fuzzing.md): the f32 low-pass filter stops
-        // moving once its step `gain (held - filtered)` rounds away, half
-        // an ulp of the temperature short of it: up to `ulp / (2 gain)`
-        // off a constant input (0.01 C at 4 kHz and 0.67 s, 3.8 C at the
-        // 100 kHz and 10 s validation accepts). Allowed here (twice the
-        // bound), so that the fuzzer goes on past it.
-        let ulp = f32::from_bits(target.abs().to_bits() + 1) - target.abs();
-        let tol_t = tol_t + ulp / self.cfg.filter_gain;
+        // Finding F2 (docs/fuzzing.md), fixed: the low-pass is a
+        // compensated sum and reaches its input within an ulp; no
+        // allowance for a stall.
         let mut within = 0u32;
         let mut last = None;
         for k in 0..max_ticks {

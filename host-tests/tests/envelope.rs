@@ -49,7 +49,10 @@ fn check<F: Float + std::fmt::Debug>(raw: &RawParams, p: &Params<F>, t: f64) -> 
         assert!(zeta >= -F::ONE && zeta <= F::ONE, "{raw:?} at {t} C: {l:?}");
         // |lambda| >= |Re lambda| and |Im lambda|, within rounding.
         let slack = F::from_f64(1.0 + 1e-5);
-        assert!(wn * slack >= e.re.abs() && wn * slack >= e.im.abs(), "{raw:?} at {t} C: {l:?}");
+        assert!(
+            wn * slack >= e.re.abs() && wn * slack >= e.im.abs(),
+            "{raw:?} at {t} C: {l:?}"
+        );
     }
     assert!(l.plunger_damping_ratio.is_finite(), "{raw:?} at {t} C: {l:?}");
     assert_eq!(l.stable, l.eigenvalues.iter().all(|e| e.re < F::ZERO));
@@ -90,5 +93,8 @@ fn linearise_is_finite_or_refused_over_the_plausible_envelope() {
     }
     // Enough of the envelope was accepted and linearised to mean something.
     eprintln!("{designs} designs; linearised {ok64} times in f64, {ok32} in f32");
-    assert!(designs >= 500 && ok64 >= 2500 && ok32 >= 2500, "{designs} {ok64} {ok32}");
+    assert!(
+        designs >= 500 && ok64 >= 2500 && ok32 >= 2500,
+        "{designs} {ok64} {ok32}"
+    );
 }
