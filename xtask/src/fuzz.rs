@@ -1,9 +1,10 @@
 //! `cargo xtask fuzz`: the libFuzzer targets of `fuzz/` (docs/fuzzing.md),
 //! each for a bounded time or number of executions.
 //!
-//! * cargo-fuzz: used if installed, else `cargo install cargo-fuzz
-//!   --version CARGO_FUZZ --locked` within a deadline (crates.io); a
-//!   failed install is an error that says so.
+//! * cargo-fuzz: used if installed (on `PATH` or under `target/tools`),
+//!   else `cargo install cargo-fuzz --version CARGO_FUZZ --locked --root
+//!   target/tools` within a deadline (crates.io), kept with the build
+//!   cache; a failed install is an error that says so.
 //! * The build: `cargo fuzz build --release --debug-assertions --sanitizer
 //!   none` with `RUSTC_BOOTSTRAP=1` on the workspace's stable toolchain
 //!   (cargo-fuzz's coverage flags are nightly-only; no nightly is needed,
@@ -73,16 +74,39 @@ pub struct Summary {
     pub crashes: Vec<PathBuf>,
 }
 
-/// `cargo fuzz`, installing it if missing.
-fn ensure_cargo_fuzz(cargo: &str) -> Result<(), String> {
-    let version = process::capture(Command::new(cargo).args(["fuzz", "--version"]), Duration::from_secs(60));
+/// Where cargo-fuzz is installed when it is missing (`cargo install
+/// --root`), with its build cache beside it: under `target/`, so that CI
+/// keeps it with the build cache and reruns skip the install.
+pub const TOOLS: &str = "target/tools";
+
+/// `PATH` with `root/TOOLS/bin` first (a cargo-fuzz installed there wins).
+fn tools_path(root: &Path) -> std::ffi::OsString {
+    let bin = root.join(TOOLS).join("bin");
+    let rest = std::env::var_os("PATH").unwrap_or_default();
+    std::env::join_paths(std::iter::once(bin).chain(std::env::split_paths(&rest))).unwrap_or(rest)
+}
+
+/// `cargo fuzz`, installing it under [`TOOLS`] if missing.
+fn ensure_cargo_fuzz(cargo: &str, root: &Path) -> Result<(), String> {
+    let version = process::capture(
+        Command::new(cargo).env("PATH", tools_path(root)).args(["fuzz", "--version"]),
+        Duration::from_secs(60),
+    );
     if version.ok() {
         eprintln!("xtask: {}", version.stdout.trim());
         return Ok(());
     }
-    eprintln!("xtask: cargo-fuzz is not installed: cargo install cargo-fuzz --version {CARGO_FUZZ} --locked");
+    let tools = root.join(TOOLS);
+    eprintln!(
+        "xtask: cargo-fuzz is not installed: cargo install cargo-fuzz --version {CARGO_FUZZ} --locked --root {}",
+        tools.display()
+    );
     let installed = process::run(
-        Command::new(cargo).args(["install", "cargo-fuzz", "--version", CARGO_FUZZ, "--locked"]),
+        Command::new(cargo)
+            .args(["install", "cargo-fuzz", "--version", CARGO_FUZZ, "--locked", "--root"])
+            .arg(&tools)
+            .arg("--target-dir")
+            .arg(tools.join("build")),
         Duration::from_secs(15 * 60),
     );
     if installed != Some(0) {
@@ -106,7 +130,10 @@ const BUILD_FLAGS: [&str; 5] = [
 
 fn cargo_fuzz(cargo: &str, root: &Path) -> Command {
     let mut cmd = Command::new(cargo);
-    cmd.current_dir(root).env("RUSTC_BOOTSTRAP", "1").arg("fuzz");
+    cmd.current_dir(root)
+        .env("RUSTC_BOOTSTRAP", "1")
+        .env("PATH", tools_path(root))
+        .arg("fuzz");
     cmd
 }
 
@@ -121,7 +148,7 @@ pub fn run(root: &Path, opts: &Options) -> Result<Vec<Summary>, String> {
             .map(|t| parse_target(t, opts.runs))
             .collect::<Result<_, _>>()?
     };
-    ensure_cargo_fuzz(&cargo)?;
+    ensure_cargo_fuzz(&cargo, root)?;
     let t0 = Instant::now();
     let built = process::run(
         cargo_fuzz(&cargo, root).arg("build").args(BUILD_FLAGS),
