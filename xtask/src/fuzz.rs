@@ -89,7 +89,9 @@ fn tools_path(root: &Path) -> std::ffi::OsString {
 /// `cargo fuzz`, installing it under [`TOOLS`] if missing.
 fn ensure_cargo_fuzz(cargo: &str, root: &Path) -> Result<(), String> {
     let version = process::capture(
-        Command::new(cargo).env("PATH", tools_path(root)).args(["fuzz", "--version"]),
+        Command::new(cargo)
+            .env("PATH", tools_path(root))
+            .args(["fuzz", "--version"]),
         Duration::from_secs(60),
     );
     if version.ok() {
