@@ -211,7 +211,9 @@ fn hold<F: Float, T: Real>(
     }
     // The linearisation at a stop is the free motion there: a plunger
     // driven a whole stroke onto the closed stop through cold oil arrives
-    // in up to ~90 of those time constants (docs/fuzzing.md, O2).
+    // in up to ~110 of those time constants (docs/fuzzing.md, O2;
+    // `cargo run --release -p host-tests --example settling`): hence the
+    // floor of MIN_HOLD.
     let cap = cap.max(MIN_HOLD);
     let tick = case.config.tick;
     let max_ticks = (cap / tick).ceil() as u32;
