@@ -48,6 +48,10 @@ const STEPS: [(f64, f64); 7] = [
 ];
 const TOLERANCES: [f64; 2] = [1e-2, 1e-3];
 
+/// Per stop at the end: every settling time and the worst (value, case),
+/// per tolerance.
+type ByStop = (Stop, [Vec<f64>; 2], [(f64, String); 2]);
+
 fn perturbed_paper(rng: &mut Rng, paper: &RawParams) -> RawParams {
     let mut raw = *paper;
     raw.core = raw.core.map(|n| n.value * 4f64.powf(rng.uniform(-1.0, 1.0)));
@@ -85,7 +89,7 @@ fn settle(raw: &RawParams, from: f64, to: f64) -> Option<([f64; 2], Stop, f64)> 
             }
         }
     }
-    if last_out.iter().any(|&k| k == ticks) {
+    if last_out.contains(&ticks) {
         // Never settled: a finding, not a figure.
         eprintln!("not settled within {ticks} ticks: {from} -> {to} C, tau {tau:.4} s, {raw:?}");
         return Some(([f64::INFINITY; 2], eq.stop, tau));
@@ -126,7 +130,7 @@ fn main() {
     let paper = compensator_cli::load(&host_tests::repo_root().join("presets/paper.toml")).expect("paper preset");
     let mut rng = Rng::new(seed);
     // Per (stop at the end, tolerance): every settling time, and the worst.
-    let mut by_stop: Vec<(Stop, [Vec<f64>; 2], [(f64, String); 2])> = Vec::new();
+    let mut by_stop: Vec<ByStop> = Vec::new();
     let mut used = 0;
     let (mut est_steps, mut est_reseated, mut est_worst) = (0, 0, String::new());
     while used < designs {
@@ -162,13 +166,10 @@ fn main() {
                     by_stop.last_mut().unwrap()
                 }
             };
-            for i in 0..2 {
-                entry.1[i].push(n[i]);
-                if n[i] > entry.2[i].0 {
-                    entry.2[i] = (
-                        n[i],
-                        format!("design {used}, {from} -> {to} C, tau {:.1} ms", tau * 1e3),
-                    );
+            for (i, &ni) in n.iter().enumerate() {
+                entry.1[i].push(ni);
+                if ni > entry.2[i].0 {
+                    entry.2[i] = (ni, format!("design {used}, {from} -> {to} C, tau {:.1} ms", tau * 1e3));
                 }
             }
         }

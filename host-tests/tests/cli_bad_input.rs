@@ -85,9 +85,9 @@ fn every_command_refuses_every_bad_field_by_its_name() {
     }
     std::fs::remove_dir_all(&dir).ok();
     // Every command saw most kinds of bad value.
-    for c in 0..COMMANDS.len() {
+    for (c, (command, _)) in COMMANDS.iter().enumerate() {
         let kinds = cases_seen.iter().filter(|(k, _)| *k == c).count();
-        assert!(kinds >= 8, "{:?}: {kinds} kinds of bad value", COMMANDS[c].0);
+        assert!(kinds >= 8, "{command:?}: {kinds} kinds of bad value");
     }
     assert!(runs >= 12 * 40, "{runs}");
 }

@@ -90,11 +90,12 @@ pub fn hurwitz_stable<T: Real>(m: &[[T; 4]; 4]) -> bool {
     hurwitz_quartic(&characteristic_polynomial(&scaled))
 }
 
-/// The Routh-Hurwitz conditions of the monic quartic `s^4 + a3 s^3 + a2 s^2
-/// + a1 s + a0` (coefficients `[a3, a2, a1, a0]`): every root has a
-/// negative real part exactly when all four are positive and `a3 a2 a1 >
-/// a1^2 + a3^2 a0`, here divided by `a3 a1 > 0`: `a2 > a1 / a3 + a3 (a0 /
-/// a1)` (which implies `a3 a2 > a1`). The quotient form has no product of
+/// The Routh-Hurwitz conditions of the monic quartic
+/// `s^4 + a3 s^3 + a2 s^2 + a1 s + a0` (coefficients `[a3, a2, a1, a0]`):
+/// every root has a negative real part exactly when all four are positive
+/// and `a3 a2 a1 > a1^2 + a3^2 a0`, here divided by `a3 a1 > 0`:
+/// `a2 > a1 / a3 + a3 (a0 / a1)` (which implies `a3 a2 > a1`). Source:
+/// Routh-Hurwitz criterion for a quartic. The quotient form has no product of
 /// three coefficients: a term that overflows is one `a2` cannot exceed,
 /// and the verdict stays right for coefficients anywhere in the type's
 /// range. `false` when a coefficient is NaN.
