@@ -72,10 +72,18 @@ fn main() {
     let mut raw = example();
     raw.core.density_15 = 4.641327459062115e-303;
     raw.core.volume_a = 2.1094012579938076e301;
-    replay("F3 (oil of 4.6e-303 kg/m^3, chamber a of 2.1e301 m^3, 51.9 C)", &raw, 51.874236874236885);
+    replay(
+        "F3 (oil of 4.6e-303 kg/m^3, chamber a of 2.1e301 m^3, 51.9 C)",
+        &raw,
+        51.874236874236885,
+    );
 
     let mut raw = example();
     raw.core.spring_rate = 2.23137064562084e-106;
     raw.core.outlet_pressure = 4.183097312812741e93;
-    replay("F4 (spring 2.2e-106 N/m, p_c 4.2e93 Pa, 162.9 C)", &raw, 162.93040293040292);
+    replay(
+        "F4 (spring 2.2e-106 N/m, p_c 4.2e93 Pa, 162.9 C)",
+        &raw,
+        162.93040293040292,
+    );
 }
