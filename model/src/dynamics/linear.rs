@@ -58,8 +58,9 @@ pub fn characteristic_polynomial<T: Real>(m: &[[T; 4]; 4]) -> [T; 4] {
 /// (Routh-Hurwitz conditions for a quartic; no iteration); `false` for a
 /// matrix with an entry that is not finite.
 ///
-/// The matrix is first divided by its largest entry's magnitude (which
-/// scales the eigenvalues and keeps their signs), so that the coefficients
+/// A matrix whose largest entry lies outside 2^-16..2^16 is first divided
+/// by that entry's magnitude (which scales the eigenvalues and keeps their
+/// signs), so that the coefficients
 /// of its characteristic polynomial are at most 4, 12, 24 and 24 in
 /// magnitude, and the conditions are taken in the quotient form of
 /// [`hurwitz_quartic`]: no product that can overflow, on any finite
@@ -74,9 +75,12 @@ pub fn hurwitz_stable<T: Real>(m: &[[T; 4]; 4]) -> bool {
             big = big.max(e.abs());
         }
     }
-    if T::SATURATES || !(big > T::ZERO) {
-        // Fixed point would lose the small entries' bits; a zero matrix
-        // is not stable.
+    // Entries within 2^-16..2^16 (the model-unit Jacobians: no division
+    // then): the coefficients, products of up to four entries, stay within
+    // 2^-64..2^69, far inside even `f32`. Fixed point would lose the small
+    // entries' bits; a zero matrix is not stable.
+    let (lo, hi) = (T::from_f64(1.0 / 65_536.0), T::from_f64(65_536.0));
+    if T::SATURATES || !(big > T::ZERO) || (big >= lo && big <= hi) {
         return hurwitz_quartic(&characteristic_polynomial(m));
     }
     // Divided, not multiplied by 1 / big (which overflows for a subnormal
