@@ -58,14 +58,19 @@ pub fn characteristic_polynomial<T: Real>(m: &[[T; 4]; 4]) -> [T; 4] {
 /// (Routh-Hurwitz conditions for a quartic; no iteration); `false` for a
 /// matrix with an entry that is not finite.
 ///
-/// A matrix whose largest entry lies outside 2^-16..2^16 is first divided
-/// by that entry's magnitude (which scales the eigenvalues and keeps their
-/// signs), so that the coefficients
-/// of its characteristic polynomial are at most 4, 12, 24 and 24 in
-/// magnitude, and the conditions are taken in the quotient form of
-/// [`hurwitz_quartic`]: no product that can overflow, on any finite
-/// matrix.
+/// Where a coefficient of the characteristic polynomial overflows or falls
+/// into the subnormals, the matrix is divided by its largest entry's
+/// magnitude (which scales the eigenvalues and keeps their signs), so that
+/// the coefficients are at most 4, 12, 24 and 24 in magnitude; the
+/// conditions are taken in the quotient form of [`hurwitz_quartic`]: no
+/// product that can overflow, on any finite matrix.
 pub fn hurwitz_stable<T: Real>(m: &[[T; 4]; 4]) -> bool {
+    // The usual case (the model-unit Jacobians): every coefficient finite
+    // and clear of the subnormals, nothing to scale.
+    let a = characteristic_polynomial(m);
+    if T::SATURATES || a.iter().all(|c| c.is_finite() && c.abs() >= T::tiny()) {
+        return hurwitz_quartic(&a);
+    }
     let mut big = T::ZERO;
     for row in m {
         for &e in row {
@@ -75,13 +80,9 @@ pub fn hurwitz_stable<T: Real>(m: &[[T; 4]; 4]) -> bool {
             big = big.max(e.abs());
         }
     }
-    // Entries within 2^-16..2^16 (the model-unit Jacobians: no division
-    // then): the coefficients, products of up to four entries, stay within
-    // 2^-64..2^69, far inside even `f32`. Fixed point would lose the small
-    // entries' bits; a zero matrix is not stable.
-    let (lo, hi) = (T::from_f64(1.0 / 65_536.0), T::from_f64(65_536.0));
-    if T::SATURATES || !(big > T::ZERO) || (big >= lo && big <= hi) {
-        return hurwitz_quartic(&characteristic_polynomial(m));
+    if !(big > T::ZERO) {
+        // A zero matrix is not stable.
+        return false;
     }
     // Divided, not multiplied by 1 / big (which overflows for a subnormal
     // big): every quotient is at most one.
