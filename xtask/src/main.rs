@@ -162,7 +162,7 @@ enum Command {
     /// The cargo-fuzz targets of fuzz/, each for a bounded time or number
     /// of executions (docs/fuzzing.md; installs cargo-fuzz if missing)
     Fuzz {
-        /// Seconds per target [default: 30 unless --runs is given]
+        /// Seconds per target [default: 30 unless --runs or a --target T=N is given]
         #[arg(long, value_name = "N")]
         seconds: Option<u64>,
         /// Executions per target
