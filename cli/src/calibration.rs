@@ -1,22 +1,151 @@
-//! Calibration against the paper's Tables 1 and 2: the `calibrate` command.
+//! Calibration from measured static data: the `calibrate` command.
 //!
-//! [`fit`] keeps a base parameter set's geometry and fits
-//! 1. the oil (Walther `a`, `b`) and the geometry factor `G` of
-//!    `A = G nu sqrt(rho)` to all 18 points of Table 1 (`G` becomes the
-//!    capillary length), then
-//! 2. the spring rate and preload (`A_p / c` and `x0`) to Table 2's
-//!    quasi-static column at 4 bar.
+//! Data, long form, one row per measurement (any temperatures, any number
+//! of pressure drops), read by [`crate::csv::read_numeric`]:
 //!
-//! [`calibrate`] writes the fitted set as TOML with its provenance.
+//! * pressure data `t_c,dp_pa,dp_ab_pa`: oil temperature [C], inlet-outlet
+//!   drop `p_p - p_c` [Pa], chamber pressure difference `p_b - p_a` [Pa];
+//! * displacement data `t_c,x_m` (optionally `dp_pa`; without it the base
+//!   file's `operating.pressure_drop`): plunger displacement [m].
+//!
+//! What static data determine (`docs/model.md` section 4): the chamber
+//! pressure difference depends on temperature only through
+//! `A(t) = G nu(t) sqrt(rho(t))`, so pressure data fit the oil's Walther
+//! constants `fluid.walther_a`, `fluid.walther_b` and the geometry factor
+//! `G` (expressed as the capillary length `laminar_throttle.length`, the
+//! other throttle dimensions kept); the displacement `x = Phi(A) - x0`
+//! then fits the spring's compliance `A_p / c` and preload `x0`
+//! (`plunger.spring_rate`, `plunger.preload`, the plunger diameter kept).
+//! The density law, the other dimensions and everything dynamic (mass,
+//! damping, volumes, bulk modulus: `identify`) are kept from the base file.
+//!
+//! The fit runs in two stages, as in the paper: the pressure stage alone,
+//! then the displacement stage at the fitted oil. The displacement stage's
+//! covariance includes the pressure stage's uncertainty propagated through
+//! the oil (two-step estimator: `cov2 + M cov1 M^T`, with
+//! `M = -(J2^T J2)^-1 J2^T J21` the sensitivity of the stage-2 optimum to
+//! the stage-1 parameters), so the reported standard errors and
+//! correlations cover all five parameters together.
+//!
+//! [`fit`] computes the estimates and [`calibrate`] renders them
+//! (`compensator calibrate`).
 
+use crate::csv::read_numeric;
 use crate::error::CliError;
-use crate::lsq::{Fit, levenberg_marquardt};
-use crate::paper::tables::{Table1, Table2, invert_table1, load_tables, table1_residuals, table2_residuals};
+use crate::lsq::{self, Fit, Uncertainty, least_squares};
 use crate::params_file;
 use compensator::Params;
+use compensator::equilibrium::{a_parameter, equilibrium, geometry_factor, pressure_difference};
 use compensator::params::{RawCore, RawParams};
+use nalgebra::DMatrix;
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// One measurement of the chamber pressure difference.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PressurePoint {
+    /// Oil temperature [C].
+    pub t_c: f64,
+    /// Inlet-outlet drop `p_p - p_c` [Pa].
+    pub dp_pa: f64,
+    /// Chamber pressure difference `p_b - p_a` [Pa].
+    pub dp_ab_pa: f64,
+}
+
+/// One measurement of the plunger displacement.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DisplacementPoint {
+    /// Oil temperature [C].
+    pub t_c: f64,
+    /// Displacement [m].
+    pub x_m: f64,
+    /// Inlet-outlet drop [Pa]; `None`: the base file's pressure drop.
+    pub dp_pa: Option<f64>,
+}
+
+/// The columns `names` of a data file, by position, or an error naming the
+/// missing one and the columns found.
+fn columns(t: &crate::csv::Numeric, names: &[&str]) -> Result<Vec<usize>, String> {
+    names
+        .iter()
+        .map(|n| {
+            t.column(n).ok_or_else(|| {
+                format!(
+                    "no column {n} (columns: {}; expected {})",
+                    t.header.join(","),
+                    names.join(",")
+                )
+            })
+        })
+        .collect()
+}
+
+/// `row R (line L), column C`.
+fn at(t: &crate::csv::Numeric, row: usize, column: &str) -> String {
+    format!("row {} (line {}), column {column}", row + 1, t.lines[row])
+}
+
+/// Reads pressure data `t_c,dp_pa,dp_ab_pa` (other columns are ignored).
+///
+/// Errors (naming row and column): a missing column, a cell that is not a
+/// finite number, `dp_pa <= 0`, `|dp_ab_pa| >= dp_pa` (a chamber pressure
+/// outside the supply and outlet pressures), no rows.
+pub fn read_pressure(text: &str) -> Result<Vec<PressurePoint>, String> {
+    let t = read_numeric(text)?;
+    let c = columns(&t, &["t_c", "dp_pa", "dp_ab_pa"])?;
+    let mut out = Vec::with_capacity(t.rows.len());
+    for (i, r) in t.rows.iter().enumerate() {
+        let p = PressurePoint {
+            t_c: r[c[0]],
+            dp_pa: r[c[1]],
+            dp_ab_pa: r[c[2]],
+        };
+        if p.dp_pa <= 0.0 {
+            return Err(format!("{}: {} Pa is not a positive drop", at(&t, i, "dp_pa"), p.dp_pa));
+        }
+        if p.dp_ab_pa.abs() >= p.dp_pa {
+            return Err(format!(
+                "{}: {} Pa is not inside (-dp_pa, dp_pa) = (-{}, {}) Pa: a chamber pressure \
+                 lies between the supply and outlet pressures",
+                at(&t, i, "dp_ab_pa"),
+                p.dp_ab_pa,
+                p.dp_pa,
+                p.dp_pa
+            ));
+        }
+        out.push(p);
+    }
+    if out.is_empty() {
+        return Err("no data rows".into());
+    }
+    Ok(out)
+}
+
+/// Reads displacement data `t_c,x_m[,dp_pa]` (other columns are ignored).
+///
+/// Errors (naming row and column): a missing column, a cell that is not a
+/// finite number, `dp_pa <= 0`, no rows.
+pub fn read_displacement(text: &str) -> Result<Vec<DisplacementPoint>, String> {
+    let t = read_numeric(text)?;
+    let c = columns(&t, &["t_c", "x_m"])?;
+    let dp = t.column("dp_pa");
+    let mut out = Vec::with_capacity(t.rows.len());
+    for (i, r) in t.rows.iter().enumerate() {
+        let p = DisplacementPoint {
+            t_c: r[c[0]],
+            x_m: r[c[1]],
+            dp_pa: dp.map(|j| r[j]),
+        };
+        if let Some(d) = p.dp_pa.filter(|d| *d <= 0.0) {
+            return Err(format!("{}: {d} Pa is not a positive drop", at(&t, i, "dp_pa")));
+        }
+        out.push(p);
+    }
+    if out.is_empty() {
+        return Err("no data rows".into());
+    }
+    Ok(out)
+}
 
 /// Capillary length that gives geometry factor `g` with the base's other
 /// throttle dimensions: `L = G pi d_l^4 / (128 sqrt(2) C_d f)`.
@@ -30,134 +159,665 @@ fn params_of(core: &RawCore) -> Option<Params<f64>> {
     Params::<f64>::from_core(core, None).ok()
 }
 
+/// Model residuals against pressure data [Pa]; `None` where the model
+/// cannot be evaluated.
+pub fn pressure_residuals(core: &RawCore, data: &[PressurePoint]) -> Option<Vec<f64>> {
+    let params = params_of(core)?;
+    data.iter()
+        .map(|p| {
+            let fluid = params.oil.state(p.t_c).ok()?;
+            Some(pressure_difference(a_parameter(&params, &fluid), p.dp_pa) - p.dp_ab_pa)
+        })
+        .collect()
+}
+
+/// The model's displacement [m] at temperature `t_c` and drop `dp_pa`
+/// (`None`: the core's own).
+pub fn model_displacement(core: &RawCore, t_c: f64, dp_pa: Option<f64>) -> Option<f64> {
+    let mut c = *core;
+    if let Some(dp) = dp_pa {
+        c.pressure_drop = dp;
+    }
+    equilibrium(&params_of(&c)?, t_c).ok().map(|e| e.x)
+}
+
+/// Model residuals against displacement data [m]; `None` where the model
+/// cannot be evaluated.
+pub fn displacement_residuals(core: &RawCore, data: &[DisplacementPoint]) -> Option<Vec<f64>> {
+    data.iter()
+        .map(|p| Some(model_displacement(core, p.t_c, p.dp_pa)? - p.x_m))
+        .collect()
+}
+
+/// One fitted parameter with its uncertainty.
+#[derive(Debug, Clone)]
+pub struct Estimate {
+    /// Parameter path (`fluid.walther_a`), as in the parameter file.
+    pub path: &'static str,
+    /// Unit.
+    pub unit: &'static str,
+    /// Fitted value.
+    pub value: f64,
+    /// Standard error (same unit).
+    pub std_error: f64,
+    /// Which data determined it: `pressure` or `displacement`.
+    pub data: &'static str,
+}
+
+/// One stage of the fit: its least-squares result and its uncertainty in
+/// the fit's own coordinates.
+#[derive(Debug, Clone)]
+pub struct Stage {
+    /// The least-squares fit.
+    pub fit: Fit,
+    /// Its uncertainty (the displacement stage's conditional on the oil).
+    pub uncertainty: Uncertainty,
+}
+
 /// Outcome of [`fit`].
 #[derive(Debug, Clone)]
 pub struct Calibration {
     /// The calibrated parameter set (base with fitted fields).
     pub params: RawParams,
-    /// Table 1 fit (Walther a, b, log10 G) and its residuals [bar].
-    pub table1: Fit,
-    /// Table 2 fit (A_p / c in 1e-9 m/Pa, x0 in 1e-5 m) and its residuals [mm].
-    pub table2: Fit,
+    /// The fitted parameters, pressure stage first.
+    pub estimates: Vec<Estimate>,
+    /// Correlation matrix of the estimates (same order).
+    pub correlation: DMatrix<f64>,
+    /// Pressure stage: residuals in Pa.
+    pub pressure: Stage,
+    /// Displacement stage (with displacement data): residuals in m.
+    pub displacement: Option<Stage>,
+    /// Warnings about poorly determined parameters, one line each.
+    pub warnings: Vec<String>,
 }
 
-/// Fits the base parameter set to Tables 1 and 2 (see the module docs).
-pub fn fit(base: &RawParams, t1: &Table1, t2: &Table2) -> Result<Calibration, String> {
-    let start = params_of(&base.core).ok_or("base parameters are not valid")?;
-    let g0 = compensator::equilibrium::geometry_factor(&start);
-    let with_fluid = |p: &[f64]| {
-        let mut c = base.core;
-        c.walther_a = p[0];
-        c.walther_b = p[1];
-        c.laminar_length = capillary_length_for(&base.core, 10f64.powf(p[2]));
-        c
-    };
-    // Start from an oil whose A(t) crosses the data: invert the 4 bar
-    // column's end points for nu and solve Walther's two constants.
-    let x0 = initial_walther(base, t1, g0).unwrap_or([base.core.walther_a, base.core.walther_b]);
-    let fit1 = levenberg_marquardt(
-        |p| match params_of(&with_fluid(p)) {
-            Some(params) => table1_residuals(&params, t1),
-            None => vec![f64::INFINITY; t1.len()],
-        },
-        &[x0[0], x0[1], g0.log10()],
-        &[1e-7, 1e-7, 1e-7],
-        500,
-    );
-    if !fit1.rms().is_finite() {
-        return Err("Table 1 fit failed: the model cannot be evaluated at the table's temperatures".into());
-    }
-    let fluid_core = with_fluid(&fit1.x);
-    let area = std::f64::consts::FRAC_PI_4 * base.core.plunger_diameter.powi(2);
-    let with_spring = |p: &[f64]| {
-        let mut c = fluid_core;
-        c.spring_rate = area / (p[0] * 1e-9);
-        c.preload = (p[1] * 1e-5).max(0.0);
-        c
-    };
-    let k0 = area / base.core.spring_rate * 1e9;
-    let fit2 = levenberg_marquardt(
-        |p| match params_of(&with_spring(p)) {
-            Some(params) => table2_residuals(&params, t2),
-            None => vec![f64::INFINITY; t2.temps.len()],
-        },
-        &[k0, base.core.preload * 1e5],
-        &[1e-7, 1e-7],
-        500,
-    );
-    if !fit2.rms().is_finite() {
-        return Err("Table 2 fit failed".into());
-    }
-    let mut params = *base;
-    params.core = with_spring(&fit2.x);
-    params
-        .validate()
-        .map_err(|e| format!("calibrated parameters are not valid: {e}"))?;
-    Ok(Calibration {
-        params,
-        table1: fit1,
-        table2: fit2,
-    })
+/// Relative standard error above which a fitted parameter is reported as
+/// not determined by the data (a 95 % interval would then include zero and
+/// twice the value).
+pub const REL_SE_LIMIT: f64 = 0.5;
+
+/// Fit coordinates of the pressure stage: `[w_ref, walther_b, log10 G]`
+/// with `w_ref = walther_a - walther_b log10(T_ref)` the Walther function
+/// `log10 log10(nu + 0.7)` at the data's mean `log10 T` (centred, so that
+/// the conditioning check sees the viscosity level and slope, not the
+/// intercept at 0 K, which is correlated with the slope by construction).
+struct Oil {
+    base: RawCore,
+    log_t_ref: f64,
 }
 
-/// Walther constants through two points of Table 1's first column,
-/// inverted for `A` and divided by `G sqrt(rho)`.
-fn initial_walther(base: &RawParams, t1: &Table1, g: f64) -> Option<[f64; 2]> {
-    let params = params_of(&base.core)?;
-    let inv = invert_table1(t1);
-    let (i0, i1) = (0, t1.temps.len().checked_sub(1)?);
-    let nu_cst = |i: usize| -> Option<f64> {
-        let rho = params.oil.density(t1.temps[i]).ok()?;
-        let nu = inv.a[i][0] / (g * rho.sqrt()) * 1e6;
+impl Oil {
+    fn core(&self, u: &[f64]) -> RawCore {
+        let mut c = self.base;
+        c.walther_b = u[1];
+        c.walther_a = u[0] + u[1] * self.log_t_ref;
+        c.laminar_length = capillary_length_for(&self.base, 10f64.powf(u[2]));
+        c
+    }
+}
+
+/// Walther's constants through the two extreme temperatures of the
+/// pressure data, each inverted for `A` (`A^2 = (dp - y)^2 / (2 (dp + y))`)
+/// and divided by `G sqrt(rho)`.
+fn initial_walther(base: &RawCore, data: &[PressurePoint], g: f64) -> Option<[f64; 2]> {
+    let params = params_of(base)?;
+    let lo = data.iter().min_by(|a, b| a.t_c.total_cmp(&b.t_c))?;
+    let hi = data.iter().max_by(|a, b| a.t_c.total_cmp(&b.t_c))?;
+    if hi.t_c - lo.t_c < 1.0 {
+        return None;
+    }
+    let nu_cst = |p: &PressurePoint| -> Option<f64> {
+        let rho = params.oil.density(p.t_c).ok()?;
+        let a = ((p.dp_pa - p.dp_ab_pa).powi(2) / (2.0 * (p.dp_pa + p.dp_ab_pa))).sqrt();
+        let nu = a / (g * rho.sqrt()) * 1e6;
         (nu > 0.0).then_some(nu)
     };
     let w = |nu: f64| (nu + 0.7).log10().log10();
-    let (n0, n1) = (nu_cst(i0)?, nu_cst(i1)?);
-    let (l0, l1) = ((t1.temps[i0] + 273.15).log10(), (t1.temps[i1] + 273.15).log10());
+    let (n0, n1) = (nu_cst(lo)?, nu_cst(hi)?);
+    let (l0, l1) = ((lo.t_c + 273.15).log10(), (hi.t_c + 273.15).log10());
     let b = (w(n0) - w(n1)) / (l1 - l0);
     let a = w(n0) + b * l0;
     (a.is_finite() && b.is_finite() && b > 0.0).then_some([a, b])
 }
 
-/// `calibrate`: fitted preset as TOML with its provenance in comments,
-/// from the base file `base_path` and the tables in `data` (without them:
-/// the built-in `presets/model-example.toml` and `data/paper/`).
-pub fn calibrate(base_path: Option<&Path>, data: Option<&Path>) -> Result<String, CliError> {
-    let base = match base_path {
+/// Central-difference steps for parameters near `x`: 1e-6 relative (about
+/// the cube root of the machine epsilon, the best for central differences),
+/// at least 1e-9.
+fn steps(x: &[f64]) -> Vec<f64> {
+    x.iter().map(|v| 1e-6 * v.abs().max(1e-3)).collect()
+}
+
+/// The data cannot determine the parameters: exit status 2 naming the data.
+fn undetermined(which: &str, names: &[&str], e: lsq::Undetermined) -> CliError {
+    CliError::Input(format!("{which}: cannot fit {}: {e}", names.join(", ")))
+}
+
+/// Fits the base parameter set to the data (see the module docs).
+///
+/// Errors: [`CliError::Input`] when the data cannot determine the
+/// parameters (no degree of freedom, a rank-deficient Jacobian: the message
+/// names the data and the parameters) or the base file is not valid;
+/// [`CliError::Failed`] when the minimiser does not converge.
+pub fn fit(
+    base: &RawParams,
+    pressure: &[PressurePoint],
+    displacement: Option<&[DisplacementPoint]>,
+) -> Result<Calibration, CliError> {
+    let f = &RawCore::FIELD;
+    let start = params_of(&base.core).ok_or_else(|| CliError::Input("--base: parameters are not valid".into()))?;
+    let g0 = geometry_factor(&start);
+    let log_t_ref = pressure.iter().map(|p| (p.t_c + 273.15).log10()).sum::<f64>() / pressure.len() as f64;
+    let oil = Oil {
+        base: base.core,
+        log_t_ref,
+    };
+    let level = format!(
+        "the viscosity at {:.0} C (fluid.walther_a at the fitted walther_b)",
+        10f64.powf(log_t_ref) - 273.15
+    );
+    let names1 = [level.as_str(), f.walther_b.path, f.laminar_length.path];
+    if pressure.len() <= 3 {
+        return Err(undetermined(
+            "--pressure-data",
+            &names1,
+            lsq::Undetermined::NoDegreesOfFreedom {
+                points: pressure.len(),
+                parameters: 3,
+            },
+        ));
+    }
+    // Start from the oil through the data's extreme temperatures, or the
+    // base file's oil where that one cannot be evaluated at every point.
+    let r1 = |u: &[f64]| pressure_residuals(&oil.core(u), pressure);
+    let (u0, j0) = [
+        initial_walther(&base.core, pressure, g0),
+        Some([base.core.walther_a, base.core.walther_b]),
+    ]
+    .into_iter()
+    .flatten()
+    .find_map(|[a0, b0]| {
+        let u0 = [a0 - b0 * log_t_ref, b0, g0.log10()];
+        lsq::jacobian(r1, &u0, &steps(&u0)).map(|j| (u0, j))
+    })
+    .ok_or_else(|| {
+        CliError::Input(
+            "--pressure-data: the base file's oil cannot be evaluated at every temperature of the data".into(),
+        )
+    })?;
+    lsq::check_design(&j0, &names1).map_err(|e| undetermined("--pressure-data", &names1, e))?;
+    let fit1 = least_squares(r1, &u0, &steps(&u0)).map_err(|e| CliError::Failed(format!("--pressure-data: {e}")))?;
+    let unc1 = lsq::analyse(&fit1.jacobian, &fit1.residuals, &names1)
+        .map_err(|e| undetermined("--pressure-data", &names1, e))?;
+    let mut warnings: Vec<String> = unc1
+        .warnings()
+        .into_iter()
+        .map(|w| format!("pressure data: {w}"))
+        .collect();
+    let fluid_core = oil.core(&fit1.x);
+    // Covariance of (walther_a, walther_b, log10 G) from that of (w_ref, b, log10 G).
+    let to_ab = DMatrix::from_row_slice(3, 3, &[1.0, log_t_ref, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
+    let cov1 = &to_ab * &unc1.cov * to_ab.transpose();
+    let theta1 = [fluid_core.walther_a, fluid_core.walther_b, fit1.x[2]];
+
+    let area = std::f64::consts::FRAC_PI_4 * base.core.plunger_diameter.powi(2);
+    // Stage-2 coordinates: compliance A_p / c [1e-9 m/Pa], preload [1e-5 m].
+    let spring = |core: RawCore, v: &[f64]| {
+        let mut c = core;
+        c.spring_rate = area / (v[0] * 1e-9);
+        c.preload = (v[1] * 1e-5).max(0.0);
+        c
+    };
+    let mut core = fluid_core;
+    let mut displacement_stage = None;
+    let mut cov = cov1.clone();
+    let mut internal = theta1.to_vec();
+    if let Some(data) = displacement {
+        let names2 = [f.spring_rate.path, f.preload.path];
+        if data.len() <= 2 {
+            return Err(undetermined(
+                "--displacement-data",
+                &names2,
+                lsq::Undetermined::NoDegreesOfFreedom {
+                    points: data.len(),
+                    parameters: 2,
+                },
+            ));
+        }
+        let v0 = [area / base.core.spring_rate * 1e9, base.core.preload * 1e5];
+        let r2 = |v: &[f64]| displacement_residuals(&spring(fluid_core, v), data);
+        let j0 = lsq::jacobian(r2, &v0, &steps(&v0)).ok_or_else(|| {
+            CliError::Input("--displacement-data: the model cannot be evaluated at the data's temperatures".into())
+        })?;
+        lsq::check_design(&j0, &names2).map_err(|e| undetermined("--displacement-data", &names2, e))?;
+        let fit2 =
+            least_squares(r2, &v0, &steps(&v0)).map_err(|e| CliError::Failed(format!("--displacement-data: {e}")))?;
+        let unc2 = lsq::analyse(&fit2.jacobian, &fit2.residuals, &names2)
+            .map_err(|e| undetermined("--displacement-data", &names2, e))?;
+        warnings.extend(unc2.warnings().into_iter().map(|w| format!("displacement data: {w}")));
+        core = spring(fluid_core, &fit2.x);
+        // Sensitivity of the displacement residuals to the oil (J21), and
+        // the propagated covariance of the two-step estimate.
+        let with_oil = |t: &[f64]| {
+            let mut c = core;
+            c.walther_a = t[0];
+            c.walther_b = t[1];
+            c.laminar_length = capillary_length_for(&base.core, 10f64.powf(t[2]));
+            c
+        };
+        let h = steps(&theta1);
+        let m = data.len();
+        let mut j21 = DMatrix::zeros(m, 3);
+        for j in 0..3 {
+            let (mut tp, mut tm) = (theta1, theta1);
+            tp[j] += h[j];
+            tm[j] -= h[j];
+            let rp = displacement_residuals(&with_oil(&tp), data);
+            let rm = displacement_residuals(&with_oil(&tm), data);
+            let (Some(rp), Some(rm)) = (rp, rm) else {
+                return Err(CliError::Failed(
+                    "--displacement-data: the model cannot be evaluated next to the fitted oil".into(),
+                ));
+            };
+            for i in 0..m {
+                j21[(i, j)] = (rp[i] - rm[i]) / (2.0 * h[j]);
+            }
+        }
+        let j2 = &fit2.jacobian;
+        let jtj = j2.transpose() * j2;
+        let inv = jtj
+            .try_inverse()
+            .ok_or_else(|| CliError::Failed("--displacement-data: singular normal equations".into()))?;
+        let sens = -(inv * j2.transpose() * &j21);
+        let cov22 = &unc2.cov + &sens * &cov1 * sens.transpose();
+        let cov21 = &sens * &cov1;
+        let mut full = DMatrix::zeros(5, 5);
+        full.view_mut((0, 0), (3, 3)).copy_from(&cov1);
+        full.view_mut((3, 3), (2, 2)).copy_from(&cov22);
+        full.view_mut((3, 0), (2, 3)).copy_from(&cov21);
+        full.view_mut((0, 3), (3, 2)).copy_from(&cov21.transpose());
+        cov = full;
+        internal.extend_from_slice(&fit2.x);
+        displacement_stage = Some(Stage {
+            fit: fit2,
+            uncertainty: unc2,
+        });
+    }
+    // From fit coordinates to the parameter file's fields (delta method):
+    // L = c 10^u (dL/du = L ln 10), spring_rate = A_p / (v 1e-9)
+    // (d/dv = -spring_rate / v), preload = 1e-5 v.
+    let mut d = vec![1.0, 1.0, core.laminar_length * std::f64::consts::LN_10];
+    if displacement_stage.is_some() {
+        d.push(-core.spring_rate / internal[3]);
+        d.push(1e-5);
+    }
+    let p = d.len();
+    let cov_named = DMatrix::from_fn(p, p, |i, j| d[i] * cov[(i, j)] * d[j]);
+    let fields = [f.walther_a, f.walther_b, f.laminar_length, f.spring_rate, f.preload];
+    let values = [
+        core.walther_a,
+        core.walther_b,
+        core.laminar_length,
+        core.spring_rate,
+        core.preload,
+    ];
+    let estimates: Vec<Estimate> = (0..p)
+        .map(|i| Estimate {
+            path: fields[i].path,
+            unit: fields[i].unit,
+            value: values[i],
+            std_error: cov_named[(i, i)].max(0.0).sqrt(),
+            data: if i < 3 { "pressure" } else { "displacement" },
+        })
+        .collect();
+    for e in &estimates {
+        let rel = e.std_error / e.value.abs();
+        if !(rel <= REL_SE_LIMIT) {
+            warnings.push(format!(
+                "{} = {:.4e} {} has a standard error of {:.0} % of its value (above {:.0} %): the {} data \
+                 do not determine it; it is kept in the preset only because the fit needs a value",
+                e.path,
+                e.value,
+                e.unit,
+                100.0 * rel,
+                100.0 * REL_SE_LIMIT,
+                e.data
+            ));
+        }
+    }
+    let mut params = *base;
+    params.core = core;
+    params
+        .validate()
+        .map_err(|e| CliError::Failed(format!("calibrated parameters are not valid: {e}")))?;
+    Ok(Calibration {
+        params,
+        estimates,
+        correlation: lsq::correlation(&cov_named),
+        pressure: Stage {
+            fit: fit1,
+            uncertainty: unc1,
+        },
+        displacement: displacement_stage,
+        warnings,
+    })
+}
+
+impl Calibration {
+    /// The stage that fitted `data` (`pressure` or `displacement`).
+    fn stage(&self, data: &str) -> &Stage {
+        match (data, &self.displacement) {
+            ("displacement", Some(s)) => s,
+            _ => &self.pressure,
+        }
+    }
+
+    /// The report table (CSV): one row per fitted parameter,
+    /// `parameter,unit,value,std_error,rel_std_error,data,points,dof,
+    /// residual_rms,residual_unit,corr_<parameter>...`, where
+    /// `residual_rms = sqrt(RSS / dof)` of the data that fitted it.
+    pub fn table(&self) -> String {
+        let mut header = vec![
+            "parameter".to_string(),
+            "unit".into(),
+            "value".into(),
+            "std_error".into(),
+            "rel_std_error".into(),
+            "data".into(),
+            "points".into(),
+            "dof".into(),
+            "residual_rms".into(),
+            "residual_unit".into(),
+        ];
+        header.extend(self.estimates.iter().map(|e| format!("corr_{}", e.path)));
+        let mut out = header.join(",");
+        out.push('\n');
+        for (i, e) in self.estimates.iter().enumerate() {
+            let u = &self.stage(e.data).uncertainty;
+            let unit = if e.data == "pressure" { "Pa" } else { "m" };
+            let _ = write!(
+                out,
+                "{},{},{},{},{},{},{},{},{},{}",
+                e.path,
+                e.unit.replace(' ', "_"),
+                e.value,
+                e.std_error,
+                e.std_error / e.value.abs(),
+                e.data,
+                u.points,
+                u.dof,
+                u.s(),
+                unit
+            );
+            for j in 0..self.estimates.len() {
+                let _ = write!(out, ",{}", self.correlation[(i, j)]);
+            }
+            out.push('\n');
+        }
+        out
+    }
+
+    /// One line per stage for standard error: points, degrees of freedom,
+    /// residual RMS.
+    pub fn summary(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        let u = &self.pressure.uncertainty;
+        out.push(format!(
+            "pressure data: {} points, 3 parameters, {} degrees of freedom; residual RMS {:.4e} Pa \
+             (sqrt(RSS/dof) = {:.4e} Pa), max {:.4e} Pa",
+            u.points,
+            u.dof,
+            self.pressure.fit.rms(),
+            u.s(),
+            self.pressure.fit.max_abs()
+        ));
+        if let Some(s) = &self.displacement {
+            let u = &s.uncertainty;
+            out.push(format!(
+                "displacement data: {} points, 2 parameters, {} degrees of freedom; residual RMS {:.4e} m \
+                 (sqrt(RSS/dof) = {:.4e} m), max {:.4e} m",
+                u.points,
+                u.dof,
+                s.fit.rms(),
+                u.s(),
+                s.fit.max_abs()
+            ));
+        }
+        out
+    }
+
+    /// The calibrated parameter file: TOML with the fit in comments.
+    pub fn preset(&self, command: &str) -> String {
+        let mut out = String::new();
+        let _ = writeln!(out, "# Calibrated from measured static data.");
+        let _ = writeln!(out, "# Generated by: {command}");
+        for line in self.summary() {
+            let _ = writeln!(out, "# {line}");
+        }
+        for e in &self.estimates {
+            let _ = writeln!(
+                out,
+                "# {} = {} +- {:.3e} {} (standard error, {} data)",
+                e.path, e.value, e.std_error, e.unit, e.data
+            );
+        }
+        for w in &self.warnings {
+            let _ = writeln!(out, "# WARNING: {w}");
+        }
+        out.push('\n');
+        out.push_str(&params_file::to_toml(&self.params));
+        out
+    }
+
+    /// The figure of `--plot`: the data against the fitted curves, the
+    /// pressure difference [bar] per drop and the displacement [mm] over
+    /// temperature.
+    pub fn figure(
+        &self,
+        pressure: &[PressurePoint],
+        displacement: Option<&[DisplacementPoint]>,
+    ) -> crate::plot::Figure {
+        use crate::plot::{Figure, Panel, Series};
+        let core = &self.params.core;
+        let (lo, hi) = pressure
+            .iter()
+            .map(|p| p.t_c)
+            .chain(displacement.unwrap_or(&[]).iter().map(|p| p.t_c))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), t| (l.min(t), h.max(t)));
+        let grid: Vec<f64> = (0..=100).map(|k| lo + (hi - lo) * k as f64 / 100.0).collect();
+        let mut drops: Vec<f64> = pressure.iter().map(|p| p.dp_pa).collect();
+        drops.sort_by(f64::total_cmp);
+        drops.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * b.abs());
+        let many = drops.len() > 6;
+        let mut series = Vec::new();
+        if !many {
+            for (i, &dp) in drops.iter().enumerate() {
+                let mut pts: Vec<(f64, f64)> = pressure
+                    .iter()
+                    .filter(|p| (p.dp_pa - dp).abs() <= 1e-9 * dp)
+                    .map(|p| (p.t_c, p.dp_ab_pa * 1e-5))
+                    .collect();
+                pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+                series.push(Series {
+                    color: Some(i),
+                    ..Series::points(format!("measured, dp = {} bar", bar(dp)), pts)
+                });
+                let model = grid
+                    .iter()
+                    .filter_map(|&t| {
+                        let p = PressurePoint {
+                            t_c: t,
+                            dp_pa: dp,
+                            dp_ab_pa: 0.0,
+                        };
+                        pressure_residuals(core, &[p]).map(|r| (t, r[0] * 1e-5))
+                    })
+                    .collect();
+                series.push(Series {
+                    color: Some(i),
+                    ..Series::line(format!("fitted, dp = {} bar", bar(dp)), model)
+                });
+            }
+        } else {
+            // Too many drops for one curve each: residuals against temperature.
+            series.push(Series::points(
+                "residual (model - measured)",
+                pressure
+                    .iter()
+                    .zip(&self.pressure.fit.residuals)
+                    .map(|(p, r)| (p.t_c, r * 1e-5))
+                    .collect(),
+            ));
+        }
+        let mut panels = vec![Panel {
+            y_desc: if many {
+                "residual p_b - p_a [bar]".into()
+            } else {
+                "p_b - p_a [bar]".into()
+            },
+            log_y: false,
+            legend: true,
+            series,
+        }];
+        if let Some(data) = displacement {
+            let mut pts: Vec<(f64, f64)> = data.iter().map(|p| (p.t_c, p.x_m * 1e3)).collect();
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let model = grid
+                .iter()
+                .filter_map(|&t| model_displacement(core, t, None).map(|x| (t, x * 1e3)))
+                .collect();
+            panels.push(Panel {
+                y_desc: "x [mm]".into(),
+                log_y: false,
+                legend: true,
+                series: vec![
+                    Series {
+                        color: Some(0),
+                        ..Series::points("measured", pts)
+                    },
+                    Series {
+                        color: Some(0),
+                        ..Series::line(format!("fitted, dp = {} bar", bar(core.pressure_drop)), model)
+                    },
+                ],
+            });
+        }
+        Figure {
+            title: "Calibration: measured data and the fitted model".into(),
+            x_desc: "temperature [C]".into(),
+            panels,
+        }
+    }
+}
+
+/// A drop [Pa] in bar for a legend, without representation noise (`6`, not
+/// `6.000000000000001`).
+fn bar(dp: f64) -> String {
+    let s = format!("{:.4}", dp * 1e-5);
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// Reads a data file given to `flag` (bounded like a parameter file), or
+/// the built-in text `builtin` without a path.
+fn data_text(path: Option<&Path>, flag: &str, builtin: &str) -> Result<String, CliError> {
+    match path {
+        Some(p) => crate::input::params_text(p, flag),
+        None => Ok(builtin.to_string()),
+    }
+}
+
+/// Options of `calibrate`.
+#[derive(Debug, Clone, Default)]
+pub struct Options {
+    /// Base parameter file whose geometry and dynamics are kept (`None`:
+    /// the built-in `presets/model-example.toml`).
+    pub base: Option<PathBuf>,
+    /// Pressure data (`None`: the built-in paper Table 1, and its Table 2
+    /// as displacement data unless `displacement` is given).
+    pub pressure: Option<PathBuf>,
+    /// Displacement data.
+    pub displacement: Option<PathBuf>,
+    /// Where to write the calibrated parameter file.
+    pub write_preset: Option<PathBuf>,
+    /// Where to draw the data against the fitted curves (SVG).
+    pub plot: Option<PathBuf>,
+}
+
+/// What `calibrate` prints: the report table (standard output) and the
+/// summary and warnings (standard error).
+#[derive(Debug, Clone)]
+pub struct Output {
+    /// The report table, CSV.
+    pub table: String,
+    /// Lines for standard error.
+    pub notes: Vec<String>,
+}
+
+/// `calibrate`: fits, writes the preset and the figure if asked, and
+/// returns the report (see [`Calibration::table`]).
+///
+/// Errors: bad data or base file (exit 2, naming the file, row and
+/// column), data that cannot determine the parameters (exit 2, naming
+/// them), a fit that does not converge (exit 1).
+pub fn calibrate(opts: &Options) -> Result<Output, CliError> {
+    if opts.pressure.is_none() && opts.displacement.is_some() {
+        return Err(CliError::Input(
+            "--displacement-data: needs --pressure-data (the displacement fit runs at the oil the pressure data \
+             give; without --pressure-data the paper's two tables are used together)"
+                .into(),
+        ));
+    }
+    let base = match &opts.base {
         Some(path) => crate::input::load_raw(path, "--base")?,
         None => params_file::parse(crate::input::MODEL_EXAMPLE)?,
     };
-    let (t1, t2) = load_tables(data).map_err(CliError::Input)?;
-    let cal = fit(&base, &t1, &t2).map_err(CliError::Failed)?;
-    let base_path = base_path.unwrap_or(Path::new("presets/model-example.toml"));
-    let data = data.unwrap_or(Path::new("data/paper"));
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "# Paper preset: {} with the oil, capillary length, spring rate and",
-        base_path.display()
+    let shown = |p: &Option<PathBuf>, d: &str| p.as_ref().map_or(d.to_string(), |p| p.display().to_string());
+    let p_name = shown(&opts.pressure, crate::input::PAPER_PRESSURE_PATH);
+    let pressure = read_pressure(&data_text(
+        opts.pressure.as_deref(),
+        "--pressure-data",
+        crate::input::PAPER_PRESSURE_CSV,
+    )?)
+    .map_err(|e| CliError::Input(format!("--pressure-data: {p_name}: {e}")))?;
+    let displacement_path = match (&opts.pressure, &opts.displacement) {
+        (Some(_), Some(p)) => Some(Some(p.clone())),
+        (None, _) => Some(None),
+        (Some(_), None) => None,
+    };
+    let displacement = match &displacement_path {
+        Some(path) => {
+            let name = shown(path, crate::input::PAPER_DISPLACEMENT_PATH);
+            let text = data_text(
+                path.as_deref(),
+                "--displacement-data",
+                crate::input::PAPER_DISPLACEMENT_CSV,
+            )?;
+            Some(read_displacement(&text).map_err(|e| CliError::Input(format!("--displacement-data: {name}: {e}")))?)
+        }
+        None => None,
+    };
+    let cal = fit(&base, &pressure, displacement.as_deref())?;
+    let mut command = format!(
+        "compensator calibrate --base {} --pressure-data {p_name}",
+        shown(&opts.base, "presets/model-example.toml")
     );
-    let _ = writeln!(
-        out,
-        "# preload fitted to the paper's Tables 1 and 2 ({}).",
-        data.display()
-    );
-    let _ = writeln!(
-        out,
-        "# Generated by: compensator calibrate --base {} --data {}",
-        base_path.display(),
-        data.display()
-    );
-    let _ = writeln!(
-        out,
-        "# Table 1: RMS {:.4} bar, max {:.4} bar over {} points. Table 2 (x_QS): RMS {:.4} mm, max {:.4} mm.",
-        cal.table1.rms(),
-        cal.table1.max_abs(),
-        cal.table1.residuals.len(),
-        cal.table2.rms(),
-        cal.table2.max_abs()
-    );
-    out.push('\n');
-    out.push_str(&params_file::to_toml(&cal.params));
-    Ok(out)
+    if let Some(path) = &displacement_path {
+        let _ = write!(
+            command,
+            " --displacement-data {}",
+            shown(path, crate::input::PAPER_DISPLACEMENT_PATH)
+        );
+    }
+    if let Some(path) = &opts.write_preset {
+        std::fs::write(path, cal.preset(&command))
+            .map_err(|e| CliError::Input(format!("--write-preset: {}: {e}", path.display())))?;
+    }
+    if let Some(path) = &opts.plot {
+        crate::plot::write(path, &cal.figure(&pressure, displacement.as_deref()))?;
+    }
+    let mut notes = cal.summary();
+    notes.extend(cal.warnings.iter().map(|w| format!("WARNING: {w}")));
+    Ok(Output {
+        table: cal.table(),
+        notes,
+    })
 }

@@ -3,10 +3,37 @@
 
 /// A CSV table built in memory and printed only when complete, so that a
 /// failure half-way leaves standard output empty.
+///
+/// A row that could not be computed ([`Table::row_error`]) keeps its
+/// leading cells (the temperature, say), leaves the others empty and says
+/// why in a last column `error`, which the table gains with its first
+/// such row (a table without failures has no `error` column).
 #[derive(Debug, Default, Clone)]
 pub struct Table {
     text: String,
     columns: usize,
+    has_error: bool,
+}
+
+/// Name of the column that says why a row could not be computed.
+pub const ERROR_COLUMN: &str = "error";
+
+/// `message` as one CSV cell: commas become semicolons and line breaks
+/// spaces, so that the cell needs no quoting; never empty.
+pub fn error_cell(message: &str) -> String {
+    let cell: String = message
+        .chars()
+        .map(|c| match c {
+            ',' => ';',
+            '\n' | '\r' => ' ',
+            c => c,
+        })
+        .collect();
+    if cell.trim().is_empty() {
+        "failed".to_string()
+    } else {
+        cell.trim().to_string()
+    }
 }
 
 impl Table {
@@ -15,6 +42,7 @@ impl Table {
         let mut t = Table {
             text: String::new(),
             columns: header.len(),
+            has_error: false,
         };
         t.text.push_str(&header.join(","));
         t.text.push('\n');
@@ -30,7 +58,49 @@ impl Table {
             }
             self.text.push_str(&number(*v));
         }
+        if self.has_error {
+            self.text.push(',');
+        }
         self.text.push('\n');
+    }
+
+    /// Appends a row of cells already formatted (numbers as `{}` of `f64`,
+    /// `true`/`false`, text without commas); panics in debug builds on a
+    /// wrong width.
+    pub fn row_cells(&mut self, cells: &[String]) {
+        debug_assert_eq!(cells.len(), self.columns);
+        self.text.push_str(&cells.join(","));
+        if self.has_error {
+            self.text.push(',');
+        }
+        self.text.push('\n');
+    }
+
+    /// Appends a row that could not be computed: its first cells `leading`
+    /// (e.g. the temperature), empty cells for the rest, and `message` in
+    /// the `error` column (added to the header and to the rows so far
+    /// with this first failure).
+    pub fn row_error(&mut self, leading: &[f64], message: &str) {
+        debug_assert!(leading.len() <= self.columns);
+        if !self.has_error {
+            self.has_error = true;
+            let mut text = String::with_capacity(self.text.len() + 16);
+            for (i, line) in self.text.lines().enumerate() {
+                text.push_str(line);
+                text.push_str(if i == 0 { ",error\n" } else { ",\n" });
+            }
+            self.text = text;
+        }
+        let mut cells: Vec<String> = leading.iter().map(|v| format!("{v}")).collect();
+        cells.resize(self.columns, String::new());
+        cells.push(error_cell(message));
+        self.text.push_str(&cells.join(","));
+        self.text.push('\n');
+    }
+
+    /// Whether some row could not be computed.
+    pub fn has_errors(&self) -> bool {
+        self.has_error
     }
 
     /// The CSV text.
@@ -49,39 +119,132 @@ pub fn number(v: f64) -> String {
     if exp.len() < plain.len() { exp } else { plain }
 }
 
-/// Parses CSV text with a header row into (header, rows of numbers).
-/// Lines starting with `#` are comments.
-pub fn parse(text: &str) -> Result<(Vec<String>, Vec<Vec<f64>>), String> {
-    let mut lines = text
+/// A table of numbers read from a data file: its header and its rows, with
+/// each row's line number in the file (for error messages).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Numeric {
+    /// Column names, trimmed.
+    pub header: Vec<String>,
+    /// Rows of finite numbers, each as wide as the header.
+    pub rows: Vec<Vec<f64>>,
+    /// Line of each row in the file (1-based).
+    pub lines: Vec<u64>,
+}
+
+impl Numeric {
+    /// Index of column `name`, if present.
+    pub fn column(&self, name: &str) -> Option<usize> {
+        self.header.iter().position(|h| h == name)
+    }
+}
+
+/// The field separator of a data file: `;` or a tab when its header line
+/// (the first line that is neither blank nor a `#` comment) has one and no
+/// comma, else `,`.
+fn detect_delimiter(text: &str) -> u8 {
+    let header = text
         .lines()
-        .filter(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-    let header: Vec<String> = lines
-        .next()
-        .ok_or("empty CSV")?
-        .split(',')
-        .map(|s| s.trim().to_string())
+        .find(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
+        .unwrap_or("");
+    if header.contains(',') {
+        b','
+    } else if header.contains(';') {
+        b';'
+    } else if header.contains('\t') {
+        b'\t'
+    } else {
+        b','
+    }
+}
+
+/// Reads a data file's text (as a spreadsheet exports it) into numbers,
+/// with the `csv` crate: a UTF-8 byte-order mark is skipped, the separator
+/// is detected (`,`, `;` or tab, [`detect_delimiter`]), cells may be quoted
+/// and padded with spaces, lines starting with `#` are comments, blank
+/// lines are skipped. With `;` or tab separators a decimal comma (`0,5`) is
+/// read as a decimal point, as such spreadsheets write it.
+///
+/// Errors (one line each): an empty file, a row whose width differs from
+/// the header's, a cell that is not a finite number; a cell's error names
+/// its data row (1-based, the header not counted), its line in the file
+/// and its column by name.
+pub fn read_numeric(text: &str) -> Result<Numeric, String> {
+    read(text, true)
+}
+
+/// [`read_numeric`], accepting `NaN` and infinities unless `finite_only`.
+fn read(text: &str, finite_only: bool) -> Result<Numeric, String> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let delimiter = detect_delimiter(text);
+    let mut reader = ::csv::ReaderBuilder::new()
+        .delimiter(delimiter)
+        .comment(Some(b'#'))
+        .trim(::csv::Trim::All)
+        .flexible(true)
+        .has_headers(true)
+        .from_reader(text.as_bytes());
+    let header: Vec<String> = reader
+        .headers()
+        .map_err(|e| format!("header: {e}"))?
+        .iter()
+        .map(str::to_string)
         .collect();
-    let mut rows = Vec::new();
-    for (i, line) in lines.enumerate() {
-        let row: Vec<f64> = line
-            .split(',')
-            .map(|s| {
-                s.trim()
-                    .parse::<f64>()
-                    .map_err(|_| format!("row {}: '{}' is not a number", i + 1, s.trim()))
-            })
-            .collect::<Result<_, _>>()?;
-        if row.len() != header.len() {
+    if header.iter().all(String::is_empty) {
+        return Err("empty file: no header row".into());
+    }
+    let mut out = Numeric {
+        header,
+        rows: Vec::new(),
+        lines: Vec::new(),
+    };
+    for (i, record) in reader.records().enumerate() {
+        let row_no = i + 1;
+        let record = record.map_err(|e| format!("row {row_no}: {e}"))?;
+        let line = record.position().map_or(0, |p| p.line());
+        if record.iter().all(str::is_empty) {
+            continue;
+        }
+        if record.len() != out.header.len() {
             return Err(format!(
-                "row {}: {} columns, header has {}",
-                i + 1,
-                row.len(),
-                header.len()
+                "row {row_no} (line {line}): {} cells, the header has {} columns",
+                record.len(),
+                out.header.len()
             ));
         }
-        rows.push(row);
+        let row = record
+            .iter()
+            .zip(&out.header)
+            .map(|(cell, name)| {
+                let parsed = cell.parse::<f64>().or_else(|e| {
+                    if delimiter != b',' && cell.matches(',').count() == 1 && !cell.contains('.') {
+                        cell.replace(',', ".").parse::<f64>()
+                    } else {
+                        Err(e)
+                    }
+                });
+                match parsed {
+                    Ok(v) if v.is_finite() || !finite_only => Ok(v),
+                    Ok(_) => Err(format!(
+                        "row {row_no} (line {line}), column {name}: '{cell}' is not a finite number"
+                    )),
+                    Err(_) => Err(format!(
+                        "row {row_no} (line {line}), column {name}: '{cell}' is not a number"
+                    )),
+                }
+            })
+            .collect::<Result<Vec<f64>, String>>()?;
+        out.rows.push(row);
+        out.lines.push(line);
     }
-    Ok((header, rows))
+    Ok(out)
+}
+
+/// Parses CSV text with a header row into (header, rows of numbers), as
+/// [`read_numeric`] but accepting `NaN` and infinities (a command's own
+/// output may hold them).
+pub fn parse(text: &str) -> Result<(Vec<String>, Vec<Vec<f64>>), String> {
+    let t = read(text, false)?;
+    Ok((t.header, t.rows))
 }
 
 /// Output format of a table: the CSV itself, JSON (an array of one object
@@ -97,18 +260,21 @@ pub enum Format {
     Table,
 }
 
-/// Splits CSV text (as written by [`Table`]) into its header and rows of cells.
-fn cells(text: &str) -> (Vec<&str>, Vec<Vec<&str>>) {
+/// Splits CSV text (as written by [`Table`]: no quoted cells) into its
+/// header and rows of cells.
+pub fn cells(text: &str) -> (Vec<&str>, Vec<Vec<&str>>) {
     let mut lines = text.lines().filter(|l| !l.is_empty());
     let header = lines.next().map(|l| l.split(',').collect()).unwrap_or_default();
     (header, lines.map(|l| l.split(',').collect()).collect())
 }
 
 /// A cell as a JSON value: a finite number, `true`/`false`, `null` for a
-/// non-finite number (JSON has none), else a string.
+/// non-finite number (JSON has none) or an empty cell (a row that could not
+/// be computed, a parameter `identify` could not determine), else a string.
 fn json_value(cell: &str) -> serde_json::Value {
     use serde_json::Value;
     match cell {
+        "" => Value::Null,
         "true" => Value::Bool(true),
         "false" => Value::Bool(false),
         _ if !cell.is_empty() && cell.bytes().all(|b| b.is_ascii_digit() || b == b'-') => {
@@ -125,6 +291,20 @@ fn json_value_f64(cell: &str) -> serde_json::Value {
         Ok(v) => serde_json::Number::from_f64(v).map_or(Value::Null, Value::Number),
         Err(_) => Value::String(cell.to_string()),
     }
+}
+
+/// Rows of CSV text (as written by [`Table`]) whose `error` cell is not
+/// empty, and all rows: (failed, total).
+pub fn failed_rows(text: &str) -> (usize, usize) {
+    let (header, rows) = cells(text);
+    let Some(col) = header.iter().position(|h| *h == ERROR_COLUMN) else {
+        return (0, rows.len());
+    };
+    let failed = rows
+        .iter()
+        .filter(|r| r.get(col).is_some_and(|c| !c.is_empty()))
+        .count();
+    (failed, rows.len())
 }
 
 /// Renders CSV text with a header row in `format`.
@@ -197,5 +377,34 @@ mod tests {
             assert!(number(x).len() <= 24 && number(-x).len() <= 24, "{}", number(-x));
             x *= 13.7;
         }
+    }
+
+    #[test]
+    fn reads_what_spreadsheets_write() {
+        let plain = read_numeric("t_c,x_m\n30,0.5\n40,0.75\n").unwrap();
+        assert_eq!(plain.rows, [[30.0, 0.5], [40.0, 0.75]]);
+        assert_eq!(plain.lines, [2, 3]);
+        // BOM, `;`, quotes, padding, decimal commas, CRLF, comments, blank lines.
+        let sheet =
+            read_numeric("\u{feff}# exported\r\n\"t_c\";\"x_m\"\r\n\r\n\"30\"; 0,5\r\n 40 ;\"0,75\"\r\n").unwrap();
+        assert_eq!(sheet.header, plain.header);
+        assert_eq!(sheet.rows, plain.rows);
+        let tabs = read_numeric("t_c\tx_m\n30\t0.5\n40\t0,75\n").unwrap();
+        assert_eq!(tabs.rows, plain.rows);
+        // With `,` separators a decimal comma is a column break, so a bad row.
+        let e = read_numeric("t_c,x_m\n30,0,5\n").unwrap_err();
+        assert!(e.contains("row 1 (line 2): 3 cells"), "{e}");
+    }
+
+    #[test]
+    fn errors_name_row_line_and_column() {
+        let e = read_numeric("# c\nt_c,x_m\n30,0.5\n40,x\n").unwrap_err();
+        assert_eq!(e, "row 2 (line 4), column x_m: 'x' is not a number");
+        let e = read_numeric("t_c,x_m\n30,inf\n").unwrap_err();
+        assert!(e.contains("column x_m: 'inf' is not a finite number"), "{e}");
+        assert!(read_numeric("").unwrap_err().contains("empty file"));
+        // The command's own output may hold NaN: `parse` keeps it.
+        let (_, rows) = parse("a\nNaN\n").unwrap();
+        assert!(rows[0][0].is_nan());
     }
 }

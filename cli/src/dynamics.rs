@@ -378,6 +378,14 @@ pub fn twin_config(path: &Path, dt: f64) -> Result<String, CliError> {
 pub fn eigen(path: &Path, temps_spec: &str) -> Result<String, CliError> {
     let temps = temps::parse(temps_spec)?;
     let (_, p) = load_params::<f64>(path)?;
+    Ok(eigen_table(&p, &temps).as_str().to_string())
+}
+
+/// The `eigen` table of a parameter set at `temps` [C]: eigenvalues
+/// [1/s] of the linearisation (Eq. 37), the dominant pair's damping ratio
+/// and natural frequency [rad/s]; a temperature the model cannot evaluate
+/// gets an `error` cell.
+pub fn eigen_table(p: &Params<f64>, temps: &[f64]) -> Table {
     let mut table = Table::new(&[
         "t_c",
         "re_1",
@@ -391,8 +399,14 @@ pub fn eigen(path: &Path, temps_spec: &str) -> Result<String, CliError> {
         "zeta_dominant",
         "omega_n_dominant",
     ]);
-    for &t in &temps {
-        let l = linearise(&p, t).map_err(|e| crate::error::at_temperature(t, e))?;
+    for &t in temps {
+        let l = match linearise(p, t) {
+            Ok(l) => l,
+            Err(e) => {
+                table.row_error(&[t], &e.to_string());
+                continue;
+            }
+        };
         let mut row = vec![t];
         for e in &l.eigenvalues {
             row.push(e.re);
@@ -402,7 +416,7 @@ pub fn eigen(path: &Path, temps_spec: &str) -> Result<String, CliError> {
         row.push(l.natural_frequency[0]);
         table.row(&row);
     }
-    Ok(table.as_str().to_string())
+    table
 }
 
 /// Step-response indicators (Table 3).
@@ -503,7 +517,13 @@ pub fn indicators(path: &Path, steps_spec: &str, dt: f64, t_end: f64) -> Result<
         "dominant_re",
     ]);
     for (from, to) in steps {
-        let ind = step_indicators(&raw, &p, from, to, dt, t_end)?;
+        let ind = match step_indicators(&raw, &p, from, to, dt, t_end) {
+            Ok(ind) => ind,
+            Err(e) => {
+                table.row_error(&[from, to], &e.to_string());
+                continue;
+            }
+        };
         table.row(&[
             ind.from,
             ind.to,

@@ -1,10 +1,11 @@
 //! A command's failure and the exit status it maps to, with the helpers
-//! every command uses to turn bad input into one: loading a parameter file
-//! and a model error at a listed temperature.
+//! every command uses to turn bad input into one: loading a parameter file.
+//! (A temperature the model cannot evaluate is not bad input: the tables
+//! give its row an `error` cell, `crate::csv::Table::row_error`.)
 
 use crate::params_file::LoadError;
 use crate::temps;
-use compensator::{Float, ModelError, Params, RawParams};
+use compensator::{Float, Params, RawParams};
 use std::fmt;
 use std::path::Path;
 
@@ -53,9 +54,4 @@ pub fn load_params<T: Float>(path: &Path) -> Result<(RawParams, Params<T>), CliE
     let raw = crate::input::load_raw(path, "--params")?;
     let params = Params::<T>::new(&raw).map_err(|e| CliError::Input(e.to_string()))?;
     Ok((raw, params))
-}
-
-/// A model error at a given temperature is bad input (the temperature).
-pub fn at_temperature(t: f64, e: ModelError) -> CliError {
-    CliError::Input(format!("--temps: {t} C: {e}"))
 }

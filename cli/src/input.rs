@@ -19,6 +19,17 @@ pub const MODEL_EXAMPLE: &str = include_str!("../../presets/model-example.toml")
 pub const TABLE1_CSV: &str = include_str!("../../data/paper/table1.csv");
 /// `data/paper/table2.csv`, built in.
 pub const TABLE2_CSV: &str = include_str!("../../data/paper/table2.csv");
+/// `data/paper/table3.csv`, built in.
+pub const TABLE3_CSV: &str = include_str!("../../data/paper/table3.csv");
+/// Where [`PAPER_PRESSURE_CSV`] lives in the repository.
+pub const PAPER_PRESSURE_PATH: &str = "data/calibration/paper-pressure.csv";
+/// The paper's Table 1 in the long form of `calibrate --pressure-data`, built in.
+pub const PAPER_PRESSURE_CSV: &str = include_str!("../../data/calibration/paper-pressure.csv");
+/// Where [`PAPER_DISPLACEMENT_CSV`] lives in the repository.
+pub const PAPER_DISPLACEMENT_PATH: &str = "data/calibration/paper-displacement.csv";
+/// The paper's Table 2 (quasi-static column) in the long form of
+/// `calibrate --displacement-data`, built in.
+pub const PAPER_DISPLACEMENT_CSV: &str = include_str!("../../data/calibration/paper-displacement.csv");
 
 /// Reads at most `MAX_PARAMS_BYTES` from `r`; more is bad input of `flag`.
 fn read_bounded(r: impl Read, flag: &str, what: &str) -> Result<String, CliError> {

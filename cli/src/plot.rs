@@ -1,15 +1,19 @@
-//! `--plot FILE.svg`: a figure of what a command printed, drawn with
-//! `plotters`' SVG backend (no system libraries: the viewer draws the text).
+//! `--plot FILE.svg|FILE.png`: a figure of what a command printed, drawn
+//! with `plotters`: SVG (the viewer draws the text) or PNG (plotters'
+//! bitmap backend into memory, the text rasterised by `ab_glyph` from
+//! DejaVu Sans, built into the binary by the `dejavu` crate, encoded by
+//! the `png` crate). Neither needs a system library.
 //!
 //! A figure is built from the command's CSV output (the SI columns of its
 //! header), so the plots show exactly the numbers the command printed, in
-//! readable units (mm, bar, L/min). A figure is one or more panels stacked
-//! over a shared x axis, each with its quantity and unit and a legend.
-//! Only `.svg` is written: PNG would need plotters' bitmap backend and a
-//! font library, so `.png` is refused naming `--plot` (exit status 2).
+//! the units of `--units` (SI: m, Pa, m^3/s; eng: mm, bar, L/min). A figure
+//! is one or more panels stacked over a shared x axis, each with its
+//! quantity and unit and a legend. Rows that could not be computed (an
+//! `error` column) are left out of the curves.
 
 use crate::csv;
 use crate::error::CliError;
+use crate::units::{Scale, Units};
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
@@ -18,7 +22,8 @@ use std::path::{Path, PathBuf};
 /// One curve of a panel.
 #[derive(Clone, Debug)]
 pub struct Series {
-    /// Legend text.
+    /// Legend text (empty: no legend entry, e.g. the second of two
+    /// series that share one).
     pub label: String,
     /// Points (x, y); non-finite ones are skipped.
     pub points: Vec<(f64, f64)>,
@@ -26,6 +31,37 @@ pub struct Series {
     pub dashed: bool,
     /// Marks at the points (for coarse tables, e.g. one row per 10 C).
     pub marks: bool,
+    /// Joined by a line (off: marks only, e.g. published data points).
+    pub line: bool,
+    /// Colour index (default: the series' place in its panel), so that a
+    /// curve and its data points can share one.
+    pub color: Option<usize>,
+}
+
+impl Series {
+    /// A solid line through `points`, without marks.
+    pub fn line(label: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+        Series {
+            label: label.into(),
+            points,
+            dashed: false,
+            marks: false,
+            line: true,
+            color: None,
+        }
+    }
+
+    /// Marks at `points` without a line (published data).
+    pub fn points(label: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+        Series {
+            label: label.into(),
+            points,
+            dashed: false,
+            marks: true,
+            line: false,
+            color: None,
+        }
+    }
 }
 
 /// One panel: a y quantity over the figure's x axis.
@@ -52,16 +88,32 @@ pub struct Figure {
     pub panels: Vec<Panel>,
 }
 
-/// The `--plot` argument's parser: a path ending in `.svg`. Anything else is
-/// refused by clap as an invalid value for `--plot` (exit status 2).
+/// File format of a figure, from its name.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum FileFormat {
+    /// Scalable vector graphics.
+    Svg,
+    /// Portable network graphics (a bitmap).
+    Png,
+}
+
+/// The format of a figure file by its extension (case-insensitive).
+pub fn file_format(path: &Path) -> Option<FileFormat> {
+    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase) {
+        Some(e) if e == "svg" => Some(FileFormat::Svg),
+        Some(e) if e == "png" => Some(FileFormat::Png),
+        _ => None,
+    }
+}
+
+/// The `--plot` argument's parser: a path ending in `.svg` or `.png`.
+/// Anything else is refused by clap as an invalid value for `--plot` (exit
+/// status 2).
 pub fn parse_path(s: &str) -> Result<PathBuf, String> {
     let path = PathBuf::from(s);
-    match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase) {
-        Some(e) if e == "svg" => Ok(path),
-        Some(e) if e == "png" => Err("PNG is not supported (it would need system font libraries); \
-             write FILE.svg and convert it if needed"
-            .to_string()),
-        _ => Err("the figure file must end in .svg".to_string()),
+    match file_format(&path) {
+        Some(_) => Ok(path),
+        None => Err("the figure file must end in .svg or .png".to_string()),
     }
 }
 
@@ -74,9 +126,28 @@ const COLORS: [RGBColor; 6] = [
     RGBColor(23, 190, 207),
 ];
 
-/// Width of the figure [px]; each panel is `PANEL_HEIGHT` high.
+/// Width of the figure [px]; each panel is `PANEL_HEIGHT` high (a figure
+/// of one panel `SINGLE_PANEL_HEIGHT`).
 const WIDTH: u32 = 900;
 const PANEL_HEIGHT: u32 = 300;
+const SINGLE_PANEL_HEIGHT: u32 = 460;
+
+/// Height of a panel of `fig` [px].
+fn panel_height(fig: &Figure) -> u32 {
+    if fig.panels.len() == 1 {
+        SINGLE_PANEL_HEIGHT
+    } else {
+        PANEL_HEIGHT
+    }
+}
+
+/// The legend's height as a fraction of a panel's plotting area `height`
+/// [px] high: about 23 px a labelled series and a margin.
+fn legend_height(panel: &Panel, height: u32) -> f64 {
+    let lines = panel.series.iter().filter(|s| !s.label.is_empty()).count() as f64;
+    let per_line = 23.0 / (height as f64 - 70.0).max(100.0);
+    0.06 + per_line * lines
+}
 
 fn finite(points: &[(f64, f64)], log_y: bool) -> Vec<(f64, f64)> {
     points
@@ -145,8 +216,7 @@ fn padded(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
 
 /// The corner of the panel where the legend hides the fewest points (in
 /// the panel's fractions: the legend is about 40 % wide, 10 % high per line).
-fn legend_corner(panel: &Panel, x: (f64, f64), y: (f64, f64)) -> (SeriesLabelPosition, usize) {
-    let h = 0.06 + 0.1 * panel.series.len() as f64;
+fn legend_corner(panel: &Panel, h: f64, x: (f64, f64), y: (f64, f64)) -> (SeriesLabelPosition, usize) {
     let fy = |v: f64| if panel.log_y { v.ln() } else { v };
     let corners = [
         (SeriesLabelPosition::UpperRight, 0.6, 1.0 - h),
@@ -170,15 +240,28 @@ fn legend_corner(panel: &Panel, x: (f64, f64), y: (f64, f64)) -> (SeriesLabelPos
     (best.0.clone(), hidden(best))
 }
 
-/// A tick label: integers without a fraction, others to six decimals at
-/// most, large magnitudes in scientific notation.
-fn tick(v: &f64) -> String {
-    let v = *v;
-    if v == 0.0 {
-        "0".into()
-    } else if v.abs() >= 1e6 || v.abs() < 1e-4 {
-        format!("{v:.0e}")
-    } else if v.fract() == 0.0 {
+/// A tick label on an axis spanning `[lo, hi]`: zero as `0` (a tick
+/// computed as a multiple of the step lands a rounding error away from
+/// it); on an axis whose largest magnitude is below 1e-3 or from 1e6 on,
+/// every tick in scientific notation with up to three significant digits
+/// (1.5e-5, not 2e-5); otherwise integers without a fraction and other
+/// values to six decimals at most.
+fn tick(v: f64, lo: f64, hi: f64) -> String {
+    let span = (hi - lo).abs();
+    if v == 0.0 || v.abs() <= 1e-9 * span {
+        return "0".into();
+    }
+    let mag = lo.abs().max(hi.abs());
+    if !(1e-3..1e6).contains(&mag) {
+        let s = format!("{v:.2e}");
+        return match s.split_once('e') {
+            Some((m, e)) if m.contains('.') => {
+                format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.'))
+            }
+            _ => s,
+        };
+    }
+    if v.fract() == 0.0 {
         format!("{v:.0}")
     } else {
         format!("{}", (v * 1e6).round() / 1e6)
@@ -187,16 +270,17 @@ fn tick(v: &f64) -> String {
 
 type DrawResult<T> = Result<T, Box<dyn std::error::Error>>;
 
-fn draw_panel<'a, Y>(
-    area: &DrawingArea<SVGBackend<'a>, Shift>,
+fn draw_panel<DB: DrawingBackend, Y>(
+    area: &DrawingArea<DB, Shift>,
     x_range: (f64, f64),
     y_range: Y,
+    y_bounds: (f64, f64),
     legend: SeriesLabelPosition,
-    zero_inside: bool,
     x_desc: &str,
     panel: &Panel,
 ) -> DrawResult<()>
 where
+    DB::ErrorType: 'static,
     Y: AsRangedCoord<Value = f64>,
     Y::CoordDescType: ValueFormatter<f64>,
 {
@@ -207,8 +291,8 @@ where
         .build_cartesian_2d(x_range.0..x_range.1, y_range)?;
     chart
         .configure_mesh()
-        .x_label_formatter(&tick)
-        .y_label_formatter(&tick)
+        .x_label_formatter(&|v: &f64| tick(*v, x_range.0, x_range.1))
+        .y_label_formatter(&|v: &f64| tick(*v, y_bounds.0, y_bounds.1))
         .x_desc(x_desc)
         .y_desc(panel.y_desc.as_str())
         .axis_desc_style(("sans-serif", 16))
@@ -216,7 +300,8 @@ where
         .light_line_style(WHITE.mix(0.0))
         .bold_line_style(BLACK.mix(0.12))
         .draw()?;
-    if !panel.log_y && zero_inside {
+    // A zero line where a linear panel spans 0.
+    if !panel.log_y && y_bounds.0 < 0.0 && y_bounds.1 > 0.0 {
         let (x0, x1) = x_range;
         chart.draw_series(std::iter::once(PathElement::new(
             vec![(x0, 0.0), (x1, 0.0)],
@@ -224,15 +309,29 @@ where
         )))?;
     }
     for (i, s) in panel.series.iter().enumerate() {
-        let color = COLORS[i % COLORS.len()];
+        let color = COLORS[s.color.unwrap_or(i) % COLORS.len()];
         let style = color.stroke_width(2);
         let points = thin(finite(&s.points, panel.log_y));
+        if !s.line {
+            let anno = chart.draw_series(points.iter().map(|&p| Circle::new(p, 4, color.stroke_width(2))))?;
+            if !s.label.is_empty() {
+                anno.label(s.label.as_str())
+                    .legend(move |(x, y)| Circle::new((x + 10, y), 4, color.stroke_width(2)));
+            }
+            continue;
+        }
+        if s.marks {
+            chart.draw_series(points.iter().map(|&p| Circle::new(p, 3, color.filled())))?;
+        }
         let anno = if s.dashed {
             chart.draw_series(DashedLineSeries::new(points.clone(), 8, 5, style))?
         } else {
             chart.draw_series(LineSeries::new(points.clone(), style))?
         };
         let dashed = s.dashed;
+        if s.label.is_empty() {
+            continue;
+        }
         anno.label(s.label.as_str()).legend(move |(x, y)| {
             if dashed {
                 PathElement::new(vec![(x, y), (x + 8, y)], style)
@@ -240,9 +339,6 @@ where
                 PathElement::new(vec![(x, y), (x + 20, y)], style)
             }
         });
-        if s.marks {
-            chart.draw_series(points.iter().map(|&p| Circle::new(p, 3, color.filled())))?;
-        }
     }
     if !panel.legend {
         return Ok(());
@@ -257,9 +353,60 @@ where
     Ok(())
 }
 
-fn draw(path: &Path, fig: &Figure) -> DrawResult<()> {
+/// Size of `fig` in pixels.
+fn size(fig: &Figure) -> (u32, u32) {
     let n = fig.panels.len().max(1) as u32;
-    let root = SVGBackend::new(path, (WIDTH, n * PANEL_HEIGHT + 40)).into_drawing_area();
+    (WIDTH, n * panel_height(fig) + 40)
+}
+
+/// Registers DejaVu Sans (built in) as the `sans-serif` family for the
+/// text's layout and rasterisation, once.
+fn register_font() -> DrawResult<()> {
+    static REGISTERED: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    let ok = *REGISTERED.get_or_init(|| {
+        plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular()).is_ok()
+    });
+    if ok {
+        Ok(())
+    } else {
+        Err("the built-in font DejaVu Sans could not be loaded".into())
+    }
+}
+
+fn draw(path: &Path, fig: &Figure) -> DrawResult<()> {
+    register_font()?;
+    match file_format(path) {
+        Some(FileFormat::Png) => {
+            let (w, h) = size(fig);
+            let mut rgb = vec![0u8; w as usize * h as usize * 3];
+            {
+                let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
+                draw_on(root, fig)?;
+            }
+            let file = std::io::BufWriter::new(std::fs::File::create(path)?);
+            let mut encoder = png::Encoder::new(file, w, h);
+            encoder.set_color(png::ColorType::Rgb);
+            encoder.set_depth(png::BitDepth::Eight);
+            // Adaptive filtering and the best compression: a three-panel
+            // figure takes about a third of the bytes of the defaults.
+            encoder.set_adaptive_filter(png::AdaptiveFilterType::Adaptive);
+            encoder.set_compression(png::Compression::Best);
+            let mut writer = encoder.write_header()?;
+            writer.write_image_data(&rgb)?;
+            writer.finish()?;
+            Ok(())
+        }
+        _ => {
+            let root = SVGBackend::new(path, size(fig)).into_drawing_area();
+            draw_on(root, fig)
+        }
+    }
+}
+
+fn draw_on<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, fig: &Figure) -> DrawResult<()>
+where
+    DB::ErrorType: 'static,
+{
     root.fill(&WHITE)?;
     let root = root.titled(&fig.title, ("sans-serif", 20))?;
     let areas = root.split_evenly((fig.panels.len().max(1), 1));
@@ -280,31 +427,40 @@ fn draw(path: &Path, fig: &Figure) -> DrawResult<()> {
                 .map(|p| p.1)
         };
         let (lo, mut hi) = padded(ys(), panel.log_y);
+        let h = legend_height(panel, panel_height(fig));
         if panel.log_y {
-            let (mut legend, hidden) = legend_corner(panel, x_range, (lo.ln(), hi.ln()));
+            let (mut legend, hidden) = legend_corner(panel, h, x_range, (lo.ln(), hi.ln()));
             if hidden > 0 && panel.legend {
-                let h = (0.06 + 0.1 * panel.series.len() as f64).min(0.6);
+                let h = h.min(0.6);
                 hi = (hi.ln() + (hi.ln() - lo.ln()) * (h + 0.04) / (1.0 - h - 0.04)).exp();
-                legend = legend_corner(panel, x_range, (lo.ln(), hi.ln())).0;
+                legend = legend_corner(panel, h, x_range, (lo.ln(), hi.ln())).0;
             }
-            draw_panel(area, x_range, (lo..hi).log_scale(), legend, false, &fig.x_desc, panel)?;
+            draw_panel(
+                area,
+                x_range,
+                (lo..hi).log_scale(),
+                (lo, hi),
+                legend,
+                &fig.x_desc,
+                panel,
+            )?;
         } else {
-            let (mut legend, hidden) = legend_corner(panel, x_range, (lo, hi));
+            let (mut legend, hidden) = legend_corner(panel, h, x_range, (lo, hi));
             if hidden > 0 && panel.legend {
                 // No free corner: headroom over the data for the legend.
-                let h = (0.06 + 0.1 * panel.series.len() as f64).min(0.6);
+                let h = h.min(0.6);
                 hi += (hi - lo) * (h + 0.04) / (1.0 - h - 0.04);
-                legend = legend_corner(panel, x_range, (lo, hi)).0;
+                legend = legend_corner(panel, h, x_range, (lo, hi)).0;
             }
-            draw_panel(area, x_range, lo..hi, legend, lo < 0.0 && hi > 0.0, &fig.x_desc, panel)?;
+            draw_panel(area, x_range, lo..hi, (lo, hi), legend, &fig.x_desc, panel)?;
         }
     }
     root.present()?;
     Ok(())
 }
 
-/// Writes `fig` to `path` (SVG). A file that cannot be written is bad input
-/// naming `--plot`.
+/// Writes `fig` to `path`: PNG if the name ends in `.png`, else SVG. A file
+/// that cannot be written is bad input naming `--plot`.
 pub fn write(path: &Path, fig: &Figure) -> Result<(), CliError> {
     draw(path, fig).map_err(|e| CliError::Input(format!("--plot: {}: {e}", path.display())))
 }
@@ -316,9 +472,30 @@ struct Columns {
 }
 
 impl Columns {
+    /// The numeric columns of a command's CSV output; the `error` column
+    /// is dropped and an empty cell (a row that could not be computed) is
+    /// NaN, which the curves skip.
     fn parse(text: &str) -> Result<Self, CliError> {
-        let (header, rows) = csv::parse(text).map_err(|e| CliError::Failed(format!("--plot: {e}")))?;
-        Ok(Columns { header, rows })
+        let (header, rows) = csv::cells(text);
+        let keep: Vec<usize> = (0..header.len()).filter(|&i| header[i] != csv::ERROR_COLUMN).collect();
+        let rows = rows
+            .iter()
+            .enumerate()
+            .map(|(r, row)| {
+                keep.iter()
+                    .map(|&i| match row.get(i).copied().unwrap_or("") {
+                        "" => Ok(f64::NAN),
+                        c => c
+                            .parse::<f64>()
+                            .map_err(|_| CliError::Failed(format!("--plot: row {}: '{c}' is not a number", r + 1))),
+                    })
+                    .collect::<Result<Vec<f64>, _>>()
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(Columns {
+            header: keep.iter().map(|&i| header[i].to_string()).collect(),
+            rows,
+        })
     }
 
     fn col(&self, name: &str) -> Result<Vec<f64>, CliError> {
@@ -330,26 +507,37 @@ impl Columns {
         Ok(self.rows.iter().map(|r| r[i]).collect())
     }
 
-    /// A series of column `y` scaled by `scale` over column `x`.
-    fn series(&self, x: &str, y: &str, scale: f64, label: &str) -> Result<Series, CliError> {
+    /// A series of column `y` (SI) in `scale` over column `x`.
+    fn series(&self, x: &str, y: &str, scale: Scale, label: &str) -> Result<Series, CliError> {
         let xs = self.col(x)?;
         let ys = self.col(y)?;
         Ok(Series {
             label: label.to_string(),
-            points: xs.into_iter().zip(ys).map(|(x, y)| (x, y * scale)).collect(),
+            points: xs.into_iter().zip(ys).map(|(x, y)| (x, scale.apply(y))).collect(),
             dashed: false,
             marks: self.rows.len() <= 30,
+            line: true,
+            color: None,
         })
     }
 }
 
-const MM: f64 = 1e3;
-const BAR: f64 = 1e-5;
-/// m^3/s to L/min.
-const L_MIN: f64 = 6e4;
+/// A quantity without conversion (C, 1/s, rad/s, -).
+const ONE: Scale = Scale {
+    mul: 1.0,
+    div: 1.0,
+    unit: "",
+};
+/// A quantity with its sign reversed.
+const MINUS_ONE: Scale = Scale {
+    mul: -1.0,
+    div: 1.0,
+    unit: "",
+};
 const TEMPERATURE: &str = "temperature [C]";
 
-fn panel(y_desc: &str, series: Vec<Series>) -> Panel {
+/// A linear panel with a legend.
+pub fn panel(y_desc: &str, series: Vec<Series>) -> Panel {
     Panel {
         y_desc: y_desc.to_string(),
         log_y: false,
@@ -358,27 +546,36 @@ fn panel(y_desc: &str, series: Vec<Series>) -> Panel {
     }
 }
 
+/// `quantity [unit]` for an axis.
+fn desc(quantity: &str, scale: Scale) -> String {
+    format!("{quantity} [{}]", scale.unit)
+}
+
 /// `equilibrium`: displacement, chamber pressures and flows over temperature.
-pub fn equilibrium(csv: &str) -> Result<Figure, CliError> {
+pub fn equilibrium(csv: &str, u: Units) -> Result<Figure, CliError> {
     let c = Columns::parse(csv)?;
+    let (len, pr, q) = (u.length(), u.pressure(), u.flow());
     Ok(Figure {
         title: "Quasi-static equilibrium".into(),
         x_desc: TEMPERATURE.into(),
         panels: vec![
-            panel("x [mm]", vec![c.series("t_c", "x_m", MM, "spool displacement x")?]),
             panel(
-                "p [bar]",
+                &desc("x", len),
+                vec![c.series("t_c", "x_m", len, "spool displacement x")?],
+            ),
+            panel(
+                &desc("p", pr),
                 vec![
-                    c.series("t_c", "p_a_pa", BAR, "chamber pressure p_a")?,
-                    c.series("t_c", "p_b_pa", BAR, "chamber pressure p_b")?,
+                    c.series("t_c", "p_a_pa", pr, "chamber pressure p_a")?,
+                    c.series("t_c", "p_b_pa", pr, "chamber pressure p_b")?,
                 ],
             ),
             panel(
-                "Q [L/min]",
+                &desc("Q", q),
                 vec![
-                    c.series("t_c", "q_total_m3s", L_MIN, "total flow Q_total")?,
-                    c.series("t_c", "q_throt_m3s", L_MIN, "throttle flow Q_throt")?,
-                    c.series("t_c", "q_branch_m3s", L_MIN, "branch flow Q_branch")?,
+                    c.series("t_c", "q_total_m3s", q, "total flow Q_total")?,
+                    c.series("t_c", "q_throt_m3s", q, "throttle flow Q_throt")?,
+                    c.series("t_c", "q_branch_m3s", q, "branch flow Q_branch")?,
                 ],
             ),
         ],
@@ -387,35 +584,45 @@ pub fn equilibrium(csv: &str) -> Result<Figure, CliError> {
 
 /// `asymptotic`: the series beside the quasi-static displacement, and their
 /// difference.
-pub fn asymptotic(csv: &str, order: usize) -> Result<Figure, CliError> {
+pub fn asymptotic(csv: &str, order: usize, u: Units) -> Result<Figure, CliError> {
     let c = Columns::parse(csv)?;
-    let qs = c.series("t_c", "x_qs_m", MM, "quasi-static x")?;
-    let mut asym = c.series("t_c", "x_asym_m", MM, &format!("asymptotic x, order {order}"))?;
+    let len = u.length();
+    let small = u.small_length();
+    let qs_si = c.series("t_c", "x_qs_m", ONE, "quasi-static x")?;
+    let asym_si = c.series("t_c", "x_asym_m", ONE, "")?;
+    let qs = c.series("t_c", "x_qs_m", len, "quasi-static x")?;
+    let mut asym = c.series("t_c", "x_asym_m", len, &format!("asymptotic x, order {order}"))?;
     asym.dashed = true;
     let diff = Series {
         label: format!("order-{order} series minus quasi-static"),
-        points: qs
+        points: qs_si
             .points
             .iter()
-            .zip(&asym.points)
-            .map(|(q, a)| (q.0, (a.1 - q.1) * 1e3))
+            .zip(&asym_si.points)
+            .map(|(q, a)| (q.0, small.apply(a.1 - q.1)))
             .collect(),
         dashed: false,
         marks: qs.marks,
+        line: true,
+        color: None,
     };
     Ok(Figure {
         title: format!("Asymptotic displacement (order {order}) and the quasi-static one"),
         x_desc: TEMPERATURE.into(),
-        panels: vec![panel("x [mm]", vec![qs, asym]), panel("error [um]", vec![diff])],
+        panels: vec![
+            panel(&desc("x", len), vec![qs, asym]),
+            panel(&desc("error", small), vec![diff]),
+        ],
     })
 }
 
 /// `step`: displacement, velocity and pressures over time; `overlay` (a
 /// second run's CSV and its name) is drawn dashed over each curve.
-pub fn step(csv: &str, name: &str, overlay: Option<(&str, &str)>, title: &str) -> Result<Figure, CliError> {
+pub fn step(csv: &str, name: &str, overlay: Option<(&str, &str)>, title: &str, u: Units) -> Result<Figure, CliError> {
     let runs: Vec<(Columns, &str, bool)> = std::iter::once(Ok((Columns::parse(csv)?, name, false)))
         .chain(overlay.map(|(o, n)| Columns::parse(o).map(|c| (c, n, true))))
         .collect::<Result<_, CliError>>()?;
+    let (len, vel, pr) = (u.length(), u.velocity(), u.pressure());
     let mut x = Vec::new();
     let mut v = Vec::new();
     let mut p = Vec::new();
@@ -425,10 +632,10 @@ pub fn step(csv: &str, name: &str, overlay: Option<(&str, &str)>, title: &str) -
             marks: false,
             ..s
         };
-        x.push(tag(c.series("time_s", "x_m", MM, &format!("x, {name}"))?));
-        v.push(tag(c.series("time_s", "v_m_s", MM, &format!("v, {name}"))?));
-        p.push(tag(c.series("time_s", "p_a_pa", BAR, &format!("p_a, {name}"))?));
-        p.push(tag(c.series("time_s", "p_b_pa", BAR, &format!("p_b, {name}"))?));
+        x.push(tag(c.series("time_s", "x_m", len, &format!("x, {name}"))?));
+        v.push(tag(c.series("time_s", "v_m_s", vel, &format!("v, {name}"))?));
+        p.push(tag(c.series("time_s", "p_a_pa", pr, &format!("p_a, {name}"))?));
+        p.push(tag(c.series("time_s", "p_b_pa", pr, &format!("p_b, {name}"))?));
     }
     // Pressures: p_a and p_b of a run in two colours, the overlay in the
     // same two colours; reorder so that colours pair up by quantity.
@@ -438,19 +645,24 @@ pub fn step(csv: &str, name: &str, overlay: Option<(&str, &str)>, title: &str) -
     Ok(Figure {
         title: title.to_string(),
         x_desc: "time [s]".into(),
-        panels: vec![panel("x [mm]", x), panel("v [mm/s]", v), panel("p [bar]", p)],
+        panels: vec![
+            panel(&desc("x", len), x),
+            panel(&desc("v", vel), v),
+            panel(&desc("p", pr), p),
+        ],
     })
 }
 
 /// `eigen`: the decay rates -Re(lambda) (log scale) and the oscillation
-/// frequencies Im(lambda) of the four eigenvalues over temperature.
+/// frequencies Im(lambda) of the four eigenvalues over temperature (no
+/// unit depends on `--units`).
 pub fn eigen(csv: &str) -> Result<Figure, CliError> {
     let c = Columns::parse(csv)?;
     let mut re = Vec::new();
     let mut im = Vec::new();
     for k in 1..=4 {
-        re.push(c.series("t_c", &format!("re_{k}"), -1.0, &format!("lambda_{k}"))?);
-        im.push(c.series("t_c", &format!("im_{k}"), 1.0, &format!("lambda_{k}"))?);
+        re.push(c.series("t_c", &format!("re_{k}"), MINUS_ONE, &format!("lambda_{k}"))?);
+        im.push(c.series("t_c", &format!("im_{k}"), ONE, &format!("lambda_{k}"))?);
     }
     Ok(Figure {
         title: "Eigenvalues of the linearisation at the equilibrium (colours as in the legend below)".into(),
@@ -465,7 +677,7 @@ pub fn eigen(csv: &str) -> Result<Figure, CliError> {
             panel("oscillation Im(lambda) [rad/s]", im),
             panel(
                 "damping ratio [-]",
-                vec![c.series("t_c", "zeta_dominant", 1.0, "zeta, dominant mode")?],
+                vec![c.series("t_c", "zeta_dominant", ONE, "zeta, dominant mode")?],
             ),
         ],
     })
@@ -473,28 +685,50 @@ pub fn eigen(csv: &str) -> Result<Figure, CliError> {
 
 /// `compensation`: demand against supply, the error, and the displacement
 /// against the one the demand needs.
-pub fn compensation(csv: &str) -> Result<Figure, CliError> {
+pub fn compensation(csv: &str, u: Units) -> Result<Figure, CliError> {
     let c = Columns::parse(csv)?;
-    let mut required = c.series("t_c", "required_x_m", MM, "x the demand requires")?;
+    let (len, q) = (u.length(), u.flow());
+    let mut required = c.series("t_c", "required_x_m", len, "x the demand requires")?;
     required.dashed = true;
-    let mut demand = c.series("t_c", "demand_m3s", L_MIN, "demand (leakage + machine)")?;
+    let mut demand = c.series("t_c", "demand_m3s", q, "demand (leakage + machine)")?;
     demand.dashed = true;
     Ok(Figure {
         title: "Compensation: flow supplied against the machine's demand".into(),
         x_desc: TEMPERATURE.into(),
         panels: vec![
             panel(
-                "Q [L/min]",
-                vec![c.series("t_c", "supply_m3s", L_MIN, "supply (total flow)")?, demand],
+                &desc("Q", q),
+                vec![c.series("t_c", "supply_m3s", q, "supply (total flow)")?, demand],
             ),
             panel(
-                "error [L/min]",
-                vec![c.series("t_c", "error_m3s", L_MIN, "supply minus demand")?],
+                &desc("error", q),
+                vec![c.series("t_c", "error_m3s", q, "supply minus demand")?],
             ),
             panel(
-                "x [mm]",
-                vec![c.series("t_c", "x_m", MM, "spool displacement x")?, required],
+                &desc("x", len),
+                vec![c.series("t_c", "x_m", len, "spool displacement x")?, required],
             ),
         ],
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::tick;
+
+    #[test]
+    fn tick_labels_read_as_their_axis() {
+        // A rounding error at zero is zero.
+        assert_eq!(tick(-3.39e-21, -2.5e-5, 1.7e-5), "0");
+        // One notation per axis: small quantities in scientific notation,
+        // three significant digits.
+        assert_eq!(tick(-1.5e-5, -2.5e-5, 1.7e-5), "-1.5e-5");
+        assert_eq!(tick(1.0e-4, 0.0, 1.5e-4), "1e-4");
+        assert_eq!(tick(1.25e-4, 0.0, 1.5e-4), "1.25e-4");
+        assert_eq!(tick(2.0e6, 0.0, 4.5e6), "2e6");
+        // Ordinary magnitudes in decimals.
+        assert_eq!(tick(0.0005, 0.0, 0.001), "0.0005");
+        assert_eq!(tick(40.0, 26.0, 80.0), "40");
+        assert_eq!(tick(2.5, 0.0, 5.0), "2.5");
+    }
 }

@@ -14,7 +14,7 @@
 //! error per temperature) and [`size`] (`size`: either fit, as TOML).
 
 use crate::csv::Table;
-use crate::error::{CliError, at_temperature, load_params};
+use crate::error::{CliError, load_params};
 use crate::{params_file, temps};
 use compensator::Params;
 use compensator::compensation::compensation;
@@ -151,6 +151,13 @@ pub fn compensation_table(path: &Path, temps_spec: &str) -> Result<String, CliEr
             path.display()
         )));
     }
+    Ok(compensation_of(&p, &temps).as_str().to_string())
+}
+
+/// The `compensation` table of a parameter set with a `[machine]` at
+/// `temps` [C]; a temperature the model cannot evaluate gets an `error`
+/// cell.
+pub fn compensation_of(p: &Params<f64>, temps: &[f64]) -> Table {
     let mut table = Table::new(&[
         "t_c",
         "losses_m3s",
@@ -161,8 +168,14 @@ pub fn compensation_table(path: &Path, temps_spec: &str) -> Result<String, CliEr
         "required_x_m",
         "x_m",
     ]);
-    for &t in &temps {
-        let c = compensation(&p, t).map_err(|e| at_temperature(t, e))?;
+    for &t in temps {
+        let c = match compensation(p, t) {
+            Ok(c) => c,
+            Err(e) => {
+                table.row_error(&[t], &e.to_string());
+                continue;
+            }
+        };
         table.row(&[
             t,
             c.losses,
@@ -174,7 +187,7 @@ pub fn compensation_table(path: &Path, temps_spec: &str) -> Result<String, CliEr
             c.equilibrium.x,
         ]);
     }
-    Ok(table.as_str().to_string())
+    table
 }
 
 /// A fit whose result is not a finite number failed (exit status 1),

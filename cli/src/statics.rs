@@ -1,9 +1,11 @@
 //! Static-model commands: the quasi-static equilibrium (Eqs. 2-10), its
 //! asymptotic expansion (Eqs. 16-21) and the temperature sensitivities
-//! (Eqs. 30-32), one CSV row per temperature.
+//! (Eqs. 30-32), one CSV row per temperature. A temperature the model
+//! cannot evaluate (beyond the viscosity law's range, say) gives a row
+//! with an `error` cell instead of failing the whole table.
 
 use crate::csv::Table;
-use crate::error::{CliError, at_temperature, load_params};
+use crate::error::{CliError, load_params};
 use crate::temps;
 use compensator::asymptotic::{Expansion, Reading, sensitivity as sens};
 use compensator::equilibrium::{self as eq, balance_temperature};
@@ -33,7 +35,13 @@ pub fn equilibrium_table(path: &Path, temps_spec: &str, single: bool) -> Result<
     if single {
         let (_, p) = load_params::<f32>(path)?;
         for &t in &temps {
-            let e = eq::equilibrium(&p, t as f32).map_err(|e| at_temperature(t, e))?;
+            let e = match eq::equilibrium(&p, t as f32) {
+                Ok(e) => e,
+                Err(e) => {
+                    table.row_error(&[t], &e.to_string());
+                    continue;
+                }
+            };
             table.row(&[
                 t,
                 widen(e.a),
@@ -49,7 +57,13 @@ pub fn equilibrium_table(path: &Path, temps_spec: &str, single: bool) -> Result<
     } else {
         let (_, p) = load_params::<f64>(path)?;
         for &t in &temps {
-            let e = eq::equilibrium(&p, t).map_err(|e| at_temperature(t, e))?;
+            let e = match eq::equilibrium(&p, t) {
+                Ok(e) => e,
+                Err(e) => {
+                    table.row_error(&[t], &e.to_string());
+                    continue;
+                }
+            };
             table.row(&[t, e.a, e.p_a, e.p_b, e.dp_ab, e.x, e.q_branch, e.q_throt, e.q_total]);
         }
     }
@@ -111,9 +125,10 @@ pub fn asymptotic(path: &Path, order: usize, reading: Reading, t0: &str, temps_s
     let e = Expansion::new(&p, t0, reading).map_err(|e| CliError::Input(format!("--t0: {t0} C: {e}")))?;
     let mut table = Table::new(&["t_c", "x_qs_m", "x_asym_m"]);
     for &t in &temps {
-        let qs = eq::equilibrium(&p, t).map_err(|e| at_temperature(t, e))?;
-        let terms = e.at(t).map_err(|e| at_temperature(t, e))?;
-        table.row(&[t, qs.x, terms.x(order).0]);
+        match eq::equilibrium(&p, t).and_then(|qs| Ok((qs, e.at(t)?))) {
+            Ok((qs, terms)) => table.row(&[t, qs.x, terms.x(order).0]),
+            Err(e) => table.row_error(&[t], &e.to_string()),
+        }
     }
     Ok(table.as_str().to_string())
 }
@@ -125,8 +140,10 @@ pub fn sensitivity(path: &Path, temps_spec: &str) -> Result<String, CliError> {
     let (_, p) = load_params::<f64>(path)?;
     let mut table = Table::new(&["t_c", "dx_dt_branch_m_k", "dx_dt_m_k", "dq_throt_dt_m3s_k"]);
     for &t in &temps {
-        let s = sens(&p, t).map_err(|e| at_temperature(t, e))?;
-        table.row(&[t, s.dx_dt_branch, s.dx_dt, s.dq_throt_dt]);
+        match sens(&p, t) {
+            Ok(s) => table.row(&[t, s.dx_dt_branch, s.dx_dt, s.dq_throt_dt]),
+            Err(e) => table.row_error(&[t], &e.to_string()),
+        }
     }
     Ok(table.as_str().to_string())
 }

@@ -2,49 +2,13 @@
 //! files, parameters from standard input, a closed pipe, and parameter
 //! files that are not regular files.
 
-use std::io::{Read, Write};
-use std::path::PathBuf;
+use std::io::Read;
 use std::process::{Command, Stdio};
 
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
+mod common;
+use common::{cli, root, run, run_in};
 
-fn cli() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_compensator"));
-    c.current_dir(root());
-    c
-}
-
-/// Runs the binary in the repository root with `stdin`: (code, stdout, stderr).
-fn run_in(dir: &std::path::Path, args: &[&str], stdin: &[u8]) -> (i32, String, String) {
-    let mut child = cli()
-        .current_dir(dir)
-        .args(args)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut input = child.stdin.take().unwrap();
-    let _ = input.write_all(stdin);
-    drop(input);
-    let out = child.wait_with_output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8(out.stdout).unwrap(),
-        String::from_utf8(out.stderr).unwrap(),
-    )
-}
-
-fn run(args: &[&str]) -> (i32, String, String) {
-    run_in(&root(), args, b"")
-}
-
-const COMMANDS: [&str; 11] = [
+const COMMANDS: [&str; 16] = [
     "equilibrium",
     "asymptotic",
     "sensitivity",
@@ -55,7 +19,12 @@ const COMMANDS: [&str; 11] = [
     "compensation",
     "size",
     "calibrate",
+    "identify",
     "paper",
+    "report",
+    "sweep",
+    "completions",
+    "man",
 ];
 
 #[test]
@@ -92,13 +61,15 @@ fn calibrate_and_paper_work_from_any_directory() {
     assert_eq!(out, out_root, "the built-in copies are the repository's");
     let (code, out, err) = run_in(&dir, &["calibrate"], b"");
     assert_eq!(code, 0, "{err}");
-    assert!(out.contains("[fluid]"), "{out}");
+    assert!(out.contains("plunger.spring_rate"), "{out}");
     let (_, out_root, _) = run(&[
         "calibrate",
         "--base",
         "presets/model-example.toml",
-        "--data",
-        "data/paper",
+        "--pressure-data",
+        "data/calibration/paper-pressure.csv",
+        "--displacement-data",
+        "data/calibration/paper-displacement.csv",
     ]);
     assert_eq!(out, out_root);
     // The overrides still apply.

@@ -1,12 +1,14 @@
-//! Every CLI command that reads a parameter file refuses every bad input
+//! Every CLI command that reads a parameter file (`compensator --help`:
+//! all but `completions` and `man`) refuses every bad input
 //! by name: exit status 2, nothing on standard output, one line on
 //! standard error (at most 240 bytes) naming the field, the same message
 //! the library gives (`host_tests::matrix`, docs/parameters.md).
 //!
 //! The library's matrix runs every field against every bad case; here
-//! each command gets every field once, the case rotating with the field
-//! and the command, so that every command sees every field and every kind
-//! of bad value (a few hundred runs of the debug binary, a few seconds).
+//! each command gets a third of the fields (every field goes through five
+//! commands), the case rotating with the field and the command, so that
+//! every command sees at least six kinds of bad value (about 200 runs of the debug
+//! binary, a few seconds on an idle machine).
 //! Then the inputs that are not files (`/dev/zero`, a FIFO without a
 //! writer, a directory) through every command, a closed pipe on every
 //! command's output, and compact numbers in every table.
@@ -17,7 +19,7 @@ use std::time::{Duration, Instant};
 
 /// Every command that reads a parameter file: its arguments before the
 /// file, and the flag that names it.
-const COMMANDS: [(&[&str], &str); 12] = [
+const COMMANDS: [(&[&str], &str); 15] = [
     (&["equilibrium"], "--params"),
     (&["asymptotic", "--order", "1", "--reading", "temperature"], "--params"),
     (&["sensitivity"], "--params"),
@@ -29,7 +31,10 @@ const COMMANDS: [(&[&str], &str); 12] = [
     (&["size", "--for", "machine"], "--params"),
     (&["size", "--for", "slot"], "--params"),
     (&["calibrate"], "--base"),
+    (&["identify", "--data", "data/fmu/oil-temperature.csv"], "--params"),
     (&["paper"], "--params"),
+    (&["report", "--out", "target/cli-bad-input-report"], "--params"),
+    (&["sweep", "--vary", "plunger.mass=10%", "--samples", "3"], "--params"),
 ];
 
 fn args<'a>(command: &'a [&'a str], flag: &'a str, file: &'a str) -> Vec<&'a str> {
@@ -61,10 +66,12 @@ fn every_command_refuses_every_bad_field_by_its_name() {
     let mut cases_seen = std::collections::BTreeSet::new();
     for (c, (command, flag)) in COMMANDS.iter().enumerate() {
         for (i, (field, cases)) in refused.iter().enumerate() {
-            if cases.is_empty() {
+            // A third of the fields per command (every field through five
+            // commands), to keep the test at a few hundred runs.
+            if cases.is_empty() || i % 3 != c % 3 {
                 continue;
             }
-            let (case, message) = &cases[(i + 3 * c) % cases.len()];
+            let (case, message) = &cases[(i / 3 + c) % cases.len()];
             cases_seen.insert((c, case.header()));
             let file = dir.join(format!("c{c}-f{i}.toml"));
             std::fs::write(&file, edited(&base, field, case.value(field).as_deref())).unwrap();
@@ -87,9 +94,9 @@ fn every_command_refuses_every_bad_field_by_its_name() {
     // Every command saw most kinds of bad value.
     for (c, (command, _)) in COMMANDS.iter().enumerate() {
         let kinds = cases_seen.iter().filter(|(k, _)| *k == c).count();
-        assert!(kinds >= 8, "{command:?}: {kinds} kinds of bad value");
+        assert!(kinds >= 6, "{command:?}: {kinds} kinds of bad value");
     }
-    assert!(runs >= 12 * 40, "{runs}");
+    assert!(runs >= 150, "{runs}");
 }
 
 #[test]
@@ -129,6 +136,10 @@ fn every_command_refuses_inputs_that_are_not_files_quickly() {
 fn every_command_ends_quietly_on_a_closed_pipe() {
     let bin = cli_binary().to_string_lossy().into_owned();
     for (command, flag) in COMMANDS {
+        if matches!(command[0], "identify" | "report") {
+            // No measured transient in data/ to fit; `report` writes files.
+            continue;
+        }
         let file = "presets/paper.toml";
         let mut argv = args(command, flag, file);
         if command[0] == "step" {
@@ -165,8 +176,9 @@ fn every_command_ends_quietly_on_a_closed_pipe() {
 #[test]
 fn every_table_prints_numbers_compactly() {
     for (command, flag) in COMMANDS {
-        if matches!(command[0], "size" | "calibrate" | "paper") {
-            // TOML and text, not tables (their numbers: params' fmt_float).
+        if matches!(command[0], "size" | "calibrate" | "paper" | "report" | "identify") {
+            // TOML, text, files or a fit to data, not a table of the
+            // parameter file (`size`'s numbers: params' `fmt_float`).
             continue;
         }
         let argv = args(command, flag, "presets/paper.toml");

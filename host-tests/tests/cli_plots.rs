@@ -1,6 +1,8 @@
 //! `--plot FILE.svg` (docs/plots.md): each command that draws writes an SVG
-//! with its axis quantities and legend names, leaves its CSV output as it
-//! was, and refuses a file that is not `.svg` naming `--plot` (status 2).
+//! with its axis quantities and legend names (here in `--units eng`: mm,
+//! bar, L/min), leaves its CSV output as it was, and refuses a file that is
+//! neither `.svg` nor `.png` naming `--plot` (status 2). PNG figures and
+//! SI axes: `cli/tests/cli_report.rs`.
 
 use host_tests::run_cli;
 use std::path::PathBuf;
@@ -13,12 +15,16 @@ fn temp_dir(name: &str) -> PathBuf {
     dir
 }
 
-/// Runs `args` with `--plot DIR/name.svg`; checks the CSV is the one
-/// without `--plot`, the file is an SVG and shows every string of `shows`.
+/// Runs `args --units eng` with `--plot DIR/name.svg`; checks the CSV is
+/// the one without `--plot`, the file is an SVG and shows every string of
+/// `shows`.
 fn plots(name: &str, args: &[&str], shows: &[&str]) {
     let dir = temp_dir(name);
     let file = dir.join(format!("{name}.svg"));
     let file_arg = file.to_str().unwrap();
+    let mut args = args.to_vec();
+    args.extend(["--units", "eng"]);
+    let args = &args[..];
     let mut with_plot = args.to_vec();
     with_plot.extend(["--plot", file_arg]);
     let (code, out, err) = run_cli(&with_plot);
@@ -138,7 +144,7 @@ fn compensation_plots_supply_against_demand() {
 }
 
 #[test]
-fn a_file_that_is_not_svg_is_refused_naming_plot() {
+fn a_file_that_is_neither_svg_nor_png_is_refused_naming_plot() {
     let dir = temp_dir("bad");
     for (command, extra) in [
         ("equilibrium", &[][..]),
@@ -147,7 +153,7 @@ fn a_file_that_is_not_svg_is_refused_naming_plot() {
         ("eigen", &[][..]),
         ("compensation", &[][..]),
     ] {
-        for file in ["figure.png", "figure.pdf", "figure"] {
+        for file in ["figure.pdf", "figure.jpg", "figure"] {
             let path = dir.join(file);
             let mut args = vec![command, "--params", P];
             args.extend(extra);

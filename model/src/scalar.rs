@@ -186,194 +186,128 @@ fn sqrt_f32(x: f32) -> f32 {
     libm::sqrtf(x)
 }
 
-impl Real for f32 {
-    const ZERO: Self = 0.0;
-    const ONE: Self = 1.0;
-    const HALF: Self = 0.5;
-    const TWO: Self = 2.0;
-    const NAME: &'static str = "f32";
-    #[inline]
-    fn from_f64(v: f64) -> Self {
-        v as f32
-    }
-    #[inline]
-    fn from_f32(v: f32) -> Self {
-        v
-    }
-    #[inline]
-    fn to_f64(self) -> f64 {
-        self as f64
-    }
-    #[inline]
-    fn to_f32(self) -> f32 {
-        self
-    }
-    #[inline]
-    fn sqrt(self) -> Self {
-        if self > 0.0 {
-            sqrt_f32(self)
-        } else if self.is_nan() {
-            self
-        } else {
-            0.0
+/// `Real` and `Float` for a binary floating-point type, from its `libm`
+/// routines: the two impls differ only in the routine names, so one macro
+/// writes both and they cannot drift apart.
+macro_rules! float_impls {
+    (
+        $t:ident, $name:literal, to_real: $to_real:ident, from_real: $from_real:ident,
+        sqrt: $sqrt:path, fabs: $fabs:path,
+        ln: $ln:path, log10: $log10:path, ln_1p: $ln_1p:path, exp: $exp:path,
+        exp10: $exp10:path, powf: $powf:path, copysign: $copysign:path
+    ) => {
+        impl Real for $t {
+            const ZERO: Self = 0.0;
+            const ONE: Self = 1.0;
+            const HALF: Self = 0.5;
+            const TWO: Self = 2.0;
+            const NAME: &'static str = $name;
+            #[inline]
+            #[allow(clippy::unnecessary_cast)]
+            fn from_f64(v: f64) -> Self {
+                v as $t
+            }
+            #[inline]
+            #[allow(clippy::unnecessary_cast)]
+            fn from_f32(v: f32) -> Self {
+                v as $t
+            }
+            #[inline]
+            #[allow(clippy::unnecessary_cast)]
+            fn to_f64(self) -> f64 {
+                self as f64
+            }
+            #[inline]
+            #[allow(clippy::unnecessary_cast)]
+            fn to_f32(self) -> f32 {
+                self as f32
+            }
+            #[inline]
+            fn sqrt(self) -> Self {
+                if self > 0.0 {
+                    $sqrt(self)
+                } else if self.is_nan() {
+                    self
+                } else {
+                    0.0
+                }
+            }
+            #[inline]
+            fn abs(self) -> Self {
+                $fabs(self)
+            }
+            #[inline]
+            fn is_finite(self) -> bool {
+                $t::is_finite(self)
+            }
+            #[inline]
+            fn tiny() -> Self {
+                $t::MIN_POSITIVE
+            }
         }
-    }
-    #[inline]
-    fn abs(self) -> Self {
-        libm::fabsf(self)
-    }
-    #[inline]
-    fn is_finite(self) -> bool {
-        f32::is_finite(self)
-    }
-    #[inline]
-    fn tiny() -> Self {
-        f32::MIN_POSITIVE
-    }
-}
 
-/// `f32` transcendentals from `libm` (native single precision), except
-/// `10^x` from [`crate::mathf`]: `libm::exp10f` computes in double
-/// precision, ~1,230 instructions on a Cortex-M4F against ~95.
-impl Float for f32 {
-    #[inline]
-    fn ln(self) -> Self {
-        libm::logf(self)
-    }
-    #[inline]
-    fn log10(self) -> Self {
-        libm::log10f(self)
-    }
-    #[inline]
-    fn ln_1p(self) -> Self {
-        libm::log1pf(self)
-    }
-    #[inline]
-    fn exp(self) -> Self {
-        libm::expf(self)
-    }
-    #[inline]
-    fn exp10(self) -> Self {
-        crate::mathf::exp10(self)
-    }
-    #[inline]
-    fn powf(self, p: Self) -> Self {
-        libm::powf(self, p)
-    }
-    #[inline]
-    fn nan() -> Self {
-        f32::NAN
-    }
-    #[inline]
-    fn is_nan(self) -> bool {
-        f32::is_nan(self)
-    }
-    #[inline]
-    fn copysign(self, sign: Self) -> Self {
-        libm::copysignf(self, sign)
-    }
-    #[inline]
-    fn to_real<T: Real>(self) -> T {
-        T::from_f32(self)
-    }
-    #[inline]
-    fn from_real<T: Real>(v: T) -> Self {
-        v.to_f32()
-    }
-}
-
-impl Real for f64 {
-    const ZERO: Self = 0.0;
-    const ONE: Self = 1.0;
-    const HALF: Self = 0.5;
-    const TWO: Self = 2.0;
-    const NAME: &'static str = "f64";
-    #[inline]
-    fn from_f64(v: f64) -> Self {
-        v
-    }
-    #[inline]
-    fn from_f32(v: f32) -> Self {
-        v as f64
-    }
-    #[inline]
-    fn to_f64(self) -> f64 {
-        self
-    }
-    #[inline]
-    fn to_f32(self) -> f32 {
-        self as f32
-    }
-    #[inline]
-    fn sqrt(self) -> Self {
-        if self > 0.0 {
-            libm::sqrt(self)
-        } else if self.is_nan() {
-            self
-        } else {
-            0.0
+        impl Float for $t {
+            #[inline]
+            fn ln(self) -> Self {
+                $ln(self)
+            }
+            #[inline]
+            fn log10(self) -> Self {
+                $log10(self)
+            }
+            #[inline]
+            fn ln_1p(self) -> Self {
+                $ln_1p(self)
+            }
+            #[inline]
+            fn exp(self) -> Self {
+                $exp(self)
+            }
+            #[inline]
+            fn exp10(self) -> Self {
+                $exp10(self)
+            }
+            #[inline]
+            fn powf(self, p: Self) -> Self {
+                $powf(self, p)
+            }
+            #[inline]
+            fn nan() -> Self {
+                $t::NAN
+            }
+            #[inline]
+            fn is_nan(self) -> bool {
+                $t::is_nan(self)
+            }
+            #[inline]
+            fn copysign(self, sign: Self) -> Self {
+                $copysign(self, sign)
+            }
+            #[inline]
+            fn to_real<T: Real>(self) -> T {
+                T::$to_real(self)
+            }
+            #[inline]
+            fn from_real<T: Real>(v: T) -> Self {
+                v.$from_real()
+            }
         }
-    }
-    #[inline]
-    fn abs(self) -> Self {
-        libm::fabs(self)
-    }
-    #[inline]
-    fn is_finite(self) -> bool {
-        f64::is_finite(self)
-    }
-    #[inline]
-    fn tiny() -> Self {
-        f64::MIN_POSITIVE
-    }
+    };
 }
 
-impl Float for f64 {
-    #[inline]
-    fn ln(self) -> Self {
-        libm::log(self)
-    }
-    #[inline]
-    fn log10(self) -> Self {
-        libm::log10(self)
-    }
-    #[inline]
-    fn ln_1p(self) -> Self {
-        libm::log1p(self)
-    }
-    #[inline]
-    fn exp(self) -> Self {
-        libm::exp(self)
-    }
-    #[inline]
-    fn exp10(self) -> Self {
-        libm::exp10(self)
-    }
-    #[inline]
-    fn powf(self, p: Self) -> Self {
-        libm::pow(self, p)
-    }
-    #[inline]
-    fn nan() -> Self {
-        f64::NAN
-    }
-    #[inline]
-    fn is_nan(self) -> bool {
-        f64::is_nan(self)
-    }
-    #[inline]
-    fn copysign(self, sign: Self) -> Self {
-        libm::copysign(self, sign)
-    }
-    #[inline]
-    fn to_real<T: Real>(self) -> T {
-        T::from_f64(self)
-    }
-    #[inline]
-    fn from_real<T: Real>(v: T) -> Self {
-        v.to_f64()
-    }
-}
+// `f32` transcendentals from `libm` (native single precision), except
+// `10^x` from [`crate::mathf`]: `libm::exp10f` computes in double
+// precision, ~1,230 instructions on a Cortex-M4F against ~95.
+float_impls!(
+    f32, "f32", to_real: from_f32, from_real: to_f32, sqrt: sqrt_f32, fabs: libm::fabsf,
+    ln: libm::logf, log10: libm::log10f, ln_1p: libm::log1pf, exp: libm::expf,
+    exp10: crate::mathf::exp10, powf: libm::powf, copysign: libm::copysignf
+);
+float_impls!(
+    f64, "f64", to_real: from_f64, from_real: to_f64, sqrt: libm::sqrt, fabs: libm::fabs,
+    ln: libm::log, log10: libm::log10, ln_1p: libm::log1p, exp: libm::exp,
+    exp10: libm::exp10, powf: libm::pow, copysign: libm::copysign
+);
 
 pub use fixed_point::{Fix, Q8_24, Q12_20, Q16_16};
 

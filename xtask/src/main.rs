@@ -6,6 +6,9 @@
 //!                                                build the board image, flash it with probe-rs
 //! cargo xtask test [--bless]                     everything CI checks (the test command)
 //! cargo xtask build [--params F]                 build every firmware image
+//! cargo xtask fmu [--params F] [--fmi-version 2|3] [--out DIR] [--debug]
+//!                                                the twin as a co-simulation FMU (target/fmu/compensator.fmu)
+//! cargo xtask fmu-check                          the FMU checked by FMPy (part of `test`)
 //! cargo xtask bench [--params F] [--write]       cost (the twin as built for F), footprint and stack on the emulated MCUs
 //! cargo xtask callgrind [--bless]                host instruction counts against the baseline
 //! cargo xtask msrv                               rust-version against the locked dependencies
@@ -35,6 +38,7 @@ mod bench;
 mod callgrind;
 mod firmware;
 mod flash;
+mod fmu;
 mod fuzz;
 mod msrv;
 mod panic_free;
@@ -141,6 +145,25 @@ enum Command {
         #[command(flatten)]
         params: ParamsArg,
     },
+    /// The twin as a co-simulation FMU for Modelica tools, Simulink, Hopsan, Python (docs/fmu.md)
+    Fmu {
+        #[command(flatten)]
+        params: ParamsArg,
+        /// FMI version: 2 (FMI 2.0, what Simulink, Hopsan and OpenModelica import most
+        /// reliably) or 3 (FMI 3.0)
+        #[arg(long, value_name = "2|3", default_value = "2", value_parser = ["2", "3"])]
+        fmi_version: String,
+        /// Folder to write compensator.fmu to, relative to the current directory
+        /// [default: target/fmu]
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Build the binary with the dev profile (quicker; debug assertions on;
+        /// the same f32 arithmetic) instead of release
+        #[arg(long)]
+        debug: bool,
+    },
+    /// The FMU (FMI 2.0 and 3.0) validated and simulated by FMPy in a venv (part of `test`)
+    FmuCheck,
     /// Instructions per tick (the twin as built for F), flash, RAM and stack
     Bench {
         #[command(flatten)]
@@ -208,6 +231,13 @@ fn main() -> ExitCode {
         Command::Test { bless } => cmd_test(bless),
         Command::Bench { params, write } => cmd_bench(&params, write),
         Command::Build { params } => cmd_build(&params),
+        Command::Fmu {
+            params,
+            fmi_version,
+            out,
+            debug,
+        } => cmd_fmu(&params, &fmi_version, out.as_deref(), debug),
+        Command::FmuCheck => cmd_fmu_check(),
         Command::Msrv => msrv::check(&root()).map(|_| 0).map_err(Failure::from),
         Command::Toolchain => toolchain::get(&root(), &firmware::TARGETS)
             .map(|t| {
@@ -293,6 +323,36 @@ fn cmd_run(params: &ParamsArg, csv_path: Option<&Path>) -> Outcome {
 fn cmd_build(params: &ParamsArg) -> Outcome {
     let params = params_file(params)?;
     firmware::build_all(&root(), params.as_deref())?;
+    Ok(0)
+}
+
+/// `cargo xtask fmu [--params F] [--fmi-version 2|3] [--out DIR] [--debug]`.
+fn cmd_fmu(params: &ParamsArg, fmi_version: &str, out: Option<&Path>, debug: bool) -> Outcome {
+    let params = params_file(params)?;
+    let version = match fmi_version {
+        "3" => compensator_fmu::description::FmiVersion::V3,
+        _ => compensator_fmu::description::FmiVersion::V2,
+    };
+    let root = root();
+    let out = match out {
+        Some(o) => std::env::current_dir().map_err(|e| e.to_string())?.join(o),
+        None => root.join("target/fmu"),
+    };
+    let profile = if debug {
+        fmu::Profile::Dev
+    } else {
+        fmu::Profile::Release
+    };
+    let path = fmu::build(&root, params.as_deref(), version, profile, &out)?;
+    println!("{}", path.display());
+    Ok(0)
+}
+
+/// `cargo xtask fmu-check`: what `cargo xtask test` checks of the FMU.
+fn cmd_fmu_check() -> Outcome {
+    if let Some(summary) = fmu::check(&root())? {
+        eprintln!("xtask: {summary}");
+    }
     Ok(0)
 }
 
@@ -427,6 +487,10 @@ fn cmd_test(bless: bool) -> Outcome {
             targets: Vec::new(),
         },
     )?;
+    step("FMU: FMI 2.0 and 3.0 built (cargo xtask fmu), validated and simulated by FMPy against compensator step");
+    if let Some(summary) = fmu::check(&root)? {
+        eprintln!("xtask: {summary}");
+    }
     step("host instruction counts (valgrind callgrind) against the baseline");
     callgrind::check(&root, false)?;
     step("cross toolchain");
@@ -587,6 +651,34 @@ mod tests {
                 write: true,
             })
         );
+        assert_eq!(
+            parse(&["fmu"]),
+            Ok(Command::Fmu {
+                params: params(None),
+                fmi_version: "2".into(),
+                out: None,
+                debug: false,
+            })
+        );
+        assert_eq!(
+            parse(&[
+                "fmu",
+                "--params",
+                "f.toml",
+                "--fmi-version",
+                "3",
+                "--out",
+                "dist",
+                "--debug"
+            ]),
+            Ok(Command::Fmu {
+                params: params(Some("f.toml")),
+                fmi_version: "3".into(),
+                out: Some("dist".into()),
+                debug: true,
+            })
+        );
+        assert_eq!(parse(&["fmu-check"]), Ok(Command::FmuCheck));
         assert_eq!(parse(&["callgrind", "--bless"]), Ok(Command::Callgrind { bless: true }));
         assert_eq!(parse(&["msrv"]), Ok(Command::Msrv));
         assert_eq!(parse(&["toolchain"]), Ok(Command::Toolchain));
@@ -623,6 +715,7 @@ mod tests {
         assert_eq!(parse(&["run", "--params", "--csv", "x"]), Err(ErrorKind::InvalidValue));
         assert_eq!(parse(&["flash", "--seconds", "soon"]), Err(ErrorKind::ValueValidation));
         assert_eq!(parse(&["qemu-runner"]), Err(ErrorKind::MissingRequiredArgument));
+        assert_eq!(parse(&["fmu", "--fmi-version", "1"]), Err(ErrorKind::InvalidValue));
         // No command: the help, as an error (exit status 2).
         assert_eq!(parse(&[]), Err(ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand));
     }

@@ -542,6 +542,40 @@ impl<F: Float, T: Real> Twin<F, T> {
         self.state = self.model.scales.from_si(s);
         self.xi_carry = T::ZERO;
     }
+
+    /// What the next ticks depend on besides the configuration and the
+    /// coefficients (which follow from the last temperature set): the state
+    /// in model units, the compensated carry of `xi` and whether the next
+    /// tick is graded. With [`Twin::restore`] it saves and restores a twin
+    /// exactly (an FMU's state, rolled back by a co-simulation master).
+    pub fn memory(&self) -> TwinMemory<T> {
+        TwinMemory {
+            state: self.state,
+            xi_carry: self.xi_carry,
+            abrupt: self.abrupt,
+        }
+    }
+
+    /// Puts back what [`Twin::memory`] saved: the twin, with the same
+    /// parameters, configuration and last temperature, then ticks exactly
+    /// as the one it was saved from.
+    pub fn restore(&mut self, memory: &TwinMemory<T>) {
+        self.state = memory.state;
+        self.xi_carry = memory.xi_carry;
+        self.abrupt = memory.abrupt;
+    }
+}
+
+/// A twin's memory ([`Twin::memory`]): everything its next ticks depend on
+/// besides the parameters, the configuration and the last temperature.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TwinMemory<T> {
+    /// State `(xi, w, pi_a, pi_b)` in model units.
+    pub state: [T; 4],
+    /// What rounding has left out of `xi` so far.
+    pub xi_carry: T,
+    /// The next tick starts graded (the coefficients changed abruptly).
+    pub abrupt: bool,
 }
 
 impl<F: Float, T: Real> super::Dynamic<F> for Twin<F, T> {

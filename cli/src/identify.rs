@@ -1,0 +1,908 @@
+//! Identification of the dynamic parameters from a measured transient: the
+//! `identify` command.
+//!
+//! Static data cannot give the plunger's mass, its viscous damping, or the
+//! chambers' compliance (volume over bulk modulus): they only shape how
+//! the plunger gets to its equilibrium. `identify` simulates the measured
+//! temperature history with the dynamic twin in `f64` (the core's SDIRK3
+//! twin, `docs/dynamics.md`, at the substeps the twin-config chooser picks
+//! for the data's sample interval) and fits those parameters to the
+//! measured displacement (and chamber pressures when given) by least
+//! squares ([`crate::lsq`]).
+//!
+//! Why the twin rather than the adaptive reference solver: a fit evaluates
+//! the model some tens of times per parameter, and the twin follows an
+//! arbitrary sampled temperature history tick by tick at microseconds per
+//! tick, where the reference solver follows only a step or a ramp
+//! (`compensator_reference::dynamics::Profile`) and costs milliseconds per
+//! sample. Its error on the paper preset is 0.043 % of a step against the
+//! reference (`cargo test -p host-tests --test dynamics`), well below any
+//! displacement sensor's noise. The tests generate their data with the
+//! reference solver, so the fit is checked against an independent model.
+//!
+//! Data: `time_s,t_c,x_m` (optionally `p_a_pa,p_b_pa`), uniformly sampled,
+//! starting at rest (the twin starts in the equilibrium of the first
+//! temperature). Tick `k` (from sample `k` to `k + 1`) runs at sample
+//! `k + 1`'s temperature, as the firmware ticks on its newest reading, so a
+//! step between the first two samples is a step at `t = 0`.
+//!
+//! Parameters are fitted in logarithmic coordinates (mass, bulk modulus,
+//! volumes) or scaled linear ones (the damping, which may be zero:
+//! [`Coord`]). Standard errors are those of [`crate::lsq::analyse`]
+//! (with pressures, each channel weighted by its own residual RMS after a
+//! first fit); the 95 % interval is the profile-likelihood one
+//! ([`Estimate::ci95`]). At least [`MIN_DOF`] degrees of freedom are
+//! required.
+//!
+//! Identifiability: a parameter is reported as *not identifiable* when
+//! the Jacobian cannot separate it (rank-deficient, [`crate::lsq::RANK_TOL`]),
+//! its relative standard error exceeds [`crate::calibration::REL_SE_LIMIT`]
+//! (50 %), it runs to the edge of its plausible range, its information
+//! comes from fewer than [`MIN_EFFECTIVE_SAMPLES`] samples, or its profile
+//! likelihood is flat ([`PROFILE_MIN_RISE`], [`PROFILE_FAR`]). It is then
+//! fixed at the base file's value and the others are fitted again without
+//! it, until every remaining parameter is determined. Its value is not
+//! printed (the fit's number for it would be noise).
+
+use crate::csv::read_numeric;
+use crate::dynamics::chosen;
+use crate::error::CliError;
+use crate::lsq::{self, Undetermined};
+use crate::params_file;
+use compensator::Params;
+use compensator::dynamics::twin::MAX_SUBSTEPS;
+use compensator::dynamics::{Twin, TwinConfig};
+use compensator::params::{Field, RawCore, RawParams};
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// Fewest degrees of freedom `identify` accepts (its intervals use the
+/// normal quantile 1.96; at 30 degrees of freedom Student's is 2.04).
+pub const MIN_DOF: usize = 30;
+
+/// The twin runs this many times the substeps the twin-config chooser
+/// picks for the base file (at most `MAX_SUBSTEPS`): the chooser keeps the
+/// error within 0.1 % of a step for that design, and the fit visits others
+/// (a softer oil, a heavier plunger) whose error must stay well below the
+/// measurement noise too.
+pub const SUBSTEP_FACTOR: u8 = 4;
+
+/// Profile-likelihood check: moving a parameter by two standard errors
+/// (re-fitting the others) must raise the residual sum of squares by at
+/// least this fraction of the `4 s^2` a linear model would give; a flatter
+/// profile means the local standard error is not the data's word (Raue et
+/// al., Bioinformatics 25 (2009) 1923: structural and practical
+/// non-identifiability from the profile likelihood).
+pub const PROFILE_MIN_RISE: f64 = 0.25;
+
+/// Second profile check: a value this factor smaller or larger (or the
+/// edge of the plausible range, if nearer) must be rejected by the data at
+/// 95 % — the residual sum of squares, the others re-fitted, up by at
+/// least [`CHI2_95`] `s^2`. A parameter whose profile stays under that
+/// threshold up to there has a confidence region open on that side (the
+/// bulk modulus in the stiff limit, where the chambers' compliance no
+/// longer shows) even if its local standard error looks small.
+pub const PROFILE_FAR: f64 = 10.0;
+
+/// Fewest samples a parameter's information may come from: the
+/// participation ratio `(sum J_i^2)^2 / sum J_i^4` of its Jacobian column
+/// (`n` when every residual is equally sensitive, 1 when one is). A
+/// parameter seen by a handful of samples (the bulk modulus, in the first
+/// millisecond after a step) would be fitted to their noise, with an
+/// interval the asymptotic theory does not cover.
+pub const MIN_EFFECTIVE_SAMPLES: f64 = 10.0;
+
+/// Bisection steps locating each end of a profile-likelihood interval
+/// (the bracket, a factor [`PROFILE_FAR`] wide, shrinks to 2^-12 of it).
+pub const PROFILE_BISECTIONS: usize = 12;
+
+/// 95 % quantile of chi-square with one degree of freedom.
+pub const CHI2_95: f64 = 3.841;
+
+/// Relative spread of the sample intervals accepted as uniform.
+pub const UNIFORM_TOL: f64 = 1e-6;
+
+/// A measured transient.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Transient {
+    /// Sample times [s], uniform.
+    pub time_s: Vec<f64>,
+    /// Oil temperature [C] per sample.
+    pub t_c: Vec<f64>,
+    /// Displacement [m] per sample.
+    pub x_m: Vec<f64>,
+    /// Chamber pressures `(p_a, p_b)` [Pa] per sample, if measured.
+    pub p_pa: Option<Vec<(f64, f64)>>,
+}
+
+impl Transient {
+    /// Sample interval [s].
+    pub fn tick(&self) -> f64 {
+        (self.time_s[self.time_s.len() - 1] - self.time_s[0]) / (self.time_s.len() - 1) as f64
+    }
+}
+
+/// Reads `time_s,t_c,x_m[,p_a_pa,p_b_pa]` (other columns are ignored).
+///
+/// Errors (naming row and column): a missing column, a cell that is not a
+/// finite number, fewer than 3 rows, sample times not increasing or not
+/// uniform (within [`UNIFORM_TOL`] of the first interval), only one of the
+/// two pressure columns.
+pub fn read_transient(text: &str) -> Result<Transient, String> {
+    let t = read_numeric(text)?;
+    let col = |n: &str| {
+        t.column(n).ok_or_else(|| {
+            format!(
+                "no column {n} (columns: {}; expected time_s,t_c,x_m[,p_a_pa,p_b_pa])",
+                t.header.join(",")
+            )
+        })
+    };
+    let (ct, cc, cx) = (col("time_s")?, col("t_c")?, col("x_m")?);
+    let pressures = match (t.column("p_a_pa"), t.column("p_b_pa")) {
+        (Some(a), Some(b)) => Some((a, b)),
+        (None, None) => None,
+        (Some(_), None) => return Err("column p_a_pa without p_b_pa: give both chamber pressures or neither".into()),
+        (None, Some(_)) => return Err("column p_b_pa without p_a_pa: give both chamber pressures or neither".into()),
+    };
+    if t.rows.len() < 3 {
+        return Err(format!("{} data rows: a transient needs at least 3", t.rows.len()));
+    }
+    let time: Vec<f64> = t.rows.iter().map(|r| r[ct]).collect();
+    let first = time[1] - time[0];
+    for i in 1..time.len() {
+        let dt = time[i] - time[i - 1];
+        if !(dt > 0.0) || (dt - first).abs() > UNIFORM_TOL * first.abs() {
+            return Err(format!(
+                "row {} (line {}), column time_s: interval {dt} s after the previous sample; the samples \
+                 must be uniform (the first interval is {first} s, tolerance {UNIFORM_TOL} relative)",
+                i + 1,
+                t.lines[i]
+            ));
+        }
+    }
+    Ok(Transient {
+        time_s: time,
+        t_c: t.rows.iter().map(|r| r[cc]).collect(),
+        x_m: t.rows.iter().map(|r| r[cx]).collect(),
+        p_pa: pressures.map(|(a, b)| t.rows.iter().map(|r| (r[a], r[b])).collect()),
+    })
+}
+
+/// The dynamic parameters `identify` can fit, by their path in the
+/// parameter file.
+pub const CANDIDATES: [&str; 5] = [
+    "plunger.mass",
+    "plunger.damping",
+    "fluid.bulk_modulus",
+    "chambers.volume_a",
+    "chambers.volume_b",
+];
+
+/// Fitted by default: the chambers' volumes and the bulk modulus enter
+/// only as the compliances `V / beta`, so the bulk modulus stands for both.
+pub const DEFAULT_FIT: [&str; 3] = ["plunger.mass", "plunger.damping", "fluid.bulk_modulus"];
+
+fn field(path: &str) -> &'static Field {
+    let f = &RawCore::FIELD;
+    match path {
+        "plunger.mass" => &f.mass,
+        "plunger.damping" => &f.damping,
+        "fluid.bulk_modulus" => &f.bulk_modulus,
+        "chambers.volume_a" => &f.volume_a,
+        _ => &f.volume_b,
+    }
+}
+
+fn set(core: &mut RawCore, path: &str, v: f64) {
+    match path {
+        "plunger.mass" => core.mass = v,
+        "plunger.damping" => core.damping = v,
+        "fluid.bulk_modulus" => core.bulk_modulus = v,
+        "chambers.volume_a" => core.volume_a = v,
+        _ => core.volume_b = v,
+    }
+}
+
+fn get(core: &RawCore, path: &str) -> f64 {
+    match path {
+        "plunger.mass" => core.mass,
+        "plunger.damping" => core.damping,
+        "fluid.bulk_modulus" => core.bulk_modulus,
+        "chambers.volume_a" => core.volume_a,
+        _ => core.volume_b,
+    }
+}
+
+/// Parses `--fit`: a comma list of [`CANDIDATES`] (the part after the dot
+/// is enough: `mass,damping`).
+pub fn parse_fit(list: &str) -> Result<Vec<&'static str>, String> {
+    let mut out: Vec<&'static str> = Vec::new();
+    for item in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let path = CANDIDATES
+            .iter()
+            .find(|c| **c == item || c.split('.').nth(1) == Some(item))
+            .ok_or_else(|| format!("'{item}' is not one of {}", CANDIDATES.join(", ")))?;
+        if !out.contains(path) {
+            out.push(path);
+        }
+    }
+    if out.is_empty() {
+        return Err("no parameter to fit".into());
+    }
+    Ok(out)
+}
+
+/// Simulated `(x, p_a, p_b)` at every sample of `data` with the twin in
+/// `f64`; `None` where the model cannot run (parameters refused, a
+/// temperature outside the oil model, a failed tick).
+pub fn simulate(core: &RawCore, config: TwinConfig, data: &Transient) -> Option<Vec<[f64; 3]>> {
+    let params = Params::<f64>::from_core(core, None).ok()?;
+    let mut twin = Twin::<f64, f64>::new(&params, config, data.t_c[0]).ok()?;
+    let mut out = Vec::with_capacity(data.t_c.len());
+    let s = twin.state();
+    out.push([s.x, s.p_a, s.p_b]);
+    for &t in &data.t_c[1..] {
+        twin.set_temperature(t).ok()?;
+        twin.tick().ok()?;
+        let s = twin.state();
+        out.push([s.x, s.p_a, s.p_b]);
+    }
+    Some(out)
+}
+
+/// Coordinates a parameter is fitted in: the logarithm (positive
+/// parameters: mass, bulk modulus, volumes), or the value over a scale
+/// (the damping, which may be zero: in `ln b` the fit would lose its
+/// gradient as `b -> 0`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Coord {
+    /// `u = ln v`.
+    Log,
+    /// `u = v / scale`.
+    Linear(f64),
+}
+
+impl Coord {
+    /// The coordinates of `path` for a fit starting from `base`.
+    pub fn of(path: &str, base: &RawCore) -> Coord {
+        if path == "plunger.damping" {
+            Coord::Linear(base.damping.max(1e-2))
+        } else {
+            Coord::Log
+        }
+    }
+    /// Value from coordinate.
+    pub fn value(self, u: f64) -> f64 {
+        match self {
+            Coord::Log => u.exp(),
+            Coord::Linear(s) => u * s,
+        }
+    }
+    /// Coordinate from value (a non-positive value in log coordinates
+    /// becomes the field's smallest plausible one).
+    pub fn coord(self, v: f64, min: f64) -> f64 {
+        match self {
+            Coord::Log => v.max(min).max(1e-300).ln(),
+            Coord::Linear(s) => v / s,
+        }
+    }
+    /// Standard error of the value from that of the coordinate at `u`.
+    pub fn std_error(self, u: f64, se: f64) -> f64 {
+        match self {
+            Coord::Log => u.exp() * se,
+            Coord::Linear(s) => s * se,
+        }
+    }
+    /// 95 % interval of the value: `exp(u +- 1.96 se)` or
+    /// `(u +- 1.96 se) scale` (not below zero).
+    pub fn interval(self, u: f64, se: f64) -> (f64, f64) {
+        match self {
+            Coord::Log => ((u - 1.96 * se).exp(), (u + 1.96 * se).exp()),
+            Coord::Linear(s) => (((u - 1.96 * se) * s).max(0.0), (u + 1.96 * se) * s),
+        }
+    }
+}
+
+/// A parameter the data determine.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate {
+    /// Value.
+    pub value: f64,
+    /// Standard error (same unit).
+    pub std_error: f64,
+    /// 95 % profile-likelihood interval: the values where the residual sum
+    /// of squares, the other parameters re-fitted, exceeds its minimum by
+    /// [`CHI2_95`] `s^2` (Venzon and Moolgavkar, Appl. Statist. 37 (1988)
+    /// 87). Unlike the Wald interval it follows the model's nonlinearity.
+    pub ci95: (f64, f64),
+    /// 95 % Wald interval from the standard error ([`Coord::interval`]).
+    pub wald95: (f64, f64),
+}
+
+/// One dynamic parameter's outcome.
+#[derive(Debug, Clone)]
+pub struct Identified {
+    /// Parameter path (`plunger.mass`).
+    pub path: &'static str,
+    /// Unit.
+    pub unit: &'static str,
+    /// The estimate when the data determine it; `None` when they do not
+    /// (see `reason`).
+    pub estimate: Option<Estimate>,
+    /// Why it is not identifiable (empty when it is).
+    pub reason: String,
+}
+
+/// Outcome of [`identify_params`].
+#[derive(Debug, Clone)]
+pub struct Identification {
+    /// The base parameters with the identified fields replaced.
+    pub params: RawParams,
+    /// Every requested parameter, identified or not, in the requested order.
+    pub results: Vec<Identified>,
+    /// The twin's configuration used.
+    pub config: TwinConfig,
+    /// Residual RMS of the displacement [m] at the optimum.
+    pub rms_x: f64,
+    /// Residual RMS of the pressures [Pa], if measured.
+    pub rms_p: Option<f64>,
+    /// Residuals (all channels), degrees of freedom.
+    pub points: usize,
+    /// Degrees of freedom of the final fit.
+    pub dof: usize,
+    /// Condition number of the final fit's scaled Jacobian.
+    pub condition: f64,
+    /// Warnings, one line each.
+    pub warnings: Vec<String>,
+}
+
+/// The residual sum of squares of the profile at `x[i] + d`: parameter
+/// `i` held there, the others re-fitted from `x` (infinite when the model
+/// cannot run there).
+fn profile_at(f: &dyn Fn(&[f64]) -> Option<Vec<f64>>, x: &[f64], i: usize, d: f64, step: &[f64]) -> f64 {
+    let rss = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
+    let xi = x[i] + d;
+    let others: Vec<f64> = x.iter().enumerate().filter(|(j, _)| *j != i).map(|(_, v)| *v).collect();
+    let full = |o: &[f64]| -> Vec<f64> {
+        let mut v = o.to_vec();
+        v.insert(i, xi);
+        v
+    };
+    if others.is_empty() {
+        return f(&full(&[])).map_or(f64::INFINITY, |r| rss(&r));
+    }
+    let st: Vec<f64> = step
+        .iter()
+        .enumerate()
+        .filter(|(j, _)| *j != i)
+        .map(|(_, v)| *v)
+        .collect();
+    match lsq::least_squares(|o| f(&full(o)), &others, &st) {
+        Ok(fit) => rss(&fit.residuals),
+        Err(_) => f(&full(&others)).map_or(f64::INFINITY, |r| rss(&r)),
+    }
+}
+
+/// The smaller of the profile's residual sums of squares at `x[i] +- delta`.
+fn profile(f: &dyn Fn(&[f64]) -> Option<Vec<f64>>, x: &[f64], i: usize, delta: f64, step: &[f64]) -> f64 {
+    profile_at(f, x, i, -delta, step).min(profile_at(f, x, i, delta, step))
+}
+
+/// The accepted fit: its uncertainty, optimum (fit coordinates), the
+/// coordinates and the profile-likelihood intervals of its parameters.
+type Accepted = (lsq::Uncertainty, Vec<f64>, Vec<Coord>, Vec<(f64, f64)>);
+
+/// Residual scales of the channels: displacement [m], pressures [Pa].
+#[derive(Clone, Copy, Debug)]
+struct Scales {
+    x: f64,
+    p: f64,
+}
+
+/// Weighted residuals of `core` against `data`: `(x_sim - x) / s.x`, then
+/// `(p_sim - p) / s.p` for both chambers when measured.
+fn residuals(core: &RawCore, config: TwinConfig, data: &Transient, s: Scales) -> Option<Vec<f64>> {
+    let sim = simulate(core, config, data)?;
+    let mut r: Vec<f64> = sim.iter().zip(&data.x_m).map(|(y, x)| (y[0] - x) / s.x).collect();
+    if let Some(p) = &data.p_pa {
+        for (y, (pa, pb)) in sim.iter().zip(p) {
+            r.push((y[1] - pa) / s.p);
+            r.push((y[2] - pb) / s.p);
+        }
+    }
+    Some(r)
+}
+
+/// RMS of the displacement and pressure parts of unweighted residuals.
+fn channel_rms(core: &RawCore, config: TwinConfig, data: &Transient) -> Option<(f64, Option<f64>)> {
+    let r = residuals(core, config, data, Scales { x: 1.0, p: 1.0 })?;
+    let n = data.x_m.len();
+    Some((lsq::rms(&r[..n]), data.p_pa.as_ref().map(|_| lsq::rms(&r[n..]))))
+}
+
+/// Fits `fit` (paths of [`CANDIDATES`]) of `base` to `data` (module docs).
+///
+/// Errors: [`CliError::Input`] for a base file the twin refuses, data the
+/// twin cannot follow from the base file (a temperature outside the oil
+/// model), too few degrees of freedom ([`MIN_DOF`]); [`CliError::Failed`]
+/// when the minimiser does not converge or the twin fails mid-fit.
+pub fn identify_params(base: &RawParams, data: &Transient, fit: &[&'static str]) -> Result<Identification, CliError> {
+    let tick = data.tick();
+    let choice = chosen(base, tick)?;
+    let config = TwinConfig {
+        substeps: (choice.config.substeps.saturating_mul(SUBSTEP_FACTOR)).min(MAX_SUBSTEPS),
+        ..choice.config
+    };
+    let n_res = data.x_m.len() * if data.p_pa.is_some() { 3 } else { 1 };
+    let (rx0, rp0) = channel_rms(&base.core, config, data).ok_or_else(|| {
+        CliError::Input(
+            "--data: the twin cannot follow the data with the base parameters (a temperature outside the oil model?)"
+                .into(),
+        )
+    })?;
+    // First pass weights: the base file's misfit per channel, floored at
+    // 1e-6 of the stroke and of the drop (noise-free data).
+    let mut scales = Scales {
+        x: rx0.max(1e-6 * base.core.stroke),
+        p: rp0.unwrap_or(1.0).max(1e-6 * base.core.pressure_drop),
+    };
+    let mut free: Vec<&'static str> = fit.to_vec();
+    let mut dropped: Vec<(&'static str, String)> = Vec::new();
+    let mut warnings = Vec::new();
+    let mut core = base.core;
+    let mut last: Option<Accepted> = None;
+    let mut reweighted = data.p_pa.is_none();
+    while !free.is_empty() {
+        if n_res < free.len() + MIN_DOF {
+            return Err(CliError::Input(format!(
+                "--data: {n_res} residuals for {} parameters: at least {MIN_DOF} degrees of freedom are needed \
+                 (the intervals use the normal quantile); give a longer or finer record",
+                free.len()
+            )));
+        }
+        let start = base.core;
+        let coords: Vec<Coord> = free.iter().map(|p| Coord::of(p, &start)).collect();
+        let with = |u: &[f64]| {
+            let mut c = start;
+            for ((p, v), k) in free.iter().zip(u).zip(&coords) {
+                set(&mut c, p, k.value(*v));
+            }
+            c
+        };
+        let u0: Vec<f64> = free
+            .iter()
+            .zip(&coords)
+            .map(|(p, k)| k.coord(get(&start, p), field(p).min))
+            .collect();
+        let step = vec![1e-5; u0.len()];
+        let names: Vec<&str> = free.to_vec();
+        let f = |u: &[f64]| residuals(&with(u), config, data, scales);
+        // Directions the data do not see at the start are dropped first.
+        if let Some(j0) = lsq::jacobian(f, &u0, &step)
+            && let Err(Undetermined::RankDeficient { confounded, .. }) = lsq::check_design(&j0, &names)
+        {
+            let worst = confounded.first().map(String::as_str).unwrap_or(names[0]);
+            let path = *free.iter().find(|p| **p == worst).unwrap_or(&free[0]);
+            dropped.push((
+                path,
+                format!(
+                    "the response does not depend on it (confounded with {})",
+                    confounded.join(", ")
+                ),
+            ));
+            free.retain(|p| *p != path);
+            continue;
+        }
+        let fit_result = lsq::least_squares(f, &u0, &step).map_err(|e| CliError::Failed(format!("--data: {e}")))?;
+        // Second pass on the channels' own misfit (pressures and
+        // displacement weighted by their residual RMS at the optimum).
+        if !reweighted {
+            reweighted = true;
+            if let Some((rx, Some(rp))) = channel_rms(&with(&fit_result.x), config, data) {
+                scales = Scales {
+                    x: rx.max(1e-9 * base.core.stroke),
+                    p: rp.max(1e-9 * base.core.pressure_drop),
+                };
+                continue;
+            }
+        }
+        match lsq::analyse(&fit_result.jacobian, &fit_result.residuals, &names) {
+            Err(Undetermined::RankDeficient { confounded, .. }) => {
+                let worst = confounded.first().map(String::as_str).unwrap_or(names[0]);
+                let path = *free.iter().find(|p| **p == worst).unwrap_or(&free[0]);
+                dropped.push((
+                    path,
+                    format!("the data do not separate it from {}", confounded.join(", ")),
+                ));
+                free.retain(|p| *p != path);
+            }
+            Err(e) => return Err(CliError::Input(format!("--data: {e}"))),
+            Ok(u) => {
+                let se = u.std_errors();
+                let rel_se = |i: usize| {
+                    let v = coords[i].value(fit_result.x[i]);
+                    coords[i].std_error(fit_result.x[i], se[i]) / v.abs()
+                };
+                let (worst, rel) = (0..free.len())
+                    .map(|i| (i, rel_se(i)))
+                    .max_by(|a, b| a.1.total_cmp(&b.1))
+                    .unwrap_or((0, 0.0));
+                if rel > crate::calibration::REL_SE_LIMIT {
+                    dropped.push((
+                        free[worst],
+                        format!(
+                            "relative standard error {:.0} % (above {:.0} %): the data do not determine it",
+                            100.0 * rel,
+                            100.0 * crate::calibration::REL_SE_LIMIT
+                        ),
+                    ));
+                    free.remove(worst);
+                    continue;
+                }
+                // A parameter that ran to the edge of its plausible range
+                // is bounded by the data from one side only.
+                if let Some(i) = free.iter().enumerate().position(|(i, p)| {
+                    let f = field(p);
+                    let v = coords[i].value(fit_result.x[i]);
+                    v >= f.max * 0.999 || v <= f.min * 1.001
+                }) {
+                    dropped.push((
+                        free[i],
+                        "the fit runs to the edge of its plausible range (docs/parameters.md): the data bound it \
+                         from one side only"
+                            .into(),
+                    ));
+                    free.remove(i);
+                    continue;
+                }
+                // Where the information comes from: the participation
+                // ratio of each Jacobian column (MIN_EFFECTIVE_SAMPLES).
+                let effective = |j: usize| {
+                    let col = fit_result.jacobian.column(j);
+                    let s2: f64 = col.iter().map(|v| v * v).sum();
+                    let s4: f64 = col.iter().map(|v| v.powi(4)).sum();
+                    if s4 > 0.0 { s2 * s2 / s4 } else { 0.0 }
+                };
+                if let Some((i, n_eff)) = (0..free.len())
+                    .map(|i| (i, effective(i)))
+                    .filter(|(_, n)| !(*n >= MIN_EFFECTIVE_SAMPLES))
+                    .min_by(|a, b| a.1.total_cmp(&b.1))
+                {
+                    dropped.push((
+                        free[i],
+                        format!(
+                            "its effect is concentrated in about {n_eff:.1} samples (fewer than \
+                             {MIN_EFFECTIVE_SAMPLES}): a fit to so few points adapts to their noise, and no \
+                             interval from them can be trusted"
+                        ),
+                    ));
+                    free.remove(i);
+                    continue;
+                }
+                // Profile checks (PROFILE_MIN_RISE, PROFILE_FAR).
+                let rss0: f64 = fit_result.residuals.iter().map(|r| r * r).sum();
+                let mut verdict = None;
+                let mut profile_ci = vec![(0.0, 0.0); free.len()];
+                for i in 0..free.len() {
+                    let near = (profile(&f, &fit_result.x, i, 2.0 * se[i], &step) - rss0) / (4.0 * u.s2);
+                    if !(near >= PROFILE_MIN_RISE) {
+                        verdict = Some((
+                            i,
+                            format!(
+                                "moving it by two standard errors raises the misfit by {:.0} % of what its \
+                                 standard error implies (flat profile likelihood): the data do not determine it",
+                                100.0 * near.max(0.0)
+                            ),
+                        ));
+                        break;
+                    }
+                    let fd = field(free[i]);
+                    let x = fit_result.x[i];
+                    let v = coords[i].value(x);
+                    let lower = coords[i].coord((v / PROFILE_FAR).max(fd.min * 1.001), fd.min);
+                    let upper = coords[i].coord((v * PROFILE_FAR).min(fd.max * 0.999), fd.min);
+                    for (side, (d, word)) in [(lower - x, "smaller"), (upper - x, "larger")].into_iter().enumerate() {
+                        let rise_at = |d: f64| (profile_at(&f, &fit_result.x, i, d, &step) - rss0) / u.s2;
+                        let rise = rise_at(d);
+                        if !(rise >= CHI2_95) {
+                            verdict = Some((
+                                i,
+                                format!(
+                                    "a value {:.3} times {word} fits the data as well (misfit up by {:.2} s^2, less \
+                                     than the 95 % threshold {CHI2_95}): the data bound it from one side at most",
+                                    (coords[i].value(x + d) / v).max(v / coords[i].value(x + d)),
+                                    rise.max(0.0)
+                                ),
+                            ));
+                            break;
+                        }
+                        // The 95 % profile-likelihood bound on this side:
+                        // where the profile crosses CHI2_95 (bisection).
+                        let (mut inside, mut outside) = (0.0, d);
+                        for _ in 0..PROFILE_BISECTIONS {
+                            let mid = 0.5 * (inside + outside);
+                            if rise_at(mid) < CHI2_95 {
+                                inside = mid;
+                            } else {
+                                outside = mid;
+                            }
+                        }
+                        let bound = coords[i].value(x + 0.5 * (inside + outside));
+                        if side == 0 {
+                            profile_ci[i].0 = bound;
+                        } else {
+                            profile_ci[i].1 = bound;
+                        }
+                    }
+                    if verdict.is_some() {
+                        break;
+                    }
+                }
+                if let Some((i, reason)) = verdict {
+                    dropped.push((free[i], reason));
+                    free.remove(i);
+                    continue;
+                }
+                core = with(&fit_result.x);
+                warnings.extend(u.warnings());
+                last = Some((u, fit_result.x, coords, profile_ci));
+                break;
+            }
+        }
+    }
+    // The fitted twin at another substep count? Check the chooser agrees.
+    let mut params = *base;
+    params.core = core;
+    params
+        .validate()
+        .map_err(|e| CliError::Failed(format!("identified parameters are not valid: {e}")))?;
+    if let Ok(after) = chosen(&params, tick)
+        && after.config.substeps > config.substeps
+    {
+        warnings.push(format!(
+            "the identified design needs {} substeps per tick where the fit ran {}: rerun with the \
+             written preset as --params to refine",
+            after.config.substeps, config.substeps
+        ));
+    }
+    let (rms_x, rms_p) = channel_rms(&core, config, data)
+        .ok_or_else(|| CliError::Failed("the twin fails at the identified parameters".into()))?;
+    let (dof, condition) = last.as_ref().map_or((n_res, 1.0), |(u, ..)| (u.dof, u.condition));
+    let results = fit
+        .iter()
+        .map(|p| {
+            let f = field(p);
+            if let Some((_, reason)) = dropped.iter().find(|(d, _)| d == p) {
+                return Identified {
+                    path: f.path,
+                    unit: f.unit,
+                    estimate: None,
+                    reason: reason.clone(),
+                };
+            }
+            let (u, x, coords, ci) = last.as_ref().expect("a parameter left free was fitted");
+            let i = free.iter().position(|q| q == p).expect("free parameter");
+            let se = u.std_errors()[i];
+            Identified {
+                path: f.path,
+                unit: f.unit,
+                estimate: Some(Estimate {
+                    value: coords[i].value(x[i]),
+                    std_error: coords[i].std_error(x[i], se),
+                    ci95: ci[i],
+                    wald95: coords[i].interval(x[i], se),
+                }),
+                reason: String::new(),
+            }
+        })
+        .collect();
+    Ok(Identification {
+        params,
+        results,
+        config,
+        rms_x,
+        rms_p,
+        points: n_res,
+        dof,
+        condition,
+        warnings,
+    })
+}
+
+impl Identification {
+    /// The report table (CSV), one row per requested parameter:
+    /// `parameter,unit,identifiable,value,std_error,rel_std_error,ci95_low,ci95_high`
+    /// (the numbers empty for a parameter the data do not determine).
+    pub fn table(&self) -> String {
+        let mut out = String::from("parameter,unit,identifiable,value,std_error,rel_std_error,ci95_low,ci95_high\n");
+        for r in &self.results {
+            let unit = r.unit.replace(' ', "_");
+            match r.estimate {
+                Some(Estimate {
+                    value,
+                    std_error,
+                    ci95: (lo, hi),
+                    ..
+                }) => {
+                    let _ = writeln!(
+                        out,
+                        "{},{unit},true,{value},{std_error},{},{lo},{hi}",
+                        r.path,
+                        std_error / value.abs()
+                    );
+                }
+                None => {
+                    let _ = writeln!(out, "{},{unit},false,,,,,", r.path);
+                }
+            }
+        }
+        out
+    }
+
+    /// Lines for standard error: the fit, and each parameter not identified.
+    pub fn notes(&self) -> Vec<String> {
+        let mut out = vec![format!(
+            "twin {} ({} substeps per {} s sample); {} residuals, {} degrees of freedom; residual RMS {:.4e} m{}; \
+             condition number {:.1e}",
+            self.config.scheme.name(),
+            self.config.substeps,
+            self.config.tick,
+            self.points,
+            self.dof,
+            self.rms_x,
+            self.rms_p.map_or(String::new(), |p| format!(", pressures {p:.4e} Pa")),
+            self.condition
+        )];
+        for r in &self.results {
+            if r.estimate.is_none() {
+                out.push(format!(
+                    "NOT IDENTIFIABLE: {}: {}; kept at the base file's value in the preset",
+                    r.path, r.reason
+                ));
+            }
+        }
+        out.extend(self.warnings.iter().map(|w| format!("WARNING: {w}")));
+        out
+    }
+
+    /// The identified parameter file: TOML with the fit in comments.
+    pub fn preset(&self, command: &str) -> String {
+        let mut out = String::from("# Dynamic parameters identified from a measured transient.\n");
+        let _ = writeln!(out, "# Generated by: {command}");
+        for line in self.notes() {
+            let _ = writeln!(out, "# {line}");
+        }
+        for r in &self.results {
+            if let Some(e) = r.estimate {
+                let _ = writeln!(
+                    out,
+                    "# {} = {} {} (standard error {:.3e}, 95 % interval {:.4e} .. {:.4e})",
+                    r.path, e.value, r.unit, e.std_error, e.ci95.0, e.ci95.1
+                );
+            }
+        }
+        out.push('\n');
+        out.push_str(&params_file::to_toml(&self.params));
+        out
+    }
+
+    /// The figure of `--plot`: measured and simulated displacement (and
+    /// pressures) over time.
+    pub fn figure(&self, data: &Transient) -> crate::plot::Figure {
+        use crate::plot::{Figure, Panel, Series};
+        let sim = simulate(&self.params.core, self.config, data).unwrap_or_default();
+        let series = |label: &str, pts: Vec<(f64, f64)>, dashed: bool| Series {
+            label: label.into(),
+            points: pts,
+            dashed,
+            ..Series::line(label, Vec::new())
+        };
+        let t = &data.time_s;
+        let mut panels = vec![Panel {
+            y_desc: "x [mm]".into(),
+            log_y: false,
+            legend: true,
+            series: vec![
+                series(
+                    "measured",
+                    t.iter().zip(&data.x_m).map(|(t, x)| (*t, x * 1e3)).collect(),
+                    true,
+                ),
+                series(
+                    "identified twin",
+                    t.iter().zip(&sim).map(|(t, y)| (*t, y[0] * 1e3)).collect(),
+                    false,
+                ),
+            ],
+        }];
+        if let Some(p) = &data.p_pa {
+            panels.push(Panel {
+                y_desc: "p [bar]".into(),
+                log_y: false,
+                legend: true,
+                series: vec![
+                    series(
+                        "p_a measured",
+                        t.iter().zip(p).map(|(t, p)| (*t, p.0 * 1e-5)).collect(),
+                        true,
+                    ),
+                    series(
+                        "p_b measured",
+                        t.iter().zip(p).map(|(t, p)| (*t, p.1 * 1e-5)).collect(),
+                        true,
+                    ),
+                    series(
+                        "p_a twin",
+                        t.iter().zip(&sim).map(|(t, y)| (*t, y[1] * 1e-5)).collect(),
+                        false,
+                    ),
+                    series(
+                        "p_b twin",
+                        t.iter().zip(&sim).map(|(t, y)| (*t, y[2] * 1e-5)).collect(),
+                        false,
+                    ),
+                ],
+            });
+        }
+        panels.push(Panel {
+            y_desc: "temperature [C]".into(),
+            log_y: false,
+            legend: false,
+            series: vec![series(
+                "t_c",
+                t.iter().zip(&data.t_c).map(|(t, c)| (*t, *c)).collect(),
+                false,
+            )],
+        });
+        Figure {
+            title: "Identification: measured transient and the identified twin".into(),
+            x_desc: "time [s]".into(),
+            panels,
+        }
+    }
+}
+
+/// Options of `identify`.
+#[derive(Debug, Clone, Default)]
+pub struct Options {
+    /// Base parameter file (static parameters already calibrated).
+    pub params: PathBuf,
+    /// The transient (CSV).
+    pub data: PathBuf,
+    /// `--fit` list ([`parse_fit`]); `None`: [`DEFAULT_FIT`].
+    pub fit: Option<String>,
+    /// Where to write the identified parameter file.
+    pub write_preset: Option<PathBuf>,
+    /// Where to draw the fit (SVG).
+    pub plot: Option<PathBuf>,
+}
+
+/// `identify`: the report table (CSV) and the lines for standard error.
+///
+/// Errors: bad parameter file or data (exit 2, naming the field, row and
+/// column), too few degrees of freedom (exit 2), a fit that fails (exit 1).
+pub fn identify(opts: &Options) -> Result<(String, Vec<String>), CliError> {
+    let fit = match &opts.fit {
+        Some(list) => parse_fit(list).map_err(|e| CliError::Input(format!("--fit: {e}")))?,
+        None => DEFAULT_FIT.to_vec(),
+    };
+    let base = crate::input::load_raw(&opts.params, "--params")?;
+    let shown = opts.data.display().to_string();
+    let text = crate::input::params_text(&opts.data, "--data")?;
+    let data = read_transient(&text).map_err(|e| CliError::Input(format!("--data: {shown}: {e}")))?;
+    let id = identify_params(&base, &data, &fit)?;
+    if let Some(path) = &opts.write_preset {
+        let command = format!(
+            "compensator identify --params {} --data {shown} --fit {}",
+            opts.params.display(),
+            fit.join(",")
+        );
+        std::fs::write(path, id.preset(&command))
+            .map_err(|e| CliError::Input(format!("--write-preset: {}: {e}", path.display())))?;
+    }
+    if let Some(path) = &opts.plot {
+        crate::plot::write(path, &id.figure(&data))?;
+    }
+    Ok((id.table(), id.notes()))
+}

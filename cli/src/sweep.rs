@@ -1,0 +1,500 @@
+//! `sweep`: design variants of a parameter file, on a grid of named
+//! parameters (`--set plunger.spring_rate=20e3:30e3:5`) and/or drawn
+//! within tolerances (`--vary plunger.diameter=1% --samples N --seed S`),
+//! each evaluated by the library functions the single commands use:
+//!
+//! * `x_<T>c_m`: quasi-static displacement at each `--temps` temperature
+//!   (`equilibrium`, Eqs. 2-10);
+//! * `monotonic`, `min_dx_dt_m_k`: the Eq. (32) verdict over the file's
+//!   validated range at 0.1 C spacing, and the smallest `|dx/dt|` found
+//!   (`compensator::asymptotic::monotonicity`, as `paper`);
+//! * `dominant_re`, `settling_time_s`: the dominant eigenvalue's real part
+//!   [1/s] at the step's final temperature and the 2 % settling time of the
+//!   step `--step FROM:TO` (reference solver, as `indicators`:
+//!   [`crate::dynamics::step_indicators`]);
+//! * `comp_error_rms_m3s`: the RMS compensation error over the validated
+//!   range at 1 C spacing (`compensation`; only when the file has a
+//!   `[machine]` section).
+//!
+//! Variants run on all cores (rayon); each variant's draws come from one
+//! seeded generator advanced in variant order before anything runs, and
+//! the rows are collected in variant order, so the output does not depend
+//! on the number of threads. A variant that cannot be evaluated (a varied
+//! value outside its field's plausible range, a design whose equilibrium
+//! fails) keeps its parameter values and says why in the `error` column.
+
+use crate::csv::Table;
+use crate::dynamics::{parse_steps, step_indicators, tick_count};
+use crate::error::CliError;
+use crate::temps;
+use compensator::asymptotic::monotonicity;
+use compensator::compensation::compensation;
+use compensator::equilibrium::equilibrium;
+use compensator::params::{CORE_FIELDS, ESTIMATOR_FIELDS, Field, MACHINE_FIELDS};
+use compensator::{Params, RawParams};
+use rand::{RngExt, SeedableRng, rngs::Xoshiro256PlusPlus};
+use rayon::prelude::*;
+use std::io::IsTerminal;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// Most variants of one sweep.
+pub const MAX_VARIANTS: usize = 1_000_000;
+
+/// A parameter file's field by its `section.key` name.
+pub fn field(name: &str) -> Option<&'static Field> {
+    CORE_FIELDS
+        .iter()
+        .chain(MACHINE_FIELDS.iter())
+        .chain(ESTIMATOR_FIELDS.iter())
+        .find(|f| f.path == name)
+}
+
+/// `raw` with the field `path` set to `value` (not validated).
+///
+/// # Errors
+///
+/// A `[machine]` field when `raw` has no `[machine]` section.
+pub fn with_value(raw: &RawParams, path: &str, value: f64) -> Result<RawParams, String> {
+    let set = |n: compensator::params::Named| if n.path == path { value } else { n.value };
+    let mut out = *raw;
+    out.core = raw.core.map(set);
+    out.estimator = raw.estimator.map(set);
+    match &raw.machine {
+        Some(m) => out.machine = Some(m.map(set)),
+        None if path.starts_with("machine.") => {
+            return Err(format!("{path}: the parameter file has no [machine] section"));
+        }
+        None => {}
+    }
+    Ok(out)
+}
+
+/// One `--set NAME=SPEC`: a field and its values.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GridAxis {
+    /// The field's `section.key`.
+    pub name: &'static str,
+    /// Its values [the field's unit].
+    pub values: Vec<f64>,
+}
+
+/// One `--vary NAME=TOL`: a field drawn uniformly within a tolerance
+/// around its (grid or file) value.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Tolerance {
+    /// The field's `section.key`.
+    pub name: &'static str,
+    /// Half-width of the band: a fraction of the value (`1%` -> 0.01) or,
+    /// if `relative` is false, an absolute amount [the field's unit].
+    pub half_width: f64,
+    /// Whether `half_width` is a fraction of the value.
+    pub relative: bool,
+}
+
+/// Splits `NAME=SPEC` and finds the field (unknown name: bad input naming it).
+fn name_and_spec<'a>(flag: &str, arg: &'a str) -> Result<(&'static Field, &'a str), CliError> {
+    let (name, spec) = arg
+        .split_once('=')
+        .ok_or_else(|| CliError::Input(format!("{flag}: '{arg}' is not of the form section.key=...")))?;
+    let name = name.trim();
+    let f = field(name).ok_or_else(|| {
+        CliError::Input(format!(
+            "{flag}: unknown parameter '{name}' (the names are section.key of docs/parameters.md)"
+        ))
+    })?;
+    Ok((f, spec.trim()))
+}
+
+fn number(flag: &str, name: &str, s: &str) -> Result<f64, CliError> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ => Err(CliError::Input(format!("{flag}: {name}: '{s}' is not a finite number"))),
+    }
+}
+
+/// Parses `--set NAME=START:END:N` (N evenly spaced values, both ends
+/// included) or `NAME=V1,V2,...`.
+pub fn parse_set(arg: &str) -> Result<GridAxis, CliError> {
+    let (f, spec) = name_and_spec("--set", arg)?;
+    let values = if spec.contains(':') {
+        let parts: Vec<&str> = spec.split(':').collect();
+        if parts.len() != 3 {
+            return Err(CliError::Input(format!(
+                "--set: {}: '{spec}' is not of the form start:end:count",
+                f.path
+            )));
+        }
+        let (a, b) = (number("--set", f.path, parts[0])?, number("--set", f.path, parts[1])?);
+        let n: usize = parts[2]
+            .trim()
+            .parse()
+            .ok()
+            .filter(|n| (1..=MAX_VARIANTS).contains(n))
+            .ok_or_else(|| {
+                CliError::Input(format!(
+                    "--set: {}: count '{}' is not a whole number in 1..={MAX_VARIANTS}",
+                    f.path, parts[2]
+                ))
+            })?;
+        if n == 1 {
+            vec![a]
+        } else {
+            (0..n).map(|i| a + (b - a) * i as f64 / (n - 1) as f64).collect()
+        }
+    } else {
+        spec.split(',')
+            .map(|s| number("--set", f.path, s))
+            .collect::<Result<Vec<_>, _>>()?
+    };
+    Ok(GridAxis { name: f.path, values })
+}
+
+/// Parses `--vary NAME=P%` (relative) or `NAME=A` (absolute, the field's unit).
+pub fn parse_vary(arg: &str) -> Result<Tolerance, CliError> {
+    let (f, spec) = name_and_spec("--vary", arg)?;
+    let (text, relative) = match spec.strip_suffix('%') {
+        Some(p) => (p, true),
+        None => (spec, false),
+    };
+    let v = number("--vary", f.path, text)?;
+    if v < 0.0 {
+        return Err(CliError::Input(format!("--vary: {}: '{spec}' is negative", f.path)));
+    }
+    Ok(Tolerance {
+        name: f.path,
+        half_width: if relative { v / 100.0 } else { v },
+        relative,
+    })
+}
+
+/// What a sweep computes for each variant.
+#[derive(Clone, Debug)]
+pub struct Metrics {
+    /// Temperatures of the displacement columns [C].
+    pub temps: Vec<f64>,
+    /// The step of the settling time and dominant eigenvalue [C].
+    pub step: (f64, f64),
+    /// Output interval of the reference solver for the settling time [s].
+    pub dt: f64,
+    /// Simulated time of the step [s].
+    pub t_end: f64,
+}
+
+/// A sweep: the base file, the grid, the tolerances.
+#[derive(Clone, Debug)]
+pub struct Sweep {
+    /// The base parameter set.
+    pub base: RawParams,
+    /// `--set` axes (their cartesian product; the first varies slowest).
+    pub grid: Vec<GridAxis>,
+    /// `--vary` tolerances.
+    pub vary: Vec<Tolerance>,
+    /// Draws per grid point (1 without `vary`).
+    pub samples: usize,
+    /// Seed of the draws.
+    pub seed: u64,
+    /// What to compute.
+    pub metrics: Metrics,
+}
+
+impl Sweep {
+    /// The parameter columns: the grid's fields, then the varied ones not
+    /// already on the grid.
+    pub fn parameter_names(&self) -> Vec<&'static str> {
+        let mut names: Vec<&'static str> = self.grid.iter().map(|a| a.name).collect();
+        for t in &self.vary {
+            if !names.contains(&t.name) {
+                names.push(t.name);
+            }
+        }
+        names
+    }
+
+    /// Number of variants: the grid's points times the samples.
+    ///
+    /// # Errors
+    ///
+    /// More than [`MAX_VARIANTS`] (bad input naming `--set/--samples`).
+    pub fn variant_count(&self) -> Result<usize, CliError> {
+        let mut n = self.samples.max(1);
+        for a in &self.grid {
+            n = n
+                .checked_mul(a.values.len())
+                .filter(|&n| n <= MAX_VARIANTS)
+                .ok_or_else(|| CliError::Input(format!("--set/--samples: more than {MAX_VARIANTS} variants")))?;
+        }
+        Ok(n)
+    }
+
+    /// Every variant's parameter values (in [`Self::parameter_names`]
+    /// order), in variant order: grid points, and for each `samples`
+    /// draws from one generator seeded with `seed` (Xoshiro256++).
+    pub fn variants(&self) -> Result<Vec<Vec<f64>>, CliError> {
+        let n = self.variant_count()?;
+        let names = self.parameter_names();
+        let samples = self.samples.max(1);
+        let base_value = |name: &str| {
+            let all = self
+                .base
+                .core
+                .named()
+                .into_array()
+                .into_iter()
+                .chain(self.base.estimator.named().into_array())
+                .chain(self.base.machine.iter().flat_map(|m| m.named().into_array()));
+            all.into_iter().find(|n| n.path == name).map_or(f64::NAN, |n| n.value)
+        };
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(self.seed);
+        let mut out = Vec::with_capacity(n);
+        for i in 0..n {
+            let mut point = i / samples;
+            let mut values: Vec<f64> = names.iter().map(|name| base_value(name)).collect();
+            // Grid index: the last axis varies fastest.
+            for (k, axis) in self.grid.iter().enumerate().rev() {
+                values[k] = axis.values[point % axis.values.len()];
+                point /= axis.values.len();
+            }
+            for t in &self.vary {
+                let k = names.iter().position(|n| *n == t.name).unwrap_or(0);
+                let u: f64 = rng.random_range(-1.0..=1.0);
+                values[k] += if t.relative {
+                    values[k] * t.half_width * u
+                } else {
+                    t.half_width * u
+                };
+            }
+            out.push(values);
+        }
+        Ok(out)
+    }
+}
+
+/// The column names of the metrics.
+pub fn metric_columns(metrics: &Metrics, with_machine: bool) -> Vec<String> {
+    let mut cols: Vec<String> = metrics.temps.iter().map(|t| format!("x_{t}c_m")).collect();
+    cols.extend(
+        ["monotonic", "min_dx_dt_m_k", "dominant_re", "settling_time_s"]
+            .iter()
+            .map(|s| s.to_string()),
+    );
+    if with_machine {
+        cols.push("comp_error_rms_m3s".into());
+    }
+    cols
+}
+
+/// One variant's metrics as CSV cells, or why it could not be evaluated.
+pub fn evaluate(raw: &RawParams, metrics: &Metrics) -> Result<Vec<String>, String> {
+    raw.validate().map_err(|e| e.to_string())?;
+    let p = Params::<f64>::new(raw).map_err(|e| e.to_string())?;
+    let mut cells = Vec::new();
+    for &t in &metrics.temps {
+        let e = equilibrium(&p, t).map_err(|e| format!("{t} C: {e}"))?;
+        cells.push(format!("{}", e.x));
+    }
+    let (lo, hi) = (raw.estimator.valid_min, raw.estimator.valid_max);
+    let samples = (((hi - lo) / 0.1).round() as u32).saturating_add(1);
+    let m = monotonicity(&p, lo, hi, samples).map_err(|e| format!("Eq. (32) over {lo}-{hi} C: {e}"))?;
+    cells.push(m.monotonic.to_string());
+    cells.push(format!("{}", m.worst_dx_dt));
+    let (from, to) = metrics.step;
+    let ind = step_indicators(raw, &p, from, to, metrics.dt, metrics.t_end).map_err(|e| e.to_string())?;
+    cells.push(format!("{}", ind.dominant_re));
+    cells.push(format!("{}", ind.settling_time));
+    if p.machine.is_some() {
+        let n = (hi - lo).floor() as usize;
+        let mut sum = 0.0;
+        for i in 0..=n {
+            let t = lo + i as f64;
+            let c = compensation(&p, t).map_err(|e| format!("compensation at {t} C: {e}"))?;
+            sum += c.error * c.error;
+        }
+        cells.push(format!("{}", (sum / (n + 1) as f64).sqrt()));
+    }
+    Ok(cells)
+}
+
+/// Progress on standard error: drawn only when it is a terminal, and only
+/// once the run has lasted a second (a short sweep prints nothing).
+struct Progress {
+    bar: indicatif::ProgressBar,
+    start: Instant,
+    terminal: bool,
+    shown: AtomicBool,
+}
+
+impl Progress {
+    fn new(n: usize) -> Self {
+        let bar = indicatif::ProgressBar::with_draw_target(Some(n as u64), indicatif::ProgressDrawTarget::hidden());
+        if let Ok(style) =
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} variants, {rate} variants/s, eta {eta}")
+        {
+            let rate = |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                let _ = write!(w, "{:.0}", state.per_sec());
+            };
+            bar.set_style(style.with_key("rate", rate));
+        }
+        Progress {
+            bar,
+            start: Instant::now(),
+            terminal: std::io::stderr().is_terminal(),
+            shown: AtomicBool::new(false),
+        }
+    }
+
+    fn inc(&self) {
+        if self.terminal && self.start.elapsed() > Duration::from_secs(1) && !self.shown.swap(true, Ordering::Relaxed) {
+            self.bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+        }
+        self.bar.inc(1);
+    }
+
+    fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}
+
+/// Runs the sweep: one row per variant, `variant` (0-based), the parameter
+/// columns, the metrics; a variant that fails has an `error` cell.
+pub fn run(sweep: &Sweep) -> Result<String, CliError> {
+    let variants = sweep.variants()?;
+    let names = sweep.parameter_names();
+    let metrics = &sweep.metrics;
+    let with_machine = sweep.base.machine.is_some();
+    let mut header: Vec<String> = vec!["variant".into()];
+    header.extend(names.iter().map(|s| s.to_string()));
+    header.extend(metric_columns(metrics, with_machine));
+    let header_refs: Vec<&str> = header.iter().map(String::as_str).collect();
+    let progress = Progress::new(variants.len());
+    let results: Vec<Result<Vec<String>, String>> = variants
+        .par_iter()
+        .map(|values| {
+            let mut raw = sweep.base;
+            let mut r = Ok(());
+            for (name, &v) in names.iter().zip(values) {
+                match with_value(&raw, name, v) {
+                    Ok(next) => raw = next,
+                    Err(e) => r = Err(e),
+                }
+            }
+            let out = r.and_then(|()| evaluate(&raw, metrics));
+            progress.inc();
+            out
+        })
+        .collect();
+    progress.finish();
+    let mut table = Table::new(&header_refs);
+    for (i, (values, result)) in variants.iter().zip(results).enumerate() {
+        let mut lead: Vec<String> = vec![i.to_string()];
+        lead.extend(values.iter().map(|v| format!("{v}")));
+        match result {
+            Ok(cells) => {
+                lead.extend(cells);
+                table.row_cells(&lead);
+            }
+            Err(e) => {
+                let lead: Vec<f64> = std::iter::once(i as f64).chain(values.iter().copied()).collect();
+                table.row_error(&lead, &e);
+            }
+        }
+    }
+    Ok(table.as_str().to_string())
+}
+
+/// Builds a sweep from the command's arguments.
+#[allow(clippy::too_many_arguments)]
+pub fn build(
+    base: RawParams,
+    set: &[String],
+    vary: &[String],
+    samples: Option<usize>,
+    seed: u64,
+    temps_spec: &str,
+    step_spec: &str,
+    dt: f64,
+    t_end: f64,
+) -> Result<Sweep, CliError> {
+    let grid = set.iter().map(|s| parse_set(s)).collect::<Result<Vec<_>, _>>()?;
+    for (i, a) in grid.iter().enumerate() {
+        if grid[..i].iter().any(|b| b.name == a.name) {
+            return Err(CliError::Input(format!("--set: {} is given twice", a.name)));
+        }
+    }
+    let vary = vary.iter().map(|s| parse_vary(s)).collect::<Result<Vec<_>, _>>()?;
+    for (i, a) in vary.iter().enumerate() {
+        if vary[..i].iter().any(|b| b.name == a.name) {
+            return Err(CliError::Input(format!("--vary: {} is given twice", a.name)));
+        }
+    }
+    for name in grid.iter().map(|a| a.name).chain(vary.iter().map(|t| t.name)) {
+        if name.starts_with("machine.") && base.machine.is_none() {
+            return Err(CliError::Input(format!(
+                "{name}: the parameter file has no [machine] section"
+            )));
+        }
+    }
+    let samples = match (samples, vary.is_empty()) {
+        (Some(0), _) => return Err(CliError::Input("--samples: must be at least 1".into())),
+        (Some(n), false) => n,
+        (Some(_), true) => {
+            return Err(CliError::Input("--samples: draws need --vary NAME=TOL".into()));
+        }
+        (None, false) => 100,
+        (None, true) => 1,
+    };
+    let temps = temps::parse(temps_spec)?;
+    if temps.len() > 100 {
+        return Err(CliError::Input("--temps: at most 100 temperatures in a sweep".into()));
+    }
+    let steps = parse_steps(step_spec).map_err(|e| CliError::Input(e.to_string().replace("--steps", "--step")))?;
+    let [step] = steps[..] else {
+        return Err(CliError::Input(format!(
+            "--step: '{step_spec}' is not one from:to pair"
+        )));
+    };
+    tick_count(t_end, dt)?;
+    let sweep = Sweep {
+        base,
+        grid,
+        vary,
+        samples,
+        seed,
+        metrics: Metrics { temps, step, dt, t_end },
+    };
+    sweep.variant_count()?;
+    Ok(sweep)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grids_and_tolerances_parse() {
+        let a = parse_set("plunger.spring_rate=20e3:30e3:5").unwrap();
+        assert_eq!(a.name, "plunger.spring_rate");
+        assert_eq!(a.values, vec![20e3, 22.5e3, 25e3, 27.5e3, 30e3]);
+        assert_eq!(parse_set("plunger.mass=0.01,0.02").unwrap().values, vec![0.01, 0.02]);
+        let t = parse_vary("plunger.diameter=1%").unwrap();
+        assert!(t.relative && (t.half_width - 0.01).abs() < 1e-15);
+        let e = parse_set("plunger.sprig_rate=1:2:2").unwrap_err();
+        assert_eq!(e.exit_code(), 2);
+        assert!(e.to_string().contains("plunger.sprig_rate"), "{e}");
+        assert!(parse_set("plunger.mass=1:2:0").is_err());
+        assert!(parse_vary("plunger.mass=-1%").is_err());
+    }
+
+    #[test]
+    fn with_value_sets_exactly_the_named_field() {
+        let raw = crate::params_file::parse(crate::input::PAPER_PRESET).unwrap();
+        let out = with_value(&raw, "plunger.spring_rate", 12345.0).unwrap();
+        assert_eq!(out.core.spring_rate, 12345.0);
+        let mut back = out;
+        back.core.spring_rate = raw.core.spring_rate;
+        assert_eq!(back, raw);
+        let out = with_value(&raw, "estimator.valid_max", 70.0).unwrap();
+        assert_eq!(out.estimator.valid_max, 70.0);
+        assert_eq!(out.core, raw.core);
+    }
+}

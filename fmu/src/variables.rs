@@ -1,0 +1,242 @@
+//! The FMU's variables: one flat scalar each, with its value reference,
+//! causality, unit and description. The parameters are the parameter
+//! file's fields, taken from the schema (`compensator_params::CORE_FIELDS`,
+//! `MACHINE_FIELDS`, `ESTIMATOR_FIELDS`): names, units, descriptions and
+//! plausible ranges are never restated here.
+
+use compensator_params::{CORE_FIELDS, ESTIMATOR_FIELDS, Field, Kind, MACHINE_FIELDS};
+
+/// Value reference of the independent variable `time` [s] (declared in
+/// FMI 3.0 only, where it is required).
+pub const VR_TIME: u32 = 0;
+/// Value reference of the input `T_oil` [degC].
+pub const VR_T_OIL: u32 = 1;
+/// Value reference of the first output (`x`); the outputs follow in
+/// [`OUTPUTS`] order.
+pub const VR_FIRST_OUTPUT: u32 = 10;
+/// Value reference of the Boolean parameter `machine.present`.
+pub const VR_MACHINE_PRESENT: u32 = 100;
+/// Value reference of the first parameter-file field; the fields follow in
+/// [`fields`] order (core, machine, estimator: file order).
+pub const VR_FIRST_FIELD: u32 = 1000;
+
+/// An output of the twin.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Output {
+    /// Variable name.
+    pub name: &'static str,
+    /// FMI unit name (`None`: an integer, no unit).
+    pub unit: Option<&'static str>,
+    /// Description.
+    pub doc: &'static str,
+}
+
+/// The outputs, in value-reference order from [`VR_FIRST_OUTPUT`]; the last
+/// (`flags`) is an integer, the others are Float64.
+pub const OUTPUTS: [Output; 10] = [
+    Output {
+        name: "x",
+        unit: Some("m"),
+        doc: "Plunger displacement (0: window closed).",
+    },
+    Output {
+        name: "v",
+        unit: Some("m/s"),
+        doc: "Plunger velocity.",
+    },
+    Output {
+        name: "p_a",
+        unit: Some("Pa"),
+        doc: "Chamber (a) pressure.",
+    },
+    Output {
+        name: "p_b",
+        unit: Some("Pa"),
+        doc: "Chamber (b) pressure.",
+    },
+    Output {
+        name: "Q_a",
+        unit: Some("m3/s"),
+        doc: "Flow leaving chamber (a) through its capillary.",
+    },
+    Output {
+        name: "Q_b",
+        unit: Some("m3/s"),
+        doc: "Flow leaving chamber (b) through its orifice.",
+    },
+    Output {
+        name: "Q_throt",
+        unit: Some("m3/s"),
+        doc: "Flow through the window opened by the plunger.",
+    },
+    Output {
+        name: "Q0",
+        unit: Some("m3/s"),
+        doc: "Total flow Q0 = Q_a + Q_b + Q_throt.",
+    },
+    Output {
+        name: "compensation_error",
+        unit: Some("m3/s"),
+        doc: "Q0 - (Q_work + dQ_lost(T)) of the driven machine; NaN when machine.present is false.",
+    },
+    Output {
+        name: "flags",
+        unit: None,
+        doc: "Estimator flags, a bit set: 1 AT_STOP, 2 OUT_OF_RANGE, 4 NOT_UNIQUE, 8 UNSTABLE, 16 SENSOR_FAULT, 64 DEGRADED (docs/fmu.md).",
+    },
+];
+
+/// Index of `flags` in [`OUTPUTS`].
+pub const FLAGS_OUTPUT: usize = 9;
+
+/// The parameter file's fields in file order: core, machine, estimator.
+pub fn fields() -> impl Iterator<Item = &'static Field> {
+    CORE_FIELDS
+        .iter()
+        .chain(MACHINE_FIELDS.iter())
+        .chain(ESTIMATOR_FIELDS.iter())
+}
+
+/// Number of parameter-file fields.
+pub const FIELD_COUNT: usize = CORE_FIELDS.len() + MACHINE_FIELDS.len() + ESTIMATOR_FIELDS.len();
+
+/// The field of value reference `vr`, with its index in [`fields`] order.
+pub fn field_of(vr: u32) -> Option<(usize, &'static Field)> {
+    let i = vr.checked_sub(VR_FIRST_FIELD)? as usize;
+    fields().nth(i).map(|f| (i, f))
+}
+
+/// The lowest value a field accepts (zero for a field that may be zero).
+pub fn field_min(f: &Field) -> f64 {
+    if f.kind == Kind::OrZero { 0.0 } else { f.min }
+}
+
+/// An FMI unit: its name and its SI base-unit exponents (`kg, m, s, A, K,
+/// mol, cd, rad`) with `factor` and `offset` (`value_SI = factor * value +
+/// offset`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Unit {
+    /// Name (Modelica spelling: `m3/s`, `degC`, `N.s/m`).
+    pub name: &'static str,
+    /// Exponents of kg, m, s, A, K, mol, cd, rad.
+    pub exponents: [i8; 8],
+    /// Factor to SI.
+    pub factor: f64,
+    /// Offset to SI.
+    pub offset: f64,
+}
+
+const fn unit(name: &'static str, exponents: [i8; 8]) -> Unit {
+    Unit {
+        name,
+        exponents,
+        factor: 1.0,
+        offset: 0.0,
+    }
+}
+
+/// Every unit the FMU declares: the schema's units and the outputs'.
+pub const UNITS: [Unit; 16] = [
+    unit("m", [0, 1, 0, 0, 0, 0, 0, 0]),
+    unit("m/s", [0, 1, -1, 0, 0, 0, 0, 0]),
+    unit("Pa", [1, -1, -2, 0, 0, 0, 0, 0]),
+    unit("m3/s", [0, 3, -1, 0, 0, 0, 0, 0]),
+    unit("m3", [0, 3, 0, 0, 0, 0, 0, 0]),
+    unit("kg", [1, 0, 0, 0, 0, 0, 0, 0]),
+    unit("kg/m3", [1, -3, 0, 0, 0, 0, 0, 0]),
+    unit("1/K", [0, 0, 0, 0, -1, 0, 0, 0]),
+    unit("1/K2", [0, 0, 0, 0, -2, 0, 0, 0]),
+    unit("1/K4", [0, 0, 0, 0, -4, 0, 0, 0]),
+    unit("N.s/m", [1, 0, -1, 0, 0, 0, 0, 0]),
+    unit("N/m", [1, 0, -2, 0, 0, 0, 0, 0]),
+    unit("s", [0, 0, 1, 0, 0, 0, 0, 0]),
+    unit("Hz", [0, 0, -1, 0, 0, 0, 0, 0]),
+    unit("Ohm", [1, 2, -3, -2, 0, 0, 0, 0]),
+    Unit {
+        name: "degC",
+        exponents: [0, 0, 0, 0, 1, 0, 0, 0],
+        factor: 1.0,
+        offset: 273.15,
+    },
+];
+
+/// The FMI unit of a schema unit (`"m^3/s"` -> `m3/s`, `"C"` -> `degC`,
+/// `"1/C"` -> `1/K`: a coefficient per degree is per kelvin); `None` for
+/// a dimensionless field (`"-"`) or a unit this table does not know (a
+/// unit test checks every schema field has one).
+pub fn fmi_unit(schema_unit: &str) -> Option<&'static str> {
+    Some(match schema_unit {
+        "m" => "m",
+        "m^3" => "m3",
+        "m^3/s" => "m3/s",
+        "kg" => "kg",
+        "kg/m^3" => "kg/m3",
+        "1/K" | "1/C" => "1/K",
+        "1/C^2" => "1/K2",
+        "1/C^4" => "1/K4",
+        "N s/m" => "N.s/m",
+        "N/m" => "N/m",
+        "Pa" => "Pa",
+        "s" => "s",
+        "Hz" => "Hz",
+        "ohm" => "Ohm",
+        "C" => "degC",
+        _ => return None,
+    })
+}
+
+/// The units the model description declares: those some variable uses, in
+/// [`UNITS`] order.
+pub fn used_units() -> Vec<Unit> {
+    let mut names: Vec<&str> = fields().filter_map(|f| fmi_unit(f.unit)).collect();
+    names.extend(OUTPUTS.iter().filter_map(|o| o.unit));
+    names.push("degC");
+    names.push("s");
+    UNITS.iter().copied().filter(|u| names.contains(&u.name)).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_schema_unit_is_declared() {
+        for f in fields() {
+            if f.unit == "-" {
+                continue;
+            }
+            let name = fmi_unit(f.unit).unwrap_or_else(|| panic!("{}: unit {} has no FMI unit", f.path, f.unit));
+            assert!(UNITS.iter().any(|u| u.name == name), "{}: {name} not in UNITS", f.path);
+        }
+        for o in OUTPUTS.iter().filter_map(|o| o.unit) {
+            assert!(UNITS.iter().any(|u| u.name == o));
+        }
+    }
+
+    #[test]
+    fn value_references_are_unique_and_resolve() {
+        assert_eq!(fields().count(), FIELD_COUNT);
+        let mut vrs: Vec<u32> = vec![VR_TIME, VR_T_OIL, VR_MACHINE_PRESENT];
+        vrs.extend((0..OUTPUTS.len() as u32).map(|i| VR_FIRST_OUTPUT + i));
+        vrs.extend((0..FIELD_COUNT as u32).map(|i| VR_FIRST_FIELD + i));
+        let n = vrs.len();
+        vrs.sort_unstable();
+        vrs.dedup();
+        assert_eq!(vrs.len(), n);
+        assert!(VR_FIRST_OUTPUT + OUTPUTS.len() as u32 <= VR_MACHINE_PRESENT);
+        for (i, f) in fields().enumerate() {
+            assert_eq!(field_of(VR_FIRST_FIELD + i as u32), Some((i, f)));
+        }
+        assert_eq!(field_of(VR_FIRST_FIELD + FIELD_COUNT as u32), None);
+        assert_eq!(field_of(VR_T_OIL), None);
+        assert_eq!(OUTPUTS[FLAGS_OUTPUT].name, "flags");
+    }
+
+    #[test]
+    fn temperatures_are_offset_from_kelvin() {
+        let c = UNITS.iter().find(|u| u.name == "degC").expect("degC");
+        assert_eq!((c.factor, c.offset), (1.0, 273.15));
+        assert_eq!(fmi_unit("C"), Some("degC"));
+        assert_eq!(fmi_unit("-"), None);
+    }
+}
