@@ -1,7 +1,5 @@
-//! CSV output with a header row; numbers in Rust's shortest round-trip form
-//! (`f64`'s `Display`), so that a value read back is bit-identical.
-
-use std::fmt::Write;
+//! CSV output with a header row; numbers in Rust's shortest round-trip form,
+//! so that a value read back is bit-identical, and compact ([`number`]).
 
 /// A CSV table built in memory and printed only when complete, so that a
 /// failure half-way leaves standard output empty.
@@ -58,7 +56,7 @@ impl Table {
             if i > 0 {
                 self.text.push(',');
             }
-            let _ = write!(self.text, "{v}");
+            self.text.push_str(&number(*v));
         }
         if self.has_error {
             self.text.push(',');
@@ -109,6 +107,16 @@ impl Table {
     pub fn as_str(&self) -> &str {
         &self.text
     }
+}
+
+/// `v` as the shorter of `f64`'s two shortest round-trip forms: positional
+/// (`Display`: `1`, `0.25`, `-12369.4`) or with an exponent (`Debug`:
+/// `4.5e-6`, `1e300`), so that no cell spells out the zeros of a tiny or
+/// huge value (`0.00000000000000000039928` was 38 characters; at most 24
+/// now: sign, 17 digits, point and a 4-character exponent).
+pub fn number(v: f64) -> String {
+    let (plain, exp) = (format!("{v}"), format!("{v:?}"));
+    if exp.len() < plain.len() { exp } else { plain }
 }
 
 /// A table of numbers read from a data file: its header and its rows, with
@@ -346,6 +354,30 @@ pub fn render(text: &str, format: Format) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbers_are_compact_and_read_back_exactly() {
+        for (v, want) in [
+            (1.0, "1"),
+            (0.25, "0.25"),
+            (-12369.436589746598, "-12369.436589746598"),
+            (-3.9928418951076473e-19, "-3.9928418951076473e-19"),
+            (4.5e-6, "4.5e-6"),
+            (1e300, "1e300"),
+            (f64::MIN_POSITIVE, "2.2250738585072014e-308"),
+            (5e-324, "5e-324"),
+            (0.0, "0"),
+        ] {
+            assert_eq!(number(v), want);
+            assert_eq!(number(v).parse::<f64>().unwrap().to_bits(), v.to_bits());
+        }
+        // Never longer than 24 characters.
+        let mut x = 1.2345678901234567e-300;
+        while x < 1e300 {
+            assert!(number(x).len() <= 24 && number(-x).len() <= 24, "{}", number(-x));
+            x *= 13.7;
+        }
+    }
 
     #[test]
     fn reads_what_spreadsheets_write() {

@@ -13,6 +13,8 @@
 //! cargo xtask callgrind [--bless]                host instruction counts against the baseline
 //! cargo xtask msrv                               rust-version against the locked dependencies
 //! cargo xtask target-tests                       the core's tests on the emulated Cortex-M4F
+//! cargo xtask fuzz [--seconds N] [--runs N] [--jobs J] [--keep-going] [--target T]...
+//!                                                the cargo-fuzz targets of fuzz/ (docs/fuzzing.md)
 //! cargo xtask toolchain                          find or provision the cross toolchain
 //! cargo xtask qemu-runner ELF [ARGS...]          run an ELF on QEMU (cargo runner for on-target tests)
 //! ```
@@ -37,6 +39,7 @@ mod callgrind;
 mod firmware;
 mod flash;
 mod fmu;
+mod fuzz;
 mod msrv;
 mod panic_free;
 mod params;
@@ -179,6 +182,26 @@ enum Command {
     Msrv,
     /// The core's tests on the emulated Cortex-M4F (defmt-test)
     TargetTests,
+    /// The cargo-fuzz targets of fuzz/, each for a bounded time or number
+    /// of executions (docs/fuzzing.md; installs cargo-fuzz if missing)
+    Fuzz {
+        /// Seconds per target [default: 30 unless --runs or a --target T=N is given]
+        #[arg(long, value_name = "N")]
+        seconds: Option<u64>,
+        /// Executions per target
+        #[arg(long, value_name = "N")]
+        runs: Option<u64>,
+        /// Parallel fuzzing processes per target (libFuzzer -fork)
+        #[arg(long, value_name = "J", default_value_t = 0)]
+        jobs: u32,
+        /// Go on after a crash, collecting every crash input (fails at the end)
+        #[arg(long)]
+        keep_going: bool,
+        /// Only this target, T or T=N for N executions of it (repeatable, run
+        /// in this order) [default: all]
+        #[arg(long = "target", value_name = "T")]
+        targets: Vec<String>,
+    },
     /// Find or provision the thumbv7em/thumbv7m toolchain
     Toolchain,
     /// Run an ELF on QEMU (netduinoplus2, or netduino2 for thumbv7m)
@@ -224,6 +247,27 @@ fn main() -> ExitCode {
             .map_err(Failure::from),
         Command::QemuRunner { elf, args: _ } => cmd_qemu_runner(&elf),
         Command::Callgrind { bless } => callgrind::check(&root(), bless).map(|_| 0).map_err(Failure::from),
+        Command::Fuzz {
+            seconds,
+            runs,
+            jobs,
+            keep_going,
+            targets,
+        } => {
+            let opts = fuzz::Options {
+                // 30 s unless executions bound the run (--runs or T=N).
+                seconds: seconds.or(if runs.is_none() && !targets.iter().any(|t| t.contains('=')) {
+                    Some(30)
+                } else {
+                    None
+                }),
+                runs,
+                jobs,
+                keep_going,
+                targets,
+            };
+            fuzz::run(&root(), &opts).map(|_| 0).map_err(Failure::from)
+        }
         Command::TargetTests => toolchain::get(&root(), &[firmware::M4])
             .and_then(|tc| qemu::ensure().and_then(|_| firmware::on_target_tests(&tc, &root())))
             .map(|_| 0)
@@ -432,6 +476,17 @@ fn cmd_test(bless: bool) -> Outcome {
         ],
         minutes(10),
     )?;
+    step("fuzzing: every cargo-fuzz target of fuzz/ for 25 s (cargo xtask fuzz --seconds 25)");
+    fuzz::run(
+        &root,
+        &fuzz::Options {
+            seconds: Some(25),
+            runs: None,
+            jobs: 0,
+            keep_going: false,
+            targets: Vec::new(),
+        },
+    )?;
     step("FMU: FMI 2.0 and 3.0 built (cargo xtask fmu), validated and simulated by FMPy against compensator step");
     if let Some(summary) = fmu::check(&root)? {
         eprintln!("xtask: {summary}");
@@ -628,6 +683,16 @@ mod tests {
         assert_eq!(parse(&["msrv"]), Ok(Command::Msrv));
         assert_eq!(parse(&["toolchain"]), Ok(Command::Toolchain));
         assert_eq!(parse(&["target-tests"]), Ok(Command::TargetTests));
+        assert_eq!(
+            parse(&["fuzz", "--seconds", "60", "--target", "twin", "--target", "estimator"]),
+            Ok(Command::Fuzz {
+                seconds: Some(60),
+                runs: None,
+                jobs: 0,
+                keep_going: false,
+                targets: vec!["twin".into(), "estimator".into()],
+            })
+        );
         // As a cargo runner: whatever follows the ELF is the test binary's.
         assert_eq!(
             parse(&["qemu-runner", "target/x.elf", "--quiet", "-x"]),

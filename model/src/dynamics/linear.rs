@@ -23,7 +23,7 @@ use super::fsi::Fsi;
 use super::schemes::OdeSystem;
 use super::stops::Contact;
 use crate::equilibrium::{Stop, equilibrium};
-use crate::error::ModelError;
+use crate::error::{ModelError, finite};
 pub use crate::linalg::eigen::{Complex, eigenvalues};
 use crate::params::Params;
 use crate::scalar::{Float, Real};
@@ -55,11 +55,59 @@ pub fn characteristic_polynomial<T: Real>(m: &[[T; 4]; 4]) -> [T; 4] {
 }
 
 /// `true` when every eigenvalue of `m` has a negative real part
-/// (Routh-Hurwitz conditions for a quartic; no iteration).
+/// (Routh-Hurwitz conditions for a quartic; no iteration); `false` for a
+/// matrix with an entry that is not finite.
+///
+/// Where a coefficient of the characteristic polynomial overflows or falls
+/// into the subnormals, the matrix is divided by its largest entry's
+/// magnitude (which scales the eigenvalues and keeps their signs), so that
+/// the coefficients are at most 4, 12, 24 and 24 in magnitude; the
+/// conditions are taken in the quotient form of [`hurwitz_quartic`]: no
+/// product that can overflow, on any finite matrix.
 pub fn hurwitz_stable<T: Real>(m: &[[T; 4]; 4]) -> bool {
-    let [a3, a2, a1, a0] = characteristic_polynomial(m);
+    // The usual case (the model-unit Jacobians): every coefficient finite
+    // and clear of the subnormals, nothing to scale.
+    let a = characteristic_polynomial(m);
+    if T::SATURATES || a.iter().all(|c| c.is_finite() && c.abs() >= T::tiny()) {
+        return hurwitz_quartic(&a);
+    }
+    let mut big = T::ZERO;
+    for row in m {
+        for &e in row {
+            if !e.is_finite() {
+                return false;
+            }
+            big = big.max(e.abs());
+        }
+    }
+    if !(big > T::ZERO) {
+        // A zero matrix is not stable.
+        return false;
+    }
+    // Divided, not multiplied by 1 / big (which overflows for a subnormal
+    // big): every quotient is at most one.
+    let mut scaled = *m;
+    for row in scaled.iter_mut() {
+        for e in row.iter_mut() {
+            *e = *e / big;
+        }
+    }
+    hurwitz_quartic(&characteristic_polynomial(&scaled))
+}
+
+/// The Routh-Hurwitz conditions of the monic quartic
+/// `s^4 + a3 s^3 + a2 s^2 + a1 s + a0` (coefficients `[a3, a2, a1, a0]`):
+/// every root has a negative real part exactly when all four are positive
+/// and `a3 a2 a1 > a1^2 + a3^2 a0`, here divided by `a3 a1 > 0`:
+/// `a2 > a1 / a3 + a3 (a0 / a1)` (which implies `a3 a2 > a1`). Source:
+/// Routh-Hurwitz criterion for a quartic. The quotient form has no product of
+/// three coefficients: a term that overflows is one `a2` cannot exceed,
+/// and the verdict stays right for coefficients anywhere in the type's
+/// range. `false` when a coefficient is NaN.
+pub fn hurwitz_quartic<T: Real>(a: &[T; 4]) -> bool {
+    let [a3, a2, a1, a0] = *a;
     let z = T::ZERO;
-    a3 > z && a2 > z && a1 > z && a0 > z && a3 * a2 > a1 && a3 * a2 * a1 > a1 * a1 + a3 * a3 * a0
+    a3 > z && a2 > z && a1 > z && a0 > z && a2 > a1 / a3 + a3 * (a0 / a1)
 }
 
 /// The linearised dynamics at an equilibrium.
@@ -107,21 +155,31 @@ pub fn jacobian_at_equilibrium<F: Float>(model: &Model<F>, t: F) -> Result<[[F; 
 ///
 /// # Errors
 ///
-/// As [`Model::new`], [`jacobian_at_equilibrium`] and [`eigenvalues`].
+/// As [`Model::new`], [`jacobian_at_equilibrium`] and [`eigenvalues`];
+/// `NonFinite("eigenvalues")` or `NonFinite("natural frequency")` when an
+/// eigenvalue or its modulus in 1/s is not finite (never on the parameter
+/// schema's plausible ranges: `tests` and host-tests' `dynamics`).
 pub fn linearise<F: Float>(params: &Params<F>, t: F) -> Result<Linearisation<F>, ModelError> {
     let model = Model::new(params)?;
     let jac = jacobian_at_equilibrium(&model, t)?;
     let scale = F::ONE / model.scales.time;
     let mut ev = eigenvalues(&jac)?;
     for e in ev.iter_mut() {
-        e.re *= scale;
-        e.im *= scale;
+        // In 1/s: a model-unit eigenvalue times 1 / time unit can overflow
+        // (a time unit in the subnormals), refused rather than returned.
+        e.re = finite(e.re * scale, "eigenvalues")?;
+        e.im = finite(e.im * scale, "eigenvalues")?;
     }
     let mut wn = [F::ZERO; 4];
     let mut zeta = [F::ZERO; 4];
     for i in 0..4 {
-        wn[i] = ev[i].abs();
-        zeta[i] = if wn[i] > F::ZERO { -ev[i].re / wn[i] } else { F::ONE };
+        wn[i] = finite(ev[i].abs(), "natural frequency")?;
+        // |re| <= |lambda|; the clamp only absorbs rounding.
+        zeta[i] = if wn[i] > F::ZERO {
+            (-ev[i].re / wn[i]).clamp_to(-F::ONE, F::ONE)
+        } else {
+            F::ONE
+        };
     }
     let eq = equilibrium(params, t)?;
     let c = model.coefficients::<F>(&eq.fluid)?;
@@ -163,5 +221,82 @@ mod tests {
             [0.0, 0.0, 1.0, 0.0],
         ];
         assert!(!hurwitz_stable(&unstable));
+    }
+
+    /// F4 (docs/fuzzing.md): the Routh-Hurwitz products overflowed (a
+    /// spring of 2.2e-106 N/m under 4.2e93 Pa gave "unstable" for four
+    /// negative eigenvalues). The same matrices scaled by 2^-1000..2^1000
+    /// (exactly), in `f64`, and by 2^-60..2^60 in `f32`, keep their
+    /// verdicts; so do polynomials with roots spread over 1e-30..1e30.
+    #[test]
+    fn the_verdict_survives_any_scale() {
+        let stable = [
+            [-5.0, -13.0, -19.0, -10.0],
+            [1.0, 0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0],
+        ];
+        // (s - 0.5)(s + 2)(s^2 + 2 s + 5) = s^4 + 3.5 s^3 + 8 s^2 + 8.5 s - 5:
+        // one positive root, all coefficients but a0 positive; and
+        // s^4 + s^3 + 4 s^2 + 5 s + 6, all positive, two roots at
+        // Re > 0 (a3 a2 a1 = 20 < a1^2 + a3^2 a0 = 31).
+        let one_positive = [
+            [-3.5, -8.0, -8.5, 5.0],
+            [1.0, 0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0],
+        ];
+        let oscillating = [
+            [-1.0, -4.0, -5.0, -6.0],
+            [1.0, 0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0],
+        ];
+        for k in (-1000..=1000).step_by(25) {
+            let s = 2f64.powi(k);
+            let scaled = |m: [[f64; 4]; 4]| m.map(|r| r.map(|e| e * s));
+            assert!(hurwitz_stable(&scaled(stable)), "2^{k}");
+            assert!(!hurwitz_stable(&scaled(one_positive)), "2^{k}");
+            assert!(!hurwitz_stable(&scaled(oscillating)), "2^{k}");
+            if k.abs() <= 60 {
+                let scaled = |m: [[f64; 4]; 4]| m.map(|r| r.map(|e| (e * s) as f32));
+                assert!(hurwitz_stable(&scaled(stable)), "f32 2^{k}");
+                assert!(!hurwitz_stable(&scaled(one_positive)), "f32 2^{k}");
+                assert!(!hurwitz_stable(&scaled(oscillating)), "f32 2^{k}");
+            }
+        }
+        // Roots -r spread over many decades: products of three coefficients
+        // reach 1e120 (beyond f32 from 1e13).
+        let with_roots = |r: [f64; 4]| {
+            let mut c = [1.0f64, 0.0, 0.0, 0.0, 0.0];
+            for (n, ri) in r.iter().enumerate() {
+                for k in (1..=n + 1).rev() {
+                    c[k] += ri * c[k - 1];
+                }
+            }
+            [c[1], c[2], c[3], c[4]]
+        };
+        for roots in [
+            [1e-30, 1.0, 1e10, 1e30],
+            [1e-3, 1e-2, 1e5, 1e10],
+            [2.0, 3.0, 5e12, 7e12],
+        ] {
+            let a = with_roots(roots);
+            assert!(hurwitz_quartic(&a), "{roots:?}");
+            let a32 = a.map(|c| c as f32);
+            if a32.iter().all(|c| c.is_finite() && *c > 0.0) {
+                assert!(hurwitz_quartic(&a32), "f32 {roots:?}");
+            }
+            let mut flipped = roots;
+            flipped[1] = -flipped[1];
+            assert!(!hurwitz_quartic(&with_roots(flipped)), "{flipped:?}");
+        }
+        // Not finite: no verdict of stability.
+        let mut nan = stable;
+        nan[2][1] = f64::NAN;
+        assert!(!hurwitz_stable(&nan));
+        nan[2][1] = f64::INFINITY;
+        assert!(!hurwitz_stable(&nan));
+        assert!(!hurwitz_quartic(&[f64::NAN, 1.0, 1.0, 1.0]));
     }
 }

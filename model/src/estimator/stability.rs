@@ -9,9 +9,14 @@
 /// returns them): `true` when every root has a negative real part. The
 /// same verdict as `dynamics::linear::hurwitz_stable`, from coefficients
 /// already at hand.
+///
+/// In the quotient form of
+/// [`hurwitz_quartic`](crate::dynamics::linear::hurwitz_quartic): no
+/// product of three coefficients, which overflowed `f32` from
+/// coefficients of ~1e13 on.
+#[inline]
 pub fn quartic_hurwitz(a: &[f32; 4]) -> bool {
-    let [a3, a2, a1, a0] = *a;
-    a3 > 0.0 && a2 > 0.0 && a1 > 0.0 && a0 > 0.0 && a3 * a2 > a1 && a3 * a2 * a1 > a1 * a1 + a3 * a3 * a0
+    crate::dynamics::linear::hurwitz_quartic(a)
 }
 
 /// Coefficients of `p(s - sigma)` for the monic quartic `p` with
