@@ -44,7 +44,7 @@
 //! it, until every remaining parameter is determined. Its value is not
 //! printed (the fit's number for it would be noise).
 
-use crate::csv::read_numeric;
+use crate::csv::read_columns;
 use crate::dynamics::chosen;
 use crate::error::CliError;
 use crate::lsq::{self, Undetermined};
@@ -129,7 +129,7 @@ impl Transient {
 /// uniform (within [`UNIFORM_TOL`] of the first interval), only one of the
 /// two pressure columns.
 pub fn read_transient(text: &str) -> Result<Transient, String> {
-    let t = read_numeric(text)?;
+    let t = read_columns(text, &["time_s", "t_c", "x_m", "p_a_pa", "p_b_pa"])?;
     let col = |n: &str| {
         t.column(n).ok_or_else(|| {
             format!(
