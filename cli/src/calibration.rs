@@ -111,7 +111,11 @@ pub fn read_pressure(text: &str) -> Result<Vec<PressurePoint>, String> {
             dp_ab_pa: r[c[2]],
         };
         if p.dp_pa <= 0.0 {
-            return Err(format!("{}: {} Pa is not a positive drop", at(&t, i, "dp_pa"), num(p.dp_pa)));
+            return Err(format!(
+                "{}: {} Pa is not a positive drop",
+                at(&t, i, "dp_pa"),
+                num(p.dp_pa)
+            ));
         }
         if p.dp_ab_pa.abs() >= p.dp_pa {
             return Err(format!(

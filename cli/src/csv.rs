@@ -198,7 +198,10 @@ fn read(text: &str, finite_only: bool, wanted: Option<&[&str]>) -> Result<Numeri
     if let Some(w) = wanted {
         for name in w {
             if header.iter().filter(|h| h == name).count() > 1 {
-                return Err(format!("column {name} appears twice in the header ({})", header.join(",")));
+                return Err(format!(
+                    "column {name} appears twice in the header ({})",
+                    header.join(",")
+                ));
             }
         }
     }

@@ -129,7 +129,11 @@ fn hostile_spreadsheets_are_read_or_refused_in_one_line() {
     // sum of squares: refused, not a fit with zero standard errors.
     let mut huge = String::from("t_c,dp_pa,dp_ab_pa\n");
     for (i, r) in rows.iter().enumerate() {
-        huge.push_str(&if i == 3 { "50,1e308,0".to_string() } else { r.to_string() });
+        huge.push_str(&if i == 3 {
+            "50,1e308,0".to_string()
+        } else {
+            r.to_string()
+        });
         huge.push('\n');
     }
     // A temperature the oil model cannot take is named by row; a wanted
@@ -141,7 +145,11 @@ fn hostile_spreadsheets_are_read_or_refused_in_one_line() {
         ("huge.csv", huge.as_str(), "residual sum of squares overflows"),
         ("hot.csv", hot.as_str(), "data row 4, column t_c: 5000 C"),
         ("twice.csv", twice.as_str(), "column dp_pa appears twice"),
-        ("range.csv", out_of_range.as_str(), "column dp_ab_pa: 1e308 Pa is not inside"),
+        (
+            "range.csv",
+            out_of_range.as_str(),
+            "column dp_ab_pa: 1e308 Pa is not inside",
+        ),
     ] {
         let path = temp_file(name, text.as_bytes());
         let (code, out, err) = run(&["calibrate", "--pressure-data", &path.to_string_lossy()]);

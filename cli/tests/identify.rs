@@ -274,10 +274,19 @@ fn bad_transients_exit_2_naming_row_and_column() {
         // A sample interval the twin's chooser cannot probe (it panicked).
         ("time_s,t_c,x_m\n0,40,0\n10,50,0\n20,50,0\n30,50,0\n", "tick 10 s"),
         // Displacements in mm read as m, or negative beyond noise.
-        ("time_s,t_c,x_m\n0,40,0\n0.001,50,0.7\n0.002,50,0\n", "row 2, column x_m"),
-        ("time_s,t_c,x_m\n0,40,0\n0.001,50,0\n0.002,50,-0.001\n", "row 3, column x_m"),
+        (
+            "time_s,t_c,x_m\n0,40,0\n0.001,50,0.7\n0.002,50,0\n",
+            "row 2, column x_m",
+        ),
+        (
+            "time_s,t_c,x_m\n0,40,0\n0.001,50,0\n0.002,50,-0.001\n",
+            "row 3, column x_m",
+        ),
         // A temperature the oil model cannot take.
-        ("time_s,t_c,x_m\n0,40,0\n0.001,400,0\n0.002,400,0\n", "row 2, column t_c"),
+        (
+            "time_s,t_c,x_m\n0,40,0\n0.001,400,0\n0.002,400,0\n",
+            "row 2, column t_c",
+        ),
         // A text column is ignored; a wanted column twice is ambiguous.
         ("time_s,t_c,x_m,x_m\n0,40,0,0\n", "column x_m appears twice"),
     ] {

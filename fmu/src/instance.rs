@@ -881,7 +881,10 @@ mod tests {
         inst.enter_initialization(0.0).expect("init");
         match inst.exit_initialization() {
             Err(Failure::Refused(m) | Failure::Broken(m)) => {
-                assert!(m.contains("estimator.tick_hz = 10 Hz") && m.contains("at least 40 Hz"), "{m}")
+                assert!(
+                    m.contains("estimator.tick_hz = 10 Hz") && m.contains("at least 40 Hz"),
+                    "{m}"
+                )
             }
             other => panic!("{other:?}"),
         }
