@@ -80,6 +80,11 @@ fn columns(t: &crate::csv::Numeric, names: &[&str]) -> Result<Vec<usize>, String
         .collect()
 }
 
+/// Slack on the plunger's travel for measured displacements, as a fraction
+/// of the stroke (noise or a sensor offset may put a sample just beyond a
+/// stop, not a tenth of the stroke beyond).
+pub const X_SLACK: f64 = 0.1;
+
 /// A number for a message: plain when of ordinary size, else in
 /// scientific notation (`{}` would print 1e308 with 309 digits).
 fn num(v: f64) -> String {
@@ -404,10 +409,37 @@ pub fn fit(
                 },
             ));
         }
+        // A displacement beyond the travel (a record in mm read as m) fits
+        // nothing and was reported as "the data do not separate" the spring.
+        let stroke = base.core.stroke;
+        let (lo, hi) = (-X_SLACK * stroke, (1.0 + X_SLACK) * stroke);
+        if let Some(i) = data.iter().position(|p| !(lo..=hi).contains(&p.x_m)) {
+            return Err(CliError::Input(format!(
+                "--displacement-data: data row {}, column x_m: {} m is outside the plunger's travel \
+                 [{}, {}] m (0 to plunger.stroke = {stroke} m, with {} % slack)",
+                i + 1,
+                num(data[i].x_m),
+                num(lo),
+                num(hi),
+                X_SLACK * 100.0
+            )));
+        }
         let v0 = [area / base.core.spring_rate * 1e9, base.core.preload * 1e5];
         let r2 = |v: &[f64]| displacement_residuals(&spring(fluid_core, v), data);
         let j0 = lsq::jacobian(r2, &v0, &steps(&v0)).ok_or_else(|| {
-            CliError::Input("--displacement-data: the model cannot be evaluated at the data's temperatures".into())
+            let start = spring(fluid_core, &v0);
+            let row = data
+                .iter()
+                .position(|p| model_displacement(&start, p.t_c, p.dp_pa).is_none())
+                .map_or(String::new(), |i| {
+                    let dp = data[i]
+                        .dp_pa
+                        .map_or("the base file's".to_string(), |d| format!("{} Pa", num(d)));
+                    format!(" (first at data row {}: {} C, drop {dp})", i + 1, num(data[i].t_c))
+                });
+            CliError::Input(format!(
+                "--displacement-data: the model cannot be evaluated at the data's temperatures and drops{row}"
+            ))
         })?;
         lsq::check_design(&j0, &names2).map_err(|e| undetermined("--displacement-data", &names2, e))?;
         let fit2 =

@@ -95,6 +95,28 @@ fn a_bad_cell_exits_2_naming_file_row_and_column() {
         assert_eq!(code, 2, "{text:?}: {err}");
         assert!(err.contains(why), "{text:?}: {err}");
     }
+    // A displacement in mm read as m; a drop the model cannot take.
+    for (text, why) in [
+        (
+            "t_c,x_m\n30,0\n40,0.18\n50,4e-4\n60,6e-4\n",
+            "data row 2, column x_m: 0.18 m is outside the plunger's travel",
+        ),
+        (
+            "t_c,x_m,dp_pa\n30,0,400000\n40,1e-4,1e308\n50,4e-4,400000\n",
+            "first at data row 2: 40 C, drop 1e308 Pa",
+        ),
+    ] {
+        let path = temp_file("badx2.csv", text.as_bytes());
+        let (code, _, err) = run(&[
+            "calibrate",
+            "--pressure-data",
+            PRESSURE,
+            "--displacement-data",
+            &path.to_string_lossy(),
+        ]);
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains(why), "{text:?}: {err}");
+    }
     let path = temp_file("badx.csv", b"t_c,x_m\n30,0\n40,1e-4\n50,nan\n");
     let (code, _, err) = run(&[
         "calibrate",
