@@ -1,7 +1,7 @@
 //! Calibration from measured static data: the `calibrate` command.
 //!
 //! Data, long form, one row per measurement (any temperatures, any number
-//! of pressure drops), read by [`crate::csv::read_numeric`]:
+//! of pressure drops), read by [`crate::csv::read_columns`]:
 //!
 //! * pressure data `t_c,dp_pa,dp_ab_pa`: oil temperature [C], inlet-outlet
 //!   drop `p_p - p_c` [Pa], chamber pressure difference `p_b - p_a` [Pa];
@@ -30,7 +30,7 @@
 //! [`fit`] computes the estimates and [`calibrate`] renders them
 //! (`compensator calibrate`).
 
-use crate::csv::read_numeric;
+use crate::csv::read_columns;
 use crate::error::CliError;
 use crate::lsq::{self, Fit, Uncertainty, least_squares};
 use crate::params_file;
@@ -80,6 +80,21 @@ fn columns(t: &crate::csv::Numeric, names: &[&str]) -> Result<Vec<usize>, String
         .collect()
 }
 
+/// Slack on the plunger's travel for measured displacements, as a fraction
+/// of the stroke (noise or a sensor offset may put a sample just beyond a
+/// stop, not a tenth of the stroke beyond).
+pub const X_SLACK: f64 = 0.1;
+
+/// A number for a message: plain when of ordinary size, else in
+/// scientific notation (`{}` would print 1e308 with 309 digits).
+fn num(v: f64) -> String {
+    if v == 0.0 || (1e-3..1e9).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
 /// `row R (line L), column C`.
 fn at(t: &crate::csv::Numeric, row: usize, column: &str) -> String {
     format!("row {} (line {}), column {column}", row + 1, t.lines[row])
@@ -91,7 +106,7 @@ fn at(t: &crate::csv::Numeric, row: usize, column: &str) -> String {
 /// finite number, `dp_pa <= 0`, `|dp_ab_pa| >= dp_pa` (a chamber pressure
 /// outside the supply and outlet pressures), no rows.
 pub fn read_pressure(text: &str) -> Result<Vec<PressurePoint>, String> {
-    let t = read_numeric(text)?;
+    let t = read_columns(text, &["t_c", "dp_pa", "dp_ab_pa"])?;
     let c = columns(&t, &["t_c", "dp_pa", "dp_ab_pa"])?;
     let mut out = Vec::with_capacity(t.rows.len());
     for (i, r) in t.rows.iter().enumerate() {
@@ -101,16 +116,20 @@ pub fn read_pressure(text: &str) -> Result<Vec<PressurePoint>, String> {
             dp_ab_pa: r[c[2]],
         };
         if p.dp_pa <= 0.0 {
-            return Err(format!("{}: {} Pa is not a positive drop", at(&t, i, "dp_pa"), p.dp_pa));
+            return Err(format!(
+                "{}: {} Pa is not a positive drop",
+                at(&t, i, "dp_pa"),
+                num(p.dp_pa)
+            ));
         }
         if p.dp_ab_pa.abs() >= p.dp_pa {
             return Err(format!(
                 "{}: {} Pa is not inside (-dp_pa, dp_pa) = (-{}, {}) Pa: a chamber pressure \
                  lies between the supply and outlet pressures",
                 at(&t, i, "dp_ab_pa"),
-                p.dp_ab_pa,
-                p.dp_pa,
-                p.dp_pa
+                num(p.dp_ab_pa),
+                num(p.dp_pa),
+                num(p.dp_pa)
             ));
         }
         out.push(p);
@@ -126,7 +145,7 @@ pub fn read_pressure(text: &str) -> Result<Vec<PressurePoint>, String> {
 /// Errors (naming row and column): a missing column, a cell that is not a
 /// finite number, `dp_pa <= 0`, no rows.
 pub fn read_displacement(text: &str) -> Result<Vec<DisplacementPoint>, String> {
-    let t = read_numeric(text)?;
+    let t = read_columns(text, &["t_c", "x_m", "dp_pa"])?;
     let c = columns(&t, &["t_c", "x_m"])?;
     let dp = t.column("dp_pa");
     let mut out = Vec::with_capacity(t.rows.len());
@@ -137,7 +156,7 @@ pub fn read_displacement(text: &str) -> Result<Vec<DisplacementPoint>, String> {
             dp_pa: dp.map(|j| r[j]),
         };
         if let Some(d) = p.dp_pa.filter(|d| *d <= 0.0) {
-            return Err(format!("{}: {d} Pa is not a positive drop", at(&t, i, "dp_pa")));
+            return Err(format!("{}: {} Pa is not a positive drop", at(&t, i, "dp_pa"), num(d)));
         }
         out.push(p);
     }
@@ -340,9 +359,16 @@ pub fn fit(
         lsq::jacobian(r1, &u0, &steps(&u0)).map(|j| (u0, j))
     })
     .ok_or_else(|| {
-        CliError::Input(
-            "--pressure-data: the base file's oil cannot be evaluated at every temperature of the data".into(),
-        )
+        // Name the first row whose temperature the base oil cannot take.
+        let row = pressure
+            .iter()
+            .position(|p| start.oil.state(p.t_c).is_err())
+            .map_or(String::new(), |i| {
+                format!(": data row {}, column t_c: {} C", i + 1, num(pressure[i].t_c))
+            });
+        CliError::Input(format!(
+            "--pressure-data: the base file's oil cannot be evaluated at every temperature of the data{row}"
+        ))
     })?;
     lsq::check_design(&j0, &names1).map_err(|e| undetermined("--pressure-data", &names1, e))?;
     let fit1 = least_squares(r1, &u0, &steps(&u0)).map_err(|e| CliError::Failed(format!("--pressure-data: {e}")))?;
@@ -383,10 +409,37 @@ pub fn fit(
                 },
             ));
         }
+        // A displacement beyond the travel (a record in mm read as m) fits
+        // nothing and was reported as "the data do not separate" the spring.
+        let stroke = base.core.stroke;
+        let (lo, hi) = (-X_SLACK * stroke, (1.0 + X_SLACK) * stroke);
+        if let Some(i) = data.iter().position(|p| !(lo..=hi).contains(&p.x_m)) {
+            return Err(CliError::Input(format!(
+                "--displacement-data: data row {}, column x_m: {} m is outside the plunger's travel \
+                 [{}, {}] m (0 to plunger.stroke = {stroke} m, with {} % slack)",
+                i + 1,
+                num(data[i].x_m),
+                num(lo),
+                num(hi),
+                X_SLACK * 100.0
+            )));
+        }
         let v0 = [area / base.core.spring_rate * 1e9, base.core.preload * 1e5];
         let r2 = |v: &[f64]| displacement_residuals(&spring(fluid_core, v), data);
         let j0 = lsq::jacobian(r2, &v0, &steps(&v0)).ok_or_else(|| {
-            CliError::Input("--displacement-data: the model cannot be evaluated at the data's temperatures".into())
+            let start = spring(fluid_core, &v0);
+            let row = data
+                .iter()
+                .position(|p| model_displacement(&start, p.t_c, p.dp_pa).is_none())
+                .map_or(String::new(), |i| {
+                    let dp = data[i]
+                        .dp_pa
+                        .map_or("the base file's".to_string(), |d| format!("{} Pa", num(d)));
+                    format!(" (first at data row {}: {} C, drop {dp})", i + 1, num(data[i].t_c))
+                });
+            CliError::Input(format!(
+                "--displacement-data: the model cannot be evaluated at the data's temperatures and drops{row}"
+            ))
         })?;
         lsq::check_design(&j0, &names2).map_err(|e| undetermined("--displacement-data", &names2, e))?;
         let fit2 =

@@ -169,11 +169,22 @@ fn detect_delimiter(text: &str) -> u8 {
 /// its data row (1-based, the header not counted), its line in the file
 /// and its column by name.
 pub fn read_numeric(text: &str) -> Result<Numeric, String> {
-    read(text, true)
+    read(text, true, None)
 }
 
-/// [`read_numeric`], accepting `NaN` and infinities unless `finite_only`.
-fn read(text: &str, finite_only: bool) -> Result<Numeric, String> {
+/// [`read_numeric`] reading only the columns named in `wanted`: a cell of
+/// any other column (a spreadsheet's comment or date column) is not parsed
+/// and reads as `NaN`, so "other columns are ignored" holds for text too.
+///
+/// Errors: those of [`read_numeric`] for the wanted columns, and a wanted
+/// column that appears twice in the header (which one is meant is unknown).
+pub fn read_columns(text: &str, wanted: &[&str]) -> Result<Numeric, String> {
+    read(text, true, Some(wanted))
+}
+
+/// [`read_numeric`], accepting `NaN` and infinities unless `finite_only`,
+/// parsing only the columns in `wanted` (all when `None`).
+fn read(text: &str, finite_only: bool, wanted: Option<&[&str]>) -> Result<Numeric, String> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let delimiter = detect_delimiter(text);
     let mut reader = ::csv::ReaderBuilder::new()
@@ -192,6 +203,20 @@ fn read(text: &str, finite_only: bool) -> Result<Numeric, String> {
     if header.iter().all(String::is_empty) {
         return Err("empty file: no header row".into());
     }
+    if let Some(w) = wanted {
+        for name in w {
+            if header.iter().filter(|h| h == name).count() > 1 {
+                return Err(format!(
+                    "column {name} appears twice in the header ({})",
+                    header.join(",")
+                ));
+            }
+        }
+    }
+    let parsed_column: Vec<bool> = header
+        .iter()
+        .map(|h| wanted.is_none_or(|w| w.contains(&h.as_str())))
+        .collect();
     let mut out = Numeric {
         header,
         rows: Vec::new(),
@@ -214,7 +239,11 @@ fn read(text: &str, finite_only: bool) -> Result<Numeric, String> {
         let row = record
             .iter()
             .zip(&out.header)
-            .map(|(cell, name)| {
+            .zip(&parsed_column)
+            .map(|((cell, name), &wanted)| {
+                if !wanted {
+                    return Ok(f64::NAN);
+                }
                 let parsed = cell.parse::<f64>().or_else(|e| {
                     if delimiter != b',' && cell.matches(',').count() == 1 && !cell.contains('.') {
                         cell.replace(',', ".").parse::<f64>()
@@ -243,7 +272,7 @@ fn read(text: &str, finite_only: bool) -> Result<Numeric, String> {
 /// [`read_numeric`] but accepting `NaN` and infinities (a command's own
 /// output may hold them).
 pub fn parse(text: &str) -> Result<(Vec<String>, Vec<Vec<f64>>), String> {
-    let t = read(text, false)?;
+    let t = read(text, false, None)?;
     Ok((t.header, t.rows))
 }
 
@@ -406,5 +435,19 @@ mod tests {
         // The command's own output may hold NaN: `parse` keeps it.
         let (_, rows) = parse("a\nNaN\n").unwrap();
         assert!(rows[0][0].is_nan());
+    }
+
+    #[test]
+    fn other_columns_are_ignored_even_when_not_numbers() {
+        let t = read_columns("t_c,note,x_m\n30,first run,0.5\n40,,0.75\n", &["t_c", "x_m"]).unwrap();
+        assert_eq!(t.rows.len(), 2);
+        assert_eq!((t.rows[1][0], t.rows[1][2]), (40.0, 0.75));
+        assert!(t.rows[0][1].is_nan());
+        // A wanted column still must hold numbers.
+        let e = read_columns("t_c,note,x_m\n30,a,b\n", &["t_c", "x_m"]).unwrap_err();
+        assert_eq!(e, "row 1 (line 2), column x_m: 'b' is not a number");
+        // A wanted column given twice is ambiguous.
+        let e = read_columns("t_c,x_m,x_m\n30,0.5,0.6\n", &["t_c", "x_m"]).unwrap_err();
+        assert!(e.starts_with("column x_m appears twice"), "{e}");
     }
 }

@@ -44,7 +44,7 @@
 //! it, until every remaining parameter is determined. Its value is not
 //! printed (the fit's number for it would be noise).
 
-use crate::csv::read_numeric;
+use crate::csv::read_columns;
 use crate::dynamics::chosen;
 use crate::error::CliError;
 use crate::lsq::{self, Undetermined};
@@ -129,7 +129,7 @@ impl Transient {
 /// uniform (within [`UNIFORM_TOL`] of the first interval), only one of the
 /// two pressure columns.
 pub fn read_transient(text: &str) -> Result<Transient, String> {
-    let t = read_numeric(text)?;
+    let t = read_columns(text, &["time_s", "t_c", "x_m", "p_a_pa", "p_b_pa"])?;
     let col = |n: &str| {
         t.column(n).ok_or_else(|| {
             format!(
@@ -878,6 +878,43 @@ pub struct Options {
     pub plot: Option<PathBuf>,
 }
 
+/// Slack on the plunger's travel for measured displacements: noise and a
+/// sensor's offset may put a sample slightly beyond a stop, but not by a
+/// tenth of the stroke.
+pub const STROKE_SLACK: f64 = 0.1;
+
+/// Checks a record against the base file before fitting: every
+/// temperature within the oil model's range, every displacement within
+/// `[-STROKE_SLACK, 1 + STROKE_SLACK]` strokes (a record in mm or um read as
+/// m, or from another device, would otherwise be fitted through the
+/// pressures alone and reported as identified).
+///
+/// Errors: the first offending data row (1-based) and column, with the
+/// allowed range.
+pub fn check_plausible(base: &RawParams, data: &Transient) -> Result<(), String> {
+    let stroke = base.core.stroke;
+    let (lo, hi) = (-STROKE_SLACK * stroke, (1.0 + STROKE_SLACK) * stroke);
+    if let Some(i) = data.x_m.iter().position(|x| !(lo..=hi).contains(x)) {
+        return Err(format!(
+            "row {}, column x_m: {:.4e} m is outside the plunger's travel [{lo:.4e}, {hi:.4e}] m \
+             (0 to plunger.stroke = {stroke} m, with {} % slack)",
+            i + 1,
+            data.x_m[i],
+            STROKE_SLACK * 100.0
+        ));
+    }
+    if let Ok(p) = Params::<f64>::new(base)
+        && let Some(i) = data.t_c.iter().position(|t| p.oil.state(*t).is_err())
+    {
+        return Err(format!(
+            "row {}, column t_c: the base file's oil model cannot be evaluated at {} C",
+            i + 1,
+            data.t_c[i]
+        ));
+    }
+    Ok(())
+}
+
 /// `identify`: the report table (CSV) and the lines for standard error.
 ///
 /// Errors: bad parameter file or data (exit 2, naming the field, row and
@@ -891,6 +928,7 @@ pub fn identify(opts: &Options) -> Result<(String, Vec<String>), CliError> {
     let shown = opts.data.display().to_string();
     let text = crate::input::params_text(&opts.data, "--data")?;
     let data = read_transient(&text).map_err(|e| CliError::Input(format!("--data: {shown}: {e}")))?;
+    check_plausible(&base, &data).map_err(|e| CliError::Input(format!("--data: {shown}: {e}")))?;
     let id = identify_params(&base, &data, &fit)?;
     if let Some(path) = &opts.write_preset {
         let command = format!(

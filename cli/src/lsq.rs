@@ -194,6 +194,13 @@ pub enum Undetermined {
         /// Smallest over largest singular value of the scaled Jacobian.
         ratio: f64,
     },
+    /// The residual sum of squares at the optimum overflows (or is NaN): a
+    /// measurement so large (say a drop of 1e308 Pa) that the noise, hence
+    /// every standard error, cannot be computed.
+    NonFiniteResiduals {
+        /// The largest residual's magnitude.
+        largest: f64,
+    },
 }
 
 impl std::fmt::Display for Undetermined {
@@ -211,6 +218,11 @@ impl std::fmt::Display for Undetermined {
                 "the data do not separate {} (scaled Jacobian singular, smallest/largest singular value \
                  {ratio:.1e}): only a combination of them is determined",
                 confounded.join(", ")
+            ),
+            Undetermined::NonFiniteResiduals { largest } => write!(
+                f,
+                "the residual sum of squares overflows (largest residual {largest:.3e}): a measurement \
+                 is far out of any plausible range, so the noise and every standard error are unknown"
             ),
         }
     }
@@ -383,7 +395,8 @@ pub fn check_design(jac: &DMatrix<f64>, names: &[&str]) -> Result<(), Undetermin
 /// The uncertainty of a fit with Jacobian `jac` (n x p) and residuals `r`
 /// at its optimum; `names` names the p parameters (module docs).
 ///
-/// Errors: [`Undetermined`] when `n <= p` or `jac` is rank-deficient.
+/// Errors: [`Undetermined`] when `n <= p`, `jac` is rank-deficient or the
+/// residual sum of squares is not finite.
 pub fn analyse(jac: &DMatrix<f64>, r: &[f64], names: &[&str]) -> Result<Uncertainty, Undetermined> {
     check_design(jac, names)?;
     let (n, p) = jac.shape();
@@ -396,6 +409,11 @@ pub fn analyse(jac: &DMatrix<f64>, r: &[f64], names: &[&str]) -> Result<Uncertai
     let v_t = svd.v_t.as_ref().expect("SVD computed with V");
     // (Js^T Js)^-1 = V diag(1/s^2) V^T; unscale: cov = D^-1 (..) D^-1.
     let rss: f64 = r.iter().map(|v| v * v).sum();
+    if !rss.is_finite() {
+        return Err(Undetermined::NonFiniteResiduals {
+            largest: r.iter().fold(0.0, |m, v| m.max(v.abs())),
+        });
+    }
     let dof = n - p;
     let s2 = rss / dof as f64;
     let cov = DMatrix::from_fn(p, p, |a, b| {
@@ -498,5 +516,13 @@ mod tests {
             ),
             other => panic!("{other:?}"),
         }
+    }
+
+    #[test]
+    fn refuses_an_overflowing_residual_sum_of_squares() {
+        let jac = DMatrix::from_row_slice(3, 1, &[1.0, 2.0, 3.0]);
+        let e = analyse(&jac, &[0.1, 1e308, 0.0], &["a"]).unwrap_err();
+        assert_eq!(e, Undetermined::NonFiniteResiduals { largest: 1e308 });
+        assert!(e.to_string().contains("overflows"), "{e}");
     }
 }

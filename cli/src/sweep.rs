@@ -217,12 +217,15 @@ impl Sweep {
     ///
     /// More than [`MAX_VARIANTS`] (bad input naming `--set/--samples`).
     pub fn variant_count(&self) -> Result<usize, CliError> {
-        let mut n = self.samples.max(1);
+        let too_many = || CliError::Input(format!("--set/--samples: more than {MAX_VARIANTS} variants"));
+        let mut n = Some(self.samples.max(1))
+            .filter(|&n| n <= MAX_VARIANTS)
+            .ok_or_else(too_many)?;
         for a in &self.grid {
             n = n
                 .checked_mul(a.values.len())
                 .filter(|&n| n <= MAX_VARIANTS)
-                .ok_or_else(|| CliError::Input(format!("--set/--samples: more than {MAX_VARIANTS} variants")))?;
+                .ok_or_else(too_many)?;
         }
         Ok(n)
     }
@@ -315,8 +318,24 @@ pub fn evaluate(raw: &RawParams, metrics: &Metrics) -> Result<Vec<String>, Strin
     Ok(cells)
 }
 
+/// The one-line progress note of a sweep whose standard error is not a
+/// terminal: `done` of `total` variants after `elapsed` s, `left` s to go.
+fn note(done: u64, total: u64, elapsed: f64, left: f64) -> String {
+    format!(
+        "sweep: {done} of {total} variants after {elapsed:.1} s; about {} to go at this rate",
+        if left < 120.0 {
+            format!("{left:.0} s")
+        } else if left < 7200.0 {
+            format!("{:.0} min", left / 60.0)
+        } else {
+            format!("{:.1} h", left / 3600.0)
+        }
+    )
+}
+
 /// Progress on standard error: drawn only when it is a terminal, and only
-/// once the run has lasted a second (a short sweep prints nothing).
+/// once the run has lasted a second (a short sweep prints nothing); when
+/// it is not a terminal, one line ([`note`]) with the estimated time left.
 struct Progress {
     bar: indicatif::ProgressBar,
     start: Instant,
@@ -344,10 +363,18 @@ impl Progress {
     }
 
     fn inc(&self) {
-        if self.terminal && self.start.elapsed() > Duration::from_secs(1) && !self.shown.swap(true, Ordering::Relaxed) {
-            self.bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
-        }
         self.bar.inc(1);
+        let elapsed = self.start.elapsed();
+        if elapsed > Duration::from_secs(1) && !self.shown.swap(true, Ordering::Relaxed) {
+            if self.terminal {
+                self.bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+            } else {
+                // No bar in a log or a pipe: one line, so a long sweep is not silent.
+                let (done, total) = (self.bar.position().max(1), self.bar.length().unwrap_or(0));
+                let left = elapsed.as_secs_f64() * total.saturating_sub(done) as f64 / done as f64;
+                eprintln!("{}", note(done, total, elapsed.as_secs_f64(), left));
+            }
+        }
     }
 
     fn finish(&self) {
@@ -469,6 +496,16 @@ pub fn build(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_long_sweep_without_a_terminal_says_how_long_it_will_take() {
+        assert_eq!(
+            note(100, 1_000_000, 1.0, 9999.0),
+            "sweep: 100 of 1000000 variants after 1.0 s; about 2.8 h to go at this rate"
+        );
+        assert!(note(10, 100, 1.0, 9.0).ends_with("about 9 s to go at this rate"));
+        assert!(note(10, 1000, 1.0, 600.0).ends_with("about 10 min to go at this rate"));
+    }
 
     #[test]
     fn grids_and_tolerances_parse() {

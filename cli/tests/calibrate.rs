@@ -95,6 +95,28 @@ fn a_bad_cell_exits_2_naming_file_row_and_column() {
         assert_eq!(code, 2, "{text:?}: {err}");
         assert!(err.contains(why), "{text:?}: {err}");
     }
+    // A displacement in mm read as m; a drop the model cannot take.
+    for (text, why) in [
+        (
+            "t_c,x_m\n30,0\n40,0.18\n50,4e-4\n60,6e-4\n",
+            "data row 2, column x_m: 0.18 m is outside the plunger's travel",
+        ),
+        (
+            "t_c,x_m,dp_pa\n30,0,400000\n40,1e-4,1e308\n50,4e-4,400000\n",
+            "first at data row 2: 40 C, drop 1e308 Pa",
+        ),
+    ] {
+        let path = temp_file("badx2.csv", text.as_bytes());
+        let (code, _, err) = run(&[
+            "calibrate",
+            "--pressure-data",
+            PRESSURE,
+            "--displacement-data",
+            &path.to_string_lossy(),
+        ]);
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains(why), "{text:?}: {err}");
+    }
     let path = temp_file("badx.csv", b"t_c,x_m\n30,0\n40,1e-4\n50,nan\n");
     let (code, _, err) = run(&[
         "calibrate",
@@ -108,6 +130,56 @@ fn a_bad_cell_exits_2_naming_file_row_and_column() {
         err.contains("row 3 (line 4), column x_m") && err.contains("not a finite number"),
         "{err}"
     );
+}
+
+#[test]
+fn hostile_spreadsheets_are_read_or_refused_in_one_line() {
+    let text = std::fs::read_to_string(root().join(PRESSURE)).unwrap();
+    let rows: Vec<&str> = text.lines().filter(|l| !l.starts_with('#')).skip(1).collect();
+    let (_, reference, _) = run(&["calibrate", "--pressure-data", PRESSURE]);
+    // A text column (a spreadsheet's note) is ignored, as the docs say.
+    let mut noted = String::from("t_c,dp_pa,note,dp_ab_pa\n");
+    for r in &rows {
+        let c: Vec<&str> = r.split(',').collect();
+        noted.push_str(&format!("{},{},\"bench 2, run A\",{}\n", c[0], c[1], c[2]));
+    }
+    let path = temp_file("noted.csv", noted.as_bytes());
+    let (code, out, err) = run(&["calibrate", "--pressure-data", &path.to_string_lossy()]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(out, reference);
+    // A drop of 1e308 Pa passes every cell check but overflows the residual
+    // sum of squares: refused, not a fit with zero standard errors.
+    let mut huge = String::from("t_c,dp_pa,dp_ab_pa\n");
+    for (i, r) in rows.iter().enumerate() {
+        huge.push_str(&if i == 3 {
+            "50,1e308,0".to_string()
+        } else {
+            r.to_string()
+        });
+        huge.push('\n');
+    }
+    // A temperature the oil model cannot take is named by row; a wanted
+    // column twice is ambiguous; a huge value is printed short.
+    let hot = huge.replace("50,1e308,0", "5000,400000,0");
+    let twice = text.replace("t_c,dp_pa,dp_ab_pa", "t_c,dp_pa,dp_pa");
+    let out_of_range = huge.replace("50,1e308,0", "50,400000,1e308");
+    for (name, text, why) in [
+        ("huge.csv", huge.as_str(), "residual sum of squares overflows"),
+        ("hot.csv", hot.as_str(), "data row 4, column t_c: 5000 C"),
+        ("twice.csv", twice.as_str(), "column dp_pa appears twice"),
+        (
+            "range.csv",
+            out_of_range.as_str(),
+            "column dp_ab_pa: 1e308 Pa is not inside",
+        ),
+    ] {
+        let path = temp_file(name, text.as_bytes());
+        let (code, out, err) = run(&["calibrate", "--pressure-data", &path.to_string_lossy()]);
+        assert_eq!(code, 2, "{name}: {err}");
+        assert!(out.is_empty(), "{name}: {out}");
+        assert_eq!(err.lines().count(), 1, "{name}: {err}");
+        assert!(err.contains(why) && err.len() < 400, "{name}: {err}");
+    }
 }
 
 #[test]

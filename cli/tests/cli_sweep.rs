@@ -200,6 +200,9 @@ fn unknown_names_are_bad_input_and_implausible_values_are_rows_with_an_error() {
         &["--vary", "plunger.mass=-1%"][..],
         &["--samples", "5"][..],
         &["--step", "40:50,50:60"][..],
+        // Draws alone beyond the variant bound were not checked and ran for hours.
+        &["--vary", "plunger.mass=5%", "--samples", "100000000"][..],
+        &["--set", "plunger.mass=1:2:1000", "--set", "plunger.stroke=1:2:1001"][..],
     ] {
         let (code, out, err) = run(&[&["sweep", "--params", P][..], bad].concat());
         assert_eq!(code, 2, "{bad:?}: {err}");

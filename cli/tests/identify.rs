@@ -213,9 +213,9 @@ fn the_command_reports_csv_json_and_writes_the_preset() {
     truth.core.mass = 2.0;
     truth.core.damping = 20.0;
     let data = record(&truth, 50.0, 60.0, 0.3, 300);
-    let mut text = String::from("time_s;t_c;x_m\n");
+    let mut text = String::from("time_s;t_c;note;x_m\n");
     for k in 0..data.time_s.len() {
-        text.push_str(&format!("{};{};{}\n", data.time_s[k], data.t_c[k], data.x_m[k]));
+        text.push_str(&format!("{};{};bench A;{}\n", data.time_s[k], data.t_c[k], data.x_m[k]));
     }
     let csv = temp_file("step.csv", &text);
     let mut base = truth;
@@ -271,6 +271,24 @@ fn bad_transients_exit_2_naming_row_and_column() {
         ("time_s,t_c,x_m,p_a_pa\n0,40,0,1\n", "p_a_pa without p_b_pa"),
         ("time_s,t_c,x_m\n0,40,0\n0.001,50,abc\n", "row 2 (line 3), column x_m"),
         ("time_s,t_c,x_m\n0,40,0\n0.001,50,0\n0.002,50,0\n", "degrees of freedom"),
+        // A sample interval the twin's chooser cannot probe (it panicked).
+        ("time_s,t_c,x_m\n0,40,0\n10,50,0\n20,50,0\n30,50,0\n", "tick 10 s"),
+        // Displacements in mm read as m, or negative beyond noise.
+        (
+            "time_s,t_c,x_m\n0,40,0\n0.001,50,0.7\n0.002,50,0\n",
+            "row 2, column x_m",
+        ),
+        (
+            "time_s,t_c,x_m\n0,40,0\n0.001,50,0\n0.002,50,-0.001\n",
+            "row 3, column x_m",
+        ),
+        // A temperature the oil model cannot take.
+        (
+            "time_s,t_c,x_m\n0,40,0\n0.001,400,0\n0.002,400,0\n",
+            "row 2, column t_c",
+        ),
+        // A text column is ignored; a wanted column twice is ambiguous.
+        ("time_s,t_c,x_m,x_m\n0,40,0,0\n", "column x_m appears twice"),
     ] {
         let data = temp_file("bad.csv", text);
         let (code, out, err) = run(&["identify", "--params", params, "--data", &data]);

@@ -187,6 +187,7 @@ impl Sim {
             Some((r, c)) if *r == raw => c,
             _ => {
                 let p64 = Params::<f64>::new(&raw).map_err(|e| e.to_string())?;
+                crate::check_tick(raw.estimator.tick_hz)?;
                 let valid = (raw.estimator.valid_min, raw.estimator.valid_max);
                 let tick = 1.0 / raw.estimator.tick_hz;
                 choose(&p64, tick, valid)
@@ -631,7 +632,7 @@ impl Instance {
         }
         if n > MAX_TICKS_PER_STEP {
             return Err(Failure::Refused(format!(
-                "communication step {h} s is more than {MAX_TICKS_PER_STEP} ticks of {tick} s: take shorter steps"
+                "communication step {h:e} s is more than {MAX_TICKS_PER_STEP} ticks of {tick} s: take shorter steps"
             )));
         }
         let now = sim.time();
@@ -867,6 +868,29 @@ mod tests {
         assert_eq!(inst.phase(), Phase::Step);
         assert!(inst.deserialize(&bytes).is_ok());
         assert_eq!(inst.serialize(), bytes);
+    }
+
+    #[test]
+    fn a_tick_the_chooser_cannot_probe_is_refused_naming_tick_hz() {
+        // 10 Hz is within the schema's range; the chooser's probes are not
+        // (its clamp panicked, caught only as an "internal error").
+        let mut raw = preset("paper.toml");
+        raw.estimator.tick_hz = 10.0;
+        raw.estimator.telemetry_hz = 2.0;
+        let mut inst = Instance::new(&raw);
+        inst.enter_initialization(0.0).expect("init");
+        match inst.exit_initialization() {
+            Err(Failure::Refused(m) | Failure::Broken(m)) => {
+                assert!(
+                    m.contains("estimator.tick_hz = 10 Hz") && m.contains("at least 40 Hz"),
+                    "{m}"
+                )
+            }
+            other => panic!("{other:?}"),
+        }
+        assert!(crate::chosen_config(&raw).unwrap_err().contains("estimator.tick_hz"));
+        raw.estimator.tick_hz = 40.0;
+        assert!(crate::chosen_config(&raw).is_ok());
     }
 
     #[test]
