@@ -5,7 +5,7 @@ use crate::csv::Table;
 use crate::error::{CliError, load_params};
 use crate::temps;
 use compensator::ModelError;
-use compensator::dynamics::config::{Choice, MAX_PROBE, TARGET_PCT, choose};
+use compensator::dynamics::config::{Choice, TARGET_PCT, choose};
 use compensator::dynamics::linear::linearise;
 use compensator::dynamics::reduced::ReducedTwin;
 use compensator::dynamics::{Dynamic, DynamicState, Scheme, Twin, TwinConfig};
@@ -201,25 +201,18 @@ pub fn describe(config: &TwinConfig) -> String {
     )
 }
 
-/// Longest tick [s] the twin's substep chooser accepts: its probes run
-/// at least 20 ticks and at most `MAX_PROBE` (a longer tick made the core's
-/// `clamp(20 tick, MAX_PROBE)` panic).
-pub const MAX_TICK: f64 = MAX_PROBE / 20.0;
-
 /// The chooser's configuration of the twin for a parameter file at `tick`
 /// [s], over the file's validated range (`[estimator] valid_min`,
 /// `valid_max`).
 ///
 /// Errors: [`CliError::Input`] for parameters the model refuses or a tick
-/// longer than [`MAX_TICK`] (the chooser's probes last at most
-/// `MAX_PROBE` = 0.5 s and at least 20 ticks); [`CliError::Failed`] when
-/// the chooser fails.
+/// that is not a positive duration; [`CliError::Failed`] when the chooser
+/// fails.
 pub fn chosen(raw: &RawParams, tick: f64) -> Result<Choice, CliError> {
     let p = Params::<f64>::new(raw).map_err(|e| CliError::Input(e.to_string()))?;
-    if !(tick > 0.0 && tick <= MAX_TICK) {
+    if !(tick > 0.0 && tick.is_finite()) {
         return Err(CliError::Input(format!(
-            "tick {tick} s (--dt, the data's sample interval or 1/estimator.tick_hz): the twin's substeps \
-             are chosen for ticks up to {MAX_TICK} s (20 ticks within a {MAX_PROBE} s probe)"
+            "tick {tick} s (--dt, the data's sample interval or 1/estimator.tick_hz): not a positive duration"
         )));
     }
     let valid = (raw.estimator.valid_min, raw.estimator.valid_max);

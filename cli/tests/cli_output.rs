@@ -319,3 +319,35 @@ fn step_sample_thins_the_output_not_the_tick() {
         assert!(err.contains("--sample"), "{bad}: {err}");
     }
 }
+
+/// A coarse tick is the twin's to take, not a panic: the core's chooser
+/// once crossed a clamp's bounds beyond 25 ms (exit 101).
+#[test]
+fn a_coarse_tick_runs() {
+    let (code, out, err) = run(&[
+        "step",
+        "--params",
+        "presets/paper.toml",
+        "--from",
+        "20",
+        "--to",
+        "60",
+        "--dt",
+        "10",
+        "--t-end",
+        "100",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(out.lines().count(), 1 + 11, "{out}");
+    let last: Vec<f64> = out
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|c| c.parse().unwrap())
+        .collect();
+    // At rest at 60 C after 100 s: the closed form's displacement.
+    let (_, eq, _) = run(&["equilibrium", "--params", "presets/paper.toml", "--temps", "60"]);
+    let x_eq: f64 = eq.lines().nth(1).unwrap().split(',').nth(5).unwrap().parse().unwrap();
+    assert!((last[1] - x_eq).abs() <= 1e-6 * 1.5e-3, "{} vs {x_eq}", last[1]);
+}

@@ -271,8 +271,6 @@ fn bad_transients_exit_2_naming_row_and_column() {
         ("time_s,t_c,x_m,p_a_pa\n0,40,0,1\n", "p_a_pa without p_b_pa"),
         ("time_s,t_c,x_m\n0,40,0\n0.001,50,abc\n", "row 2 (line 3), column x_m"),
         ("time_s,t_c,x_m\n0,40,0\n0.001,50,0\n0.002,50,0\n", "degrees of freedom"),
-        // A sample interval the twin's chooser cannot probe (it panicked).
-        ("time_s,t_c,x_m\n0,40,0\n10,50,0\n20,50,0\n30,50,0\n", "tick 10 s"),
         // Displacements in mm read as m, or negative beyond noise.
         (
             "time_s,t_c,x_m\n0,40,0\n0.001,50,0.7\n0.002,50,0\n",

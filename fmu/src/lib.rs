@@ -86,28 +86,6 @@ pub fn load_resource_params(dir: &Path) -> Result<RawParams, String> {
     compensator_params::file::load(&path).map_err(|e| format!("{}: {e}", path.display()))
 }
 
-/// Longest tick [s] the core's substep chooser can probe: its probes run
-/// at least 20 ticks within `MAX_PROBE` (0.5 s); a longer tick (an
-/// `estimator.tick_hz` below 40 Hz, which the schema allows) made the
-/// chooser's `clamp` panic.
-pub const MAX_TICK: f64 = compensator::dynamics::config::MAX_PROBE / 20.0;
-
-/// Refuses an `estimator.tick_hz` whose tick exceeds [`MAX_TICK`].
-///
-/// # Errors
-///
-/// One line naming the field and the lowest rate accepted.
-pub fn check_tick(tick_hz: f64) -> Result<(), String> {
-    if 1.0 / tick_hz > MAX_TICK {
-        return Err(format!(
-            "estimator.tick_hz = {tick_hz} Hz: the twin's substeps are chosen for ticks up to {MAX_TICK} s \
-             (at least {} Hz)",
-            1.0 / MAX_TICK
-        ));
-    }
-    Ok(())
-}
-
 /// The twin's configuration for a parameter file: the core's chooser at the
 /// estimator's tick over the validated range (what `build.rs` ships and
 /// `compensator step` runs).
@@ -117,7 +95,6 @@ pub fn check_tick(tick_hz: f64) -> Result<(), String> {
 /// Parameters the model refuses, or a chooser failure, in one line.
 pub fn chosen_config(raw: &RawParams) -> Result<compensator::dynamics::TwinConfig, String> {
     let p = compensator::Params::<f64>::new(raw).map_err(|e| e.to_string())?;
-    check_tick(raw.estimator.tick_hz)?;
     let valid = (raw.estimator.valid_min, raw.estimator.valid_max);
     compensator::dynamics::config::choose(&p, 1.0 / raw.estimator.tick_hz, valid)
         .map(|c| c.config)
