@@ -32,31 +32,15 @@
 use compensator::dynamics::linear::linearise;
 use compensator::dynamics::{Twin, TwinConfig};
 use compensator::equilibrium::{Stop, equilibrium};
-use compensator::estimator::{Estimator, EstimatorConfig};
 use compensator::params::RawParams;
 use compensator::{Params, Real};
-use host_tests::random::{Rng, physical_params};
+use host_tests::settling::{self, STEPS};
 
-const STEPS: [(f64, f64); 7] = [
-    (40.0, 0.0),
-    (60.0, -20.0),
-    (40.0, -40.0),
-    (40.0, 150.0),
-    (26.0, 110.0),
-    (26.0, 78.0),
-    (78.0, 26.0),
-];
 const TOLERANCES: [f64; 2] = [1e-2, 1e-3];
 
 /// Per stop at the end: every settling time and the worst (value, case),
 /// per tolerance.
 type ByStop = (Stop, [Vec<f64>; 2], [(f64, String); 2]);
-
-fn perturbed_paper(rng: &mut Rng, paper: &RawParams) -> RawParams {
-    let mut raw = *paper;
-    raw.core = raw.core.map(|n| n.value * 4f64.powf(rng.uniform(-1.0, 1.0)));
-    raw
-}
 
 /// One step's settling times in time constants (per tolerance), or `None`
 /// when the design or the step is out of the model's reach.
@@ -97,54 +81,17 @@ fn settle(raw: &RawParams, from: f64, to: f64) -> Option<([f64; 2], Stop, f64)> 
     Some((last_out.map(|k| k as f64 * tick / tau), eq.stop, tau))
 }
 
-/// Re-seats of the estimator's twin over one step (`None`: out of reach).
-fn estimator_reseats(raw: &RawParams, from: f64, to: f64) -> Option<u32> {
-    let mut raw = *raw;
-    raw.estimator.oil_min = -45.0;
-    raw.estimator.oil_max = 160.0;
-    let p32 = Params::<f32>::new(&raw).ok()?;
-    let p64 = Params::<f64>::new(&raw).ok()?;
-    let lin = linearise(&p64, to).ok()?;
-    let rate = lin.eigenvalues.iter().map(|l| -l.re).fold(f64::INFINITY, f64::min);
-    if !(rate > 2.0) {
-        return None;
-    }
-    let cfg = EstimatorConfig::new(&raw.estimator).ok()?;
-    let mut est = Estimator::new(&p32, cfg, from as f32).ok()?;
-    let hold = (400.0 / rate).max(3.0);
-    let tick = f64::from(cfg.tick());
-    let mut last = 0;
-    for (t, seconds) in [(from, 2.0), (to, hold)] {
-        for k in 0..(seconds / tick) as usize {
-            let sample = if k % 20 == 0 { Ok(Some(t as f32)) } else { Ok(None) };
-            last = est.tick(sample).reseats;
-        }
-    }
-    Some(last)
-}
-
 fn main() {
     let mut args = std::env::args().skip(1);
-    let designs: usize = args.next().map_or(300, |s| s.parse().expect("DESIGNS"));
+    let count: usize = args.next().map_or(300, |s| s.parse().expect("DESIGNS"));
     let seed: u64 = args.next().map_or(1, |s| s.parse().expect("SEED"));
     let paper = compensator_cli::load(&host_tests::repo_root().join("presets/paper.toml")).expect("paper preset");
-    let mut rng = Rng::new(seed);
     // Per (stop at the end, tolerance): every settling time, and the worst.
     let mut by_stop: Vec<ByStop> = Vec::new();
-    let mut used = 0;
     let (mut est_steps, mut est_reseated, mut est_worst) = (0, 0, String::new());
-    while used < designs {
-        let raw = if used % 2 == 0 {
-            physical_params(&mut rng)
-        } else {
-            perturbed_paper(&mut rng, &paper)
-        };
-        if raw.validate().is_err() {
-            continue;
-        }
-        used += 1;
+    for (used, raw) in settling::designs(seed, paper).take(count) {
         for (from, to) in STEPS {
-            if let Some(r) = estimator_reseats(&raw, from, to) {
+            if let Some(r) = settling::estimator_reseats(&raw, from, to) {
                 est_steps += 1;
                 if r > 0 {
                     est_reseated += 1;
@@ -175,7 +122,7 @@ fn main() {
         }
     }
     println!(
-        "{designs} designs (seed {seed}), abrupt steps, Twin<f32, f32> SHIPPED; settling time in slowest time constants"
+        "{count} designs (seed {seed}), abrupt steps, Twin<f32, f32> SHIPPED; settling time in slowest time constants"
     );
     println!("| ends | tolerance | steps | median | 99 % | max | worst case |");
     println!("|---|---:|---:|---:|---:|---:|---|");

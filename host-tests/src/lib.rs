@@ -11,6 +11,7 @@ pub mod fixed_audit;
 pub mod matrix;
 pub mod probe;
 pub mod random;
+pub mod settling;
 pub mod soak;
 pub mod survey;
 pub use compensator_reference::statics as reference;

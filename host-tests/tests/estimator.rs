@@ -567,3 +567,20 @@ fn flag_names_follow_the_bit_order() {
         assert_eq!(Flags::NAMES[f.0.trailing_zeros() as usize], name);
     }
 }
+
+/// The three abrupt cold steps onto the closed stop on which the settling
+/// study (`cargo run --release -p host-tests --example settling -- 1000`)
+/// saw the check re-seat a correct twin still travelling onto the stop
+/// (a 10-time-constant window there): none re-seats now.
+#[test]
+fn a_correct_twin_travelling_onto_the_closed_stop_is_not_reseated() {
+    use host_tests::settling::{designs, estimator_reseats};
+    let cases = [(243, 40.0, -40.0), (510, 60.0, -20.0), (956, 40.0, -40.0)];
+    let all: Vec<_> = designs(1, paper_raw()).take(956).collect();
+    for (n, from, to) in cases {
+        let (used, raw) = &all[n - 1];
+        assert_eq!(*used, n);
+        let reseats = estimator_reseats(raw, from, to).expect("within the model's reach");
+        assert_eq!(reseats, 0, "design {n}, {from} -> {to} C");
+    }
+}

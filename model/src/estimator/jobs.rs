@@ -3,14 +3,14 @@
 //! rotation is the estimator's, in the parent module).
 
 use super::stability::{quartic_hurwitz, slowest_decay_rate};
-use super::{MIN_SETTLE_TICKS, SETTLE_TIME_CONSTANTS, TWIN_SLEW};
+use super::{MAX_STOP_SETTLE, MIN_SETTLE_TICKS, SETTLE_TIME_CONSTANTS, STOP_SETTLE_TIME_CONSTANTS, TWIN_SLEW};
 use crate::asymptotic;
 use crate::compensation;
 use crate::dynamics::Twin;
 use crate::dynamics::fsi::{Contact, Fsi};
 use crate::dynamics::linear::characteristic_polynomial;
 use crate::dynamics::schemes::OdeSystem;
-use crate::equilibrium::{a_parameter, equilibrium_for};
+use crate::equilibrium::{Stop, a_parameter, equilibrium_for};
 use crate::error::ModelError;
 use crate::fluid::FluidPoint;
 use crate::params::Params;
@@ -100,16 +100,21 @@ pub(super) struct Statics {
     /// (p_a - p_c) / dp, (p_b - p_c) / dp)` (for the linearisation and the
     /// consistency check).
     pub(super) y_equilibrium: [f32; 4],
+    /// The equilibrium holds the plunger on the closed stop (the settling
+    /// window then covers the travel onto it: [`STOP_SETTLE_TIME_CONSTANTS`]).
+    pub(super) on_closed_stop: bool,
     pub(super) stable: bool,
-    /// `SETTLE_TIME_CONSTANTS / tick` [1/s] (constant).
-    settle_per_second: f32,
+    /// `1 / tick` [1/s] (constant).
+    ticks_per_second: f32,
     /// Lower bound of the slowest decay rate of the linearisation, in the
     /// twin's time unit (0: none, not stable); the next search's hint.
     slowest_rate: f32,
     /// Time constant of the slowest mode of the linearisation [s].
     pub(super) slowest_time_constant: f32,
     /// Steady ticks before the consistency check: [`SETTLE_TIME_CONSTANTS`]
-    /// of the slowest time constant, at least [`MIN_SETTLE_TICKS`];
+    /// of the slowest time constant (on the closed stop, up to
+    /// [`STOP_SETTLE_TIME_CONSTANTS`] of it within [`MAX_STOP_SETTLE`]), at
+    /// least [`MIN_SETTLE_TICKS`];
     /// `u32::MAX` (never) while the linearisation is not stable.
     pub(super) settle_ticks: u32,
     /// Machine losses at the last refreshed temperature [m^3/s].
@@ -134,8 +139,9 @@ impl Statics {
             x_equilibrium: f32::NAN,
             dx_dt: f32::NAN,
             y_equilibrium: [0.0; 4],
+            on_closed_stop: false,
             stable: true,
-            settle_per_second: SETTLE_TIME_CONSTANTS / tick,
+            ticks_per_second: 1.0 / tick,
             slowest_rate: 0.0,
             slowest_time_constant: f32::INFINITY,
             settle_ticks: u32::MAX,
@@ -191,6 +197,7 @@ pub(super) fn run(
             statics.dx_dt = asymptotic::sensitivity_at(p, point)?.dx_dt;
             statics.x_equilibrium = eq.x;
             statics.y_equilibrium = twin.model().equilibrium_state(&eq);
+            statics.on_closed_stop = eq.stop == Stop::Closed;
         }
         Job::Stability => {
             let sys = Fsi {
@@ -207,7 +214,12 @@ pub(super) fn run(
             statics.slowest_rate = sigma;
             if sigma > 0.0 {
                 statics.slowest_time_constant = twin.model().scales.time / sigma;
-                let ticks = statics.slowest_time_constant * statics.settle_per_second;
+                let tau = statics.slowest_time_constant;
+                let mut window = SETTLE_TIME_CONSTANTS * tau;
+                if statics.on_closed_stop {
+                    window = window.max((STOP_SETTLE_TIME_CONSTANTS * tau).min(MAX_STOP_SETTLE));
+                }
+                let ticks = window * statics.ticks_per_second;
                 // Saturating conversion; NaN is impossible here (sigma > 0).
                 statics.settle_ticks = if ticks < u32::MAX as f32 {
                     (ticks as u32).saturating_add(1).max(MIN_SETTLE_TICKS)
