@@ -8,10 +8,10 @@ use compensator::RawParams;
 use compensator_cli::identify::{self, Transient};
 use compensator_cli::{input, params_file};
 use compensator_reference::dynamics::{Method, Profile, simulate};
+mod common;
+use common::run;
 use rand::rngs::StdRng;
 use rand::{RngExt, SeedableRng};
-use std::path::PathBuf;
-use std::process::Command;
 
 /// Displacement noise of the synthetic records: 5 um, 0.3 % of the 1.5 mm
 /// stroke (an LVDT's linearity class), sampled at 1 kHz.
@@ -177,26 +177,6 @@ fn the_paper_design_reports_its_mass_as_not_identifiable() {
         // The preset keeps the base file's mass.
         assert_eq!(id.params.core.mass, truth.core.mass);
     }
-}
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap()
-        .to_path_buf()
-}
-
-fn run(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_compensator"))
-        .current_dir(root())
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8(out.stdout).unwrap(),
-        String::from_utf8(out.stderr).unwrap(),
-    )
 }
 
 fn temp_file(name: &str, contents: &str) -> String {
