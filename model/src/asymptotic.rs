@@ -325,15 +325,30 @@ pub fn monotonicity<T: Float>(params: &Params<T>, lo: T, hi: T, samples: u32) ->
         return Err(ModelError::OutOfRange("temperature interval"));
     }
     let n = samples.clamp(2, MAX_MONOTONICITY_SAMPLES);
-    let mut worst_t = lo;
-    let mut worst = T::ZERO;
-    let mut first = true;
-    let mut positive = 0u32;
-    let mut negative = 0u32;
-    for i in 0..n {
+    monotonicity_of((0..n).map(|i| {
         let frac = T::from_f64(i as f64 / (n - 1) as f64);
         let t = lo + (hi - lo) * frac;
-        let d = sensitivity(params, t)?.dx_dt_branch;
+        Ok((t, sensitivity(params, t)?.dx_dt_branch))
+    }))
+}
+
+/// The Eq. (32) verdict over samples `(t [C], dx/dt [m/K])` of the
+/// equilibrium branch, in temperature order: [`monotonicity`]'s tally,
+/// for a caller that has the sensitivities another way (cached oil
+/// points). No sample: not monotonic, `samples` 0.
+///
+/// # Errors
+///
+/// The first sample's error (the verdict needs every sample).
+pub fn monotonicity_of<T: Float>(
+    samples: impl Iterator<Item = Result<(T, T), ModelError>>,
+) -> Result<Monotonicity<T>, ModelError> {
+    let (mut worst_t, mut worst) = (T::ZERO, T::ZERO);
+    let mut first = true;
+    let (mut n, mut positive, mut negative) = (0u32, 0u32, 0u32);
+    for sample in samples {
+        let (t, d) = sample?;
+        n += 1;
         if d > T::ZERO {
             positive += 1;
         } else if d < T::ZERO {
@@ -345,7 +360,7 @@ pub fn monotonicity<T: Float>(params: &Params<T>, lo: T, hi: T, samples: u32) ->
             first = false;
         }
     }
-    let monotonic = positive == n || negative == n;
+    let monotonic = n > 0 && (positive == n || negative == n);
     let sign = if !monotonic {
         0
     } else if positive == n {

@@ -47,6 +47,7 @@ pub mod params;
 pub mod scalar;
 pub mod sensor;
 pub mod throttle;
+pub mod uncertainty;
 
 pub use error::ModelError;
 pub use params::{ParamError, Params, RawParams};

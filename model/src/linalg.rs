@@ -11,6 +11,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod eigen;
+pub mod small;
 
 use crate::scalar::Real;
 

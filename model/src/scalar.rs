@@ -67,6 +67,26 @@ pub trait Real:
     /// Square root; returns zero for negative input (and NaN for NaN in
     /// floating point).
     fn sqrt(self) -> Self;
+    /// `sqrt(a b + c d)` (zero where the sum is negative), for a sum that
+    /// may exceed the range of a saturating type while its root does not:
+    /// fixed point sums the exact products in 64 bits.
+    #[inline]
+    fn sqrt_sum_products(a: Self, b: Self, c: Self, d: Self) -> Self {
+        (a * b + c * d).sqrt()
+    }
+    /// `(sqrt(a b + c d), 1 / sqrt(a b + c d))`: the root as
+    /// [`Real::sqrt_sum_products`] and its reciprocal, or zero in place of
+    /// a reciprocal the type cannot hold (a root below `1 / 2048` in
+    /// Q12.20, or zero; the floats' is finite for any root: that of
+    /// [`Real::tiny`] for zero), where the caller divides instead. Fixed
+    /// point takes the reciprocal from the root's own Newton iteration
+    /// where the core multiplies 32 x 32 -> 64 in one instruction (within
+    /// `2^-29` relative, not rounded exactly), saving a division.
+    #[inline]
+    fn sqrt_recip_sum_products(a: Self, b: Self, c: Self, d: Self) -> (Self, Self) {
+        let r = Self::sqrt_sum_products(a, b, c, d);
+        (r, Self::ONE / r.max(Self::tiny()))
+    }
     /// Absolute value.
     fn abs(self) -> Self;
     /// `false` for NaN and infinities; always `true` for fixed point.
@@ -311,6 +331,9 @@ float_impls!(
 
 pub use fixed_point::{Fix, Q8_24, Q12_20, Q16_16};
 
+mod kernels;
+pub use kernels::{KernelMismatch, self_check as check_kernels};
+
 /// The fixed-point format the project ships: Q12.20 (range +-2048,
 /// resolution 9.5e-7). With the FSI model's row-scaled stage equations
 /// every intermediate stays within +-2048 on the paper preset and on 50
@@ -321,6 +344,7 @@ pub use fixed_point::{Fix, Q8_24, Q12_20, Q16_16};
 pub type Fixed = Q12_20;
 
 mod fixed_point {
+    use super::kernels;
     use super::*;
     use fixed::FixedI32;
     use fixed::types::extra::LeEqU32;
@@ -378,14 +402,20 @@ mod fixed_point {
         type Output = Self;
         #[inline]
         fn add(self, rhs: Self) -> Self {
-            Fix(self.0.saturating_add(rhs.0))
+            Fix(FixedI32::<F>::from_bits(kernels::add_saturating(
+                self.0.to_bits(),
+                rhs.0.to_bits(),
+            )))
         }
     }
     impl<F: LeEqU32> Sub for Fix<F> {
         type Output = Self;
         #[inline]
         fn sub(self, rhs: Self) -> Self {
-            Fix(self.0.saturating_sub(rhs.0))
+            Fix(FixedI32::<F>::from_bits(kernels::sub_saturating(
+                self.0.to_bits(),
+                rhs.0.to_bits(),
+            )))
         }
     }
     /// A 64-bit intermediate saturated to the 32-bit format.
@@ -404,9 +434,8 @@ mod fixed_point {
         type Output = Self;
         #[inline]
         fn mul(self, rhs: Self) -> Self {
-            let p = self.0.to_bits() as i64 * rhs.0.to_bits() as i64;
-            let half = if F::U32 > 0 { 1i64 << (F::U32 - 1) } else { 0 };
-            saturate((p + half) >> F::U32)
+            let p = kernels::mul_wide(self.0.to_bits(), rhs.0.to_bits());
+            Fix(FixedI32::<F>::from_bits(kernels::round_shift(p, F::U32)))
         }
     }
     /// Rounded to nearest, saturating; `x / 0` is the saturated value with
@@ -416,6 +445,13 @@ mod fixed_point {
         type Output = Self;
         #[inline]
         fn div(self, rhs: Self) -> Self {
+            if F::U32 <= 30 {
+                return Fix(FixedI32::<F>::from_bits(kernels::div_round(
+                    self.0.to_bits(),
+                    rhs.0.to_bits(),
+                    F::U32,
+                )));
+            }
             let (n, d) = ((self.0.to_bits() as i64) << F::U32, rhs.0.to_bits() as i64);
             if d == 0 {
                 return match n {
@@ -516,7 +552,36 @@ mod fixed_point {
         }
         #[inline]
         fn sqrt(self) -> Self {
-            Fix(self.0.checked_sqrt().unwrap_or(FixedI32::<F>::ZERO))
+            let x = self.0.to_bits();
+            if x <= 0 {
+                return Self::ZERO;
+            }
+            let root = kernels::isqrt_round((x as u64) << F::U32);
+            Fix(FixedI32::<F>::from_bits(root.min(i32::MAX as u64) as i32))
+        }
+        #[inline]
+        fn sqrt_recip_sum_products(a: Self, b: Self, c: Self, d: Self) -> (Self, Self) {
+            let ab = kernels::mul_wide(a.0.to_bits(), b.0.to_bits());
+            let cd = kernels::mul_wide(c.0.to_bits(), d.0.to_bits());
+            let n = ab.saturating_add(cd).max(0) as u64;
+            let (root, recip) = kernels::sqrt_and_recip(n, F::U32);
+            (
+                Fix(FixedI32::<F>::from_bits(root)),
+                Fix(FixedI32::<F>::from_bits(recip)),
+            )
+        }
+        /// The exact products summed in 64 bits, then the root: the sum
+        /// may exceed the format's range where its root does not.
+        #[inline]
+        fn sqrt_sum_products(a: Self, b: Self, c: Self, d: Self) -> Self {
+            let ab = kernels::mul_wide(a.0.to_bits(), b.0.to_bits());
+            let cd = kernels::mul_wide(c.0.to_bits(), d.0.to_bits());
+            let n = ab.saturating_add(cd);
+            if n <= 0 {
+                return Self::ZERO;
+            }
+            let root = kernels::isqrt_round(n as u64);
+            Fix(FixedI32::<F>::from_bits(root.min(i32::MAX as u64) as i32))
         }
         #[inline]
         fn abs(self) -> Self {
@@ -535,33 +600,43 @@ mod fixed_point {
         /// LSB) goes back into `carry`'s bits.
         #[inline]
         fn mul_add_compensated(self, a: Self, b: Self, carry: &mut Self) -> Self {
-            let p = a.0.to_bits() as i64 * b.0.to_bits() as i64 + carry.0.to_bits() as i64;
+            let p = kernels::mul_wide(a.0.to_bits(), b.0.to_bits()) + carry.0.to_bits() as i64;
             let half = if F::U32 > 0 { 1i64 << (F::U32 - 1) } else { 0 };
             let q = (p + half) >> F::U32;
             *carry = Fix(FixedI32::<F>::from_bits((p - (q << F::U32)) as i32));
             saturate(self.0.to_bits() as i64 + q)
         }
-        /// The sum of the exact products (units of `2^-2F`, in 128 bits),
-        /// times `a` exactly (`2^-3F`), plus the carry; rounded to the
-        /// format, the remainder (below half an LSB, kept to `2^-2F`) back
-        /// into `carry`. Saturating throughout (no input panics).
+        /// The sum of the exact products (units of `2^-2F`), times `a`
+        /// (`2^-3F`), plus the carry, rounded to the format; the remainder
+        /// (below half an LSB, kept to `2^-2F`) back into `carry`.
+        /// Saturating throughout (no input panics). The sum is split as
+        /// `s_hi 2^F + s_lo` so that `a s` is two 32 x 32 products where
+        /// `s_hi` fits 32 bits (every tick: `|h b_i| < 1`, `|w| < 2048`),
+        /// and formed in 128 bits only beyond.
         #[inline]
         fn dot_add_compensated(self, a: Self, b: &[Self], c: &[Self], carry: &mut Self) -> Self {
             let f = F::U32;
-            let mut sum: i128 = 0;
+            let mut sum: i64 = 0;
             for (bj, cj) in b.iter().zip(c) {
-                sum = sum.saturating_add(bj.0.to_bits() as i128 * cj.0.to_bits() as i128);
+                sum = sum.saturating_add(kernels::mul_wide(bj.0.to_bits(), cj.0.to_bits()));
             }
-            let p = (a.0.to_bits() as i128)
-                .saturating_mul(sum)
-                .saturating_add((carry.0.to_bits() as i128) << f);
-            let half = if f > 0 { 1i128 << (2 * f - 1) } else { 0 };
-            let q = p.saturating_add(half) >> (2 * f);
-            // |p - q 2^2F| <= 2^(2F-1): rounded to 2^-2F, below 2^(F-1) + 1.
-            let rem = p - (q << (2 * f));
-            let rounding = if f > 0 { 1i128 << (f - 1) } else { 0 };
-            *carry = Fix(FixedI32::<F>::from_bits(((rem + rounding) >> f) as i32));
-            let q = q.clamp(-(1i128 << 33), 1i128 << 33) as i64;
+            let (a, k) = (a.0.to_bits(), carry.0.to_bits() as i64);
+            let s_hi = sum >> f;
+            // `p` rounded to `2^-2F`: a s_hi + carry + round(a s_lo 2^-F).
+            let t = if s_hi == (s_hi as i32) as i64 && f > 0 {
+                let s_lo = (sum - (s_hi << f)) as i32;
+                let low = (kernels::mul_wide(a, s_lo) + (1i64 << (f - 1))) >> f;
+                kernels::mul_wide(a, s_hi as i32) + k + low
+            } else {
+                let p = (a as i128).saturating_mul(sum as i128).saturating_add((k as i128) << f);
+                let half = if f > 0 { 1i128 << (f - 1) } else { 0 };
+                (p.saturating_add(half) >> f).clamp(i64::MIN as i128 / 2, i64::MAX as i128 / 2) as i64
+            };
+            let half = if f > 0 { 1i64 << (f - 1) } else { 0 };
+            let q = (t + half) >> f;
+            // |t - q 2^F| <= 2^(F-1): the carry, in units of 2^-2F.
+            *carry = Fix(FixedI32::<F>::from_bits((t - (q << f)) as i32));
+            let q = q.clamp(-(1i64 << 33), 1i64 << 33);
             saturate(self.0.to_bits() as i64 + q)
         }
     }

@@ -20,6 +20,9 @@ pub struct Field {
     pub key: &'static str,
     /// `section.key`, the name used in error messages.
     pub path: &'static str,
+    /// `tolerances.section.key`: where the file gives the field's standard
+    /// uncertainty, and the name errors about it use.
+    pub tolerance_path: &'static str,
     /// The Rust field it fills (`"spring_rate"` of [`RawCore`]), for
     /// generated code that writes a parameter set as a struct literal.
     pub name: &'static str,
@@ -238,6 +241,28 @@ macro_rules! schema {
             pub fn zip<U>(self, other: $fields_ty<U>) -> $fields_ty<(T, U)> {
                 $fields_ty { $( $field: (self.$field, other.$field), )* }
             }
+
+            /// One entry per field, asked for by field in file order.
+            pub fn from_fn(mut value: impl FnMut(&'static Field) -> T) -> Self {
+                $fields_ty { $( $field: value(&$name::FIELD.$field), )* }
+            }
+
+            /// The entry of the field whose `section.key` is `path`.
+            pub fn get(&self, path: &str) -> Option<&T> {
+                $( if path == $name::FIELD.$field.path { return Some(&self.$field); } )*
+                None
+            }
+
+            /// The entry of the field whose `section.key` is `path`, mutable.
+            pub fn get_mut(&mut self, path: &str) -> Option<&mut T> {
+                $( if path == $name::FIELD.$field.path { return Some(&mut self.$field); } )*
+                None
+            }
+        }
+
+        impl $fields_ty<f64> {
+            /// Zero for every field.
+            pub const ZERO: Self = $fields_ty { $( $field: 0.0, )* };
         }
 
         #[doc = concat!("The fields of [`", stringify!($name), "`], in file order (the entries of [`",
@@ -251,6 +276,7 @@ macro_rules! schema {
                     section: $section,
                     key: $key,
                     path: concat!($section, ".", $key),
+                    tolerance_path: concat!("tolerances.", $section, ".", $key),
                     name: stringify!($field),
                     unit: $unit,
                     min: $min,
@@ -300,6 +326,22 @@ macro_rules! schema {
             pub fn map(&self, mut f: impl FnMut(Named) -> f64) -> Self {
                 let named = self.named();
                 Self { $( $field: f(named.$field), )* }
+            }
+
+            /// The value of the field named `path` (`section.key`), if
+            /// this section group has it: access by name, generated from the
+            /// list, so that no hand-written match can fall through to the
+            /// wrong field.
+            pub fn value(&self, path: &str) -> Option<f64> {
+                $( if path == Self::FIELD.$field.path { return Some(self.$field); } )*
+                None
+            }
+
+            /// The field named `path` (`section.key`) to write to, if this
+            /// section group has it (see [`Self::value`]).
+            pub fn value_mut(&mut self, path: &str) -> Option<&mut f64> {
+                $( if path == Self::FIELD.$field.path { return Some(&mut self.$field); } )*
+                None
             }
 
             /// Every field at its default, NaN where the key is required.
@@ -371,14 +413,17 @@ schema! {
     /// key has a default).
     struct RawEstimator, fields EstimatorFields, const ESTIMATOR_FIELDS;
     tick_hz: "estimator"."tick_hz" ["Hz", 1.0 ..= 100_000.0] = Some(1000.0), "Estimator tick rate.";
-    filter_time_constant: "estimator"."filter_time_constant" ["s", 1.0e-5 ..= 1.0e4] = Some(0.2), "First-order temperature filter time constant.";
+    // A hydraulic power unit's oil warms at 0.01-0.1 C/s; a cold-oil
+    // injection or a valve switching supplies reaches about 1 C/s. The
+    // observer's fast mode is tuned to follow this rate (`docs/firmware.md`).
+    max_oil_rate: "estimator"."max_oil_rate" ["C/s", 1.0e-4 ..= 100.0] = Some(1.0), "Largest plausible rate of change of the oil temperature (tunes the oil-temperature observer's fast mode).";
     spike_threshold: "estimator"."spike_threshold" ["C", 1.0e-3 ..= 1.0e3] = Some(5.0), "A sample further than this from the filtered value is a spike.";
     // The counter must be able to exceed the limit in 16 bits.
     spike_limit: "estimator"."spike_limit" ["-", 0.0 ..= 65_534.0, Kind::Whole] = Some(5.0), "Consecutive agreeing out-of-band samples rejected before the next one is taken as a real step (a whole number).";
     valid_min: "estimator"."valid_min" ["C", -60.0 ..= 300.0] = Some(26.0), "Lower end of the validated temperature range (inside oil_min..oil_max).";
     valid_max: "estimator"."valid_max" ["C", -60.0 ..= 300.0] = Some(78.0), "Upper end of the validated temperature range (above valid_min, inside oil_min..oil_max).";
-    oil_min: "estimator"."oil_min" ["C", -60.0 ..= 300.0] = Some(-20.0), "Coldest temperature the fluid model accepts.";
-    oil_max: "estimator"."oil_max" ["C", -60.0 ..= 300.0] = Some(150.0), "Hottest temperature the fluid model accepts (above oil_min).";
+    oil_min: "estimator"."oil_min" ["C", -60.0 ..= 300.0] = Some(-20.0), "Lower end of the oil range the estimator and the commands accept (the oil model may end inside it: the temperature envelope, docs/parameters.md).";
+    oil_max: "estimator"."oil_max" ["C", -60.0 ..= 300.0] = Some(150.0), "Upper end of the oil range (above oil_min; where the oil's viscosity falls below Walther's 2 cSt first, the oil model ends there).";
     telemetry_hz: "estimator"."telemetry_hz" ["Hz", 1.0e-3 ..= 50_000.0, Kind::OrZero] = Some(2.0), "Telemetry rate (0: none; at most tick_hz / 2).";
     // PT10 to PT10000 and beyond.
     rtd_r0: "estimator"."rtd_r0" ["ohm", 1.0 ..= 1.0e5] = Some(100.0), "RTD resistance at 0 C (PT100).";
@@ -392,6 +437,261 @@ schema! {
     rtd_c: "estimator"."rtd_c" ["1/C^4", -1.0e-9 ..= 1.0e-9] = Some(-4.183e-12), "Callendar-Van Dusen C, below 0 C only (IEC 60751 by default).";
 }
 
+schema! {
+    /// The temperature probe in its well (optional section `[probe]`; every
+    /// key has a default): its response, noise and tolerance, which the
+    /// estimator's oil-temperature observer and its uncertainty use.
+    ///
+    /// The defaults describe a 6 mm sheathed PT100 insert of IEC 60751
+    /// class B in a thermowell in flowing oil: Endress+Hauser's Omnigrad T
+    /// TST310 datasheet gives its bare 6 mm mineral-insulated probe t0.5 =
+    /// 3.5 s and t0.9 = 8 s in water at 0.4 m/s (the IEC 60751 test), and
+    /// Guenther's technical information an insert after DIN 43762 t0.5 =
+    /// 6-9 s, with a DIN 43772 thermowell 36-40 s; oil transfers heat
+    /// less well than water. A first-order probe has `time_constant` =
+    /// t0.5 / ln 2 = t0.9 / ln 10 (`docs/firmware.md`).
+    struct RawProbe, fields ProbeFields, const PROBE_FIELDS;
+    time_constant: "probe"."time_constant" ["s", 1.0e-3 ..= 1.0e4] = Some(8.0), "First-order time constant of the probe's response to the oil temperature, in its well (t0.5 / ln 2, t0.9 / ln 10).";
+    well_time_constant: "probe"."well_time_constant" ["s", 1.0e-3 ..= 1.0e4, Kind::OrZero] = Some(0.0), "Time constant of a second, slower lag in series (the thermowell; 0: none).";
+    noise: "probe"."noise" ["C", 1.0e-6 ..= 10.0, Kind::OrZero] = Some(0.02), "Standard deviation of one reading's noise, without the converter's quantization.";
+    // IEC 60751 classes: AA 0.1 + 0.0017 |t|, A 0.15 + 0.002 |t|,
+    // B 0.3 + 0.005 |t|, C 0.6 + 0.01 |t| (C).
+    tolerance_a: "probe"."tolerance_a" ["C", 1.0e-4 ..= 10.0, Kind::OrZero] = Some(0.3), "Constant part of the probe's tolerance +-(a + b |t|) (IEC 60751 class B: 0.3 C).";
+    tolerance_b: "probe"."tolerance_b" ["1/K", 1.0e-6 ..= 0.1, Kind::OrZero] = Some(0.005), "Part of the probe's tolerance proportional to |t| (IEC 60751 class B: 0.005).";
+}
+
+impl RawProbe {
+    /// The defaults of the `[probe]` section (a class B PT100 insert in a
+    /// thermowell).
+    pub const DEFAULT: RawProbe = RawProbe::WITH_DEFAULTS;
+
+    /// Checks the probe section: every field within its plausible range (no
+    /// rule ties them together).
+    ///
+    /// # Errors
+    ///
+    /// The first field's [`Field::check`] error.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        self.check_fields()
+    }
+
+    /// Half-width of the probe's tolerance at `t` [C]: `a + b |t|` [C]
+    /// (IEC 60751's class limits).
+    pub fn tolerance_at(&self, t: f64) -> f64 {
+        self.tolerance_a + self.tolerance_b * t.abs()
+    }
+}
+
+/// Most correlations a parameter file may declare (every pair of eight
+/// fields: what `compensator calibrate` writes for its largest fits).
+pub const MAX_CORRELATIONS: usize = 28;
+
+/// A correlation coefficient between the uncertainties of two fields.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Correlation {
+    /// `section.key` of the first field.
+    pub a: &'static str,
+    /// `section.key` of the second field.
+    pub b: &'static str,
+    /// Correlation coefficient r, in [-1, 1].
+    pub coefficient: f64,
+}
+
+/// The standard uncertainties of the device's parameters (GUM: one
+/// standard deviation each, in the field's unit; 0: exactly known), from
+/// the optional `[tolerances]` section keyed like the fields
+/// (`laminar_throttle.diameter = 5.8e-6`), and their correlations from the
+/// `[[correlation]]` tables. Only the compensator's and the machine's fields
+/// have them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RawTolerances {
+    /// Of the compensator's fields [their units].
+    pub core: CoreFields<f64>,
+    /// Of the machine's fields [their units].
+    pub machine: MachineFields<f64>,
+    /// The declared correlations, `correlations[..count]`.
+    pub correlations: [Correlation; MAX_CORRELATIONS],
+    /// How many of `correlations` are declared.
+    pub count: usize,
+}
+
+const NO_CORRELATION: Correlation = Correlation {
+    a: "",
+    b: "",
+    coefficient: 0.0,
+};
+
+impl RawTolerances {
+    /// Every parameter exactly known, no correlation.
+    pub const NONE: RawTolerances = RawTolerances {
+        core: CoreFields::ZERO,
+        machine: MachineFields::ZERO,
+        correlations: [NO_CORRELATION; MAX_CORRELATIONS],
+        count: 0,
+    };
+
+    /// The standard uncertainty of the field at `path` (`section.key`), if
+    /// the field can have one.
+    pub fn get(&self, path: &str) -> Option<f64> {
+        self.core.get(path).or_else(|| self.machine.get(path)).copied()
+    }
+
+    /// The standard uncertainty of the field at `path`, mutable.
+    pub fn get_mut(&mut self, path: &str) -> Option<&mut f64> {
+        match self.core.get_mut(path) {
+            Some(v) => Some(v),
+            None => self.machine.get_mut(path),
+        }
+    }
+
+    /// The declared correlations.
+    pub fn correlations(&self) -> &[Correlation] {
+        &self.correlations[..self.count.min(MAX_CORRELATIONS)]
+    }
+
+    /// The correlation coefficient between the fields at `a` and `b` (1 for
+    /// a field with itself, 0 when none is declared).
+    pub fn correlation(&self, a: &str, b: &str) -> f64 {
+        if a == b {
+            return 1.0;
+        }
+        self.correlations()
+            .iter()
+            .find(|c| (c.a == a && c.b == b) || (c.a == b && c.b == a))
+            .map_or(0.0, |c| c.coefficient)
+    }
+
+    /// Declares the correlation `coefficient` between the fields `a` and
+    /// `b` (paths of the schema's fields; checked by [`RawParams::validate`]).
+    ///
+    /// # Errors
+    ///
+    /// [`Problem::OutOfRange`] on `a` when [`MAX_CORRELATIONS`] are declared
+    /// already.
+    pub fn push_correlation(&mut self, a: &'static str, b: &'static str, coefficient: f64) -> Result<(), ParamError> {
+        if self.count >= MAX_CORRELATIONS {
+            return Err(ParamError {
+                field: a,
+                value: coefficient,
+                problem: Problem::OutOfRange {
+                    min: 0.0,
+                    max: MAX_CORRELATIONS as f64,
+                    why: "correlations a file may declare",
+                },
+            });
+        }
+        self.correlations[self.count] = Correlation { a, b, coefficient };
+        self.count += 1;
+        Ok(())
+    }
+
+    /// Whether any parameter is uncertain.
+    pub fn any(&self) -> bool {
+        self.core
+            .into_array()
+            .iter()
+            .chain(self.machine.into_array().iter())
+            .any(|&s| s != 0.0)
+    }
+
+    /// Checks each standard uncertainty against its field's value in `raw`
+    /// and each correlation (the matrix's positive semi-definiteness is the
+    /// reader's check, `file::parse`, and the uncertainty's).
+    ///
+    /// # Errors
+    ///
+    /// On the field's tolerance path (`tolerances.plunger.spring_rate`):
+    /// [`Problem::NotANumber`], [`Problem::Infinite`], [`Problem::NotPositive`]
+    /// for a negative one, [`Problem::OutOfRange`] for one above a third of
+    /// the field's value (a device three standard deviations away would
+    /// change the sign of a physical quantity) or on a machine field without
+    /// a `[machine]` section ([`Problem::Inconsistent`]). On a correlation's
+    /// first field: [`Problem::Correlation`].
+    pub fn validate(&self, core: &RawCore, machine: Option<&RawMachine>) -> Result<(), ParamError> {
+        let core_sigmas = CORE_FIELDS
+            .iter()
+            .zip(self.core.into_array())
+            .zip(core.named().into_array());
+        for ((field, sigma), named) in core_sigmas {
+            check_sigma(field, sigma, named.value)?;
+        }
+        for (field, sigma) in MACHINE_FIELDS.iter().zip(self.machine.into_array()) {
+            match machine {
+                Some(m) => {
+                    let value = m
+                        .named()
+                        .into_array()
+                        .iter()
+                        .find(|n| n.path == field.path)
+                        .map_or(0.0, |n| n.value);
+                    check_sigma(field, sigma, value)?;
+                }
+                None if sigma != 0.0 => {
+                    return Err(ParamError {
+                        field: field.tolerance_path,
+                        value: sigma,
+                        problem: Problem::Inconsistent("a tolerance of the machine needs the [machine] section"),
+                    });
+                }
+                None => {}
+            }
+        }
+        for (i, c) in self.correlations().iter().enumerate() {
+            let bad = |why: &'static str| ParamError {
+                field: c.a,
+                value: c.coefficient,
+                problem: Problem::Correlation { with: c.b, why },
+            };
+            if !c.coefficient.is_finite() || c.coefficient.abs() > 1.0 {
+                return Err(bad("a correlation coefficient must lie in [-1, 1]"));
+            }
+            if c.a == c.b {
+                return Err(bad("a field is not correlated with itself"));
+            }
+            if self.get(c.a).is_none() || self.get(c.b).is_none() {
+                return Err(bad("only the compensator's and the machine's fields have tolerances"));
+            }
+            if self.get(c.a) == Some(0.0) || self.get(c.b) == Some(0.0) {
+                return Err(bad("both fields need a tolerance in [tolerances]"));
+            }
+            let repeated = self.correlations()[..i]
+                .iter()
+                .any(|d| (d.a == c.a && d.b == c.b) || (d.a == c.b && d.b == c.a));
+            if repeated {
+                return Err(bad("declared twice"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Checks one standard uncertainty `sigma` of `field`, whose value is
+/// `value`.
+fn check_sigma(field: &Field, sigma: f64, value: f64) -> Result<(), ParamError> {
+    let n = Named {
+        path: field.tolerance_path,
+        value: sigma,
+    };
+    finite(n)?;
+    if sigma < 0.0 {
+        return Err(err(n, Problem::NotPositive));
+    }
+    // Every field with a tolerance is a physical magnitude of one sign
+    // (Walther's constants included); three standard deviations must not
+    // reach zero.
+    if sigma > value.abs() / 3.0 {
+        return Err(err(
+            n,
+            Problem::OutOfRange {
+                min: 0.0,
+                max: value.abs() / 3.0,
+                why: "at most a third of the field's value",
+            },
+        ));
+    }
+    Ok(())
+}
+
 /// A complete, unvalidated parameter set as read from a file.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RawParams {
@@ -401,7 +701,66 @@ pub struct RawParams {
     pub machine: Option<RawMachine>,
     /// Estimator settings (defaults where the file is silent).
     pub estimator: RawEstimator,
+    /// The temperature probe (defaults where the file is silent).
+    pub probe: RawProbe,
+    /// The parameters' standard uncertainties (none where the file is
+    /// silent).
+    pub tolerances: RawTolerances,
 }
+
+/// Every field of the file in file order: core, `[machine]`, `[estimator]`,
+/// `[probe]`.
+pub fn all_fields() -> impl Iterator<Item = &'static Field> {
+    CORE_FIELDS
+        .iter()
+        .chain(MACHINE_FIELDS.iter())
+        .chain(ESTIMATOR_FIELDS.iter())
+        .chain(PROBE_FIELDS.iter())
+}
+
+/// The field named `path` (`section.key`, as in messages and `docs/parameters.md`).
+pub fn field_by_path(path: &str) -> Option<&'static Field> {
+    all_fields().find(|f| f.path == path)
+}
+
+/// Why a field could not be reached by its name ([`RawParams::get`],
+/// [`RawParams::set`]). `Display` is one line naming the path; with the
+/// `toml` feature (host builds) it adds the nearest valid name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PathError<'a> {
+    /// The name asked for, as given.
+    pub path: &'a str,
+    /// What is wrong with it.
+    pub problem: PathProblem,
+}
+
+/// What [`PathError`] found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PathProblem {
+    /// No field of the file has this `section.key`.
+    Unknown,
+    /// A `[machine]` field, and the parameter set has no `[machine]` section.
+    NoMachineSection,
+}
+
+impl fmt::Display for PathError<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let path = crate::Echo::head(self.path);
+        match self.problem {
+            PathProblem::Unknown => {
+                write!(f, "unknown parameter '{path}' (a section.key of docs/parameters.md)")?;
+                #[cfg(feature = "toml")]
+                if let Some(near) = crate::file::nearest_path(self.path) {
+                    write!(f, "; did you mean {near}?")?;
+                }
+                Ok(())
+            }
+            PathProblem::NoMachineSection => write!(f, "{path}: the parameter file has no [machine] section"),
+        }
+    }
+}
+
+impl core::error::Error for PathError<'_> {}
 
 /// What is wrong with a field.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -448,6 +807,13 @@ pub enum Problem {
     NotRepresentable(&'static str),
     /// A fraction where a count is needed.
     NotWhole,
+    /// A declared correlation between this field and `with` is wrong.
+    Correlation {
+        /// `section.key` of the other field.
+        with: &'static str,
+        /// What is wrong.
+        why: &'static str,
+    },
 }
 
 /// A rejected parameter: which field (`section.key`), its value, and why.
@@ -503,6 +869,7 @@ impl fmt::Display for ParamError {
             }
             Problem::NotRepresentable(ty) => write!(f, "{field} = {v}: not representable as {ty}"),
             Problem::NotWhole => write!(f, "{field} = {v}: must be a whole number"),
+            Problem::Correlation { with, why } => write!(f, "correlation of {field} and {with} = {v}: {why}"),
         }
     }
 }
@@ -730,22 +1097,98 @@ impl RawEstimator {
 
 impl RawParams {
     /// Validates every section: first every field of the file against its
-    /// own plausible range (core, machine, estimator, in file order), then
-    /// the rules between fields, so that the blame lands on the field that
-    /// is wrong rather than on one a rule compares it with.
+    /// own plausible range (core, machine, estimator, probe, in file order),
+    /// then the rules between fields, so that the blame lands on the field
+    /// that is wrong rather than on one a rule compares it with. The
+    /// tolerances are checked where they are used
+    /// ([`RawTolerances::validate`]: by the file reader and the uncertainty
+    /// table), not here: a firmware image validating its parameters at
+    /// start needs neither them nor the `f64` arithmetic of their rule.
     ///
     /// # Errors
     ///
     /// The first [`ParamError`] in that order (see [`RawCore::validate`]
-    /// and [`RawEstimator::validate`] for the rules).
+    /// and [`RawEstimator::validate`] for the rules;
+    /// `machine.leakage_temperature` outside the oil range).
     pub fn validate(&self) -> Result<(), ParamError> {
         self.core.check_fields()?;
         if let Some(m) = &self.machine {
             m.check_fields()?;
         }
         self.estimator.check_fields()?;
+        self.probe.check_fields()?;
         self.core.check_rules()?;
-        self.estimator.check_rules()
+        self.estimator.check_rules()?;
+        if let Some(m) = &self.machine {
+            // The losses are scaled by the viscosity at the reference
+            // temperature: the oil model must be used there.
+            let (lo, hi) = (self.estimator.oil_min, self.estimator.oil_max);
+            if !(m.leakage_temperature >= lo && m.leakage_temperature <= hi) {
+                return Err(err(
+                    m.named().leakage_temperature,
+                    Problem::OutOfRange {
+                        min: lo,
+                        max: hi,
+                        why: "the oil range, estimator.oil_min..estimator.oil_max",
+                    },
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The value of the field named `path` (`section.key`), generated from
+    /// the schema (`plunger.mass` is `self.core.mass`).
+    ///
+    /// # Errors
+    ///
+    /// [`PathProblem::Unknown`] for a name no field has,
+    /// [`PathProblem::NoMachineSection`] for a `[machine]` field of a set
+    /// without that section.
+    pub fn get<'a>(&self, path: &'a str) -> Result<f64, PathError<'a>> {
+        let err = |problem| PathError { path, problem };
+        if let Some(v) = self
+            .core
+            .value(path)
+            .or_else(|| self.estimator.value(path))
+            .or_else(|| self.probe.value(path))
+        {
+            return Ok(v);
+        }
+        match &self.machine {
+            Some(m) => m.value(path).ok_or(err(PathProblem::Unknown)),
+            None if MACHINE_FIELDS.iter().any(|f| f.path == path) => Err(err(PathProblem::NoMachineSection)),
+            None => Err(err(PathProblem::Unknown)),
+        }
+    }
+
+    /// Sets the field named `path` (`section.key`) to `value`, without
+    /// validating (call [`RawParams::validate`] after the last change).
+    ///
+    /// # Errors
+    ///
+    /// As [`RawParams::get`]; nothing is changed then.
+    pub fn set<'a>(&mut self, path: &'a str, value: f64) -> Result<(), PathError<'a>> {
+        let err = |problem| PathError { path, problem };
+        let slot = match self.core.value_mut(path) {
+            Some(slot) => Some(slot),
+            None => match self.estimator.value_mut(path) {
+                Some(slot) => Some(slot),
+                None => self.probe.value_mut(path),
+            },
+        };
+        if let Some(slot) = slot {
+            *slot = value;
+            return Ok(());
+        }
+        match &mut self.machine {
+            Some(m) => m
+                .value_mut(path)
+                .map(|slot| *slot = value)
+                .ok_or(err(PathProblem::Unknown)),
+            None if MACHINE_FIELDS.iter().any(|f| f.path == path) => Err(err(PathProblem::NoMachineSection)),
+            None => Err(err(PathProblem::Unknown)),
+        }
     }
 
     /// Assembles a parameter set from a lookup `get(section, key)`, applying
@@ -780,10 +1223,13 @@ impl RawParams {
         };
         let estimator =
             RawEstimator::from_fields(|field| get(field.section, field.key).or(field.default).unwrap_or(f64::NAN));
+        let probe = RawProbe::from_fields(|field| get(field.section, field.key).or(field.default).unwrap_or(f64::NAN));
         let raw = RawParams {
             core,
             machine,
             estimator,
+            probe,
+            tolerances: RawTolerances::NONE,
         };
         raw.validate()?;
         Ok(raw)

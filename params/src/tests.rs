@@ -8,7 +8,7 @@
 //! the macro: a field inserted, removed, moved or given another's key makes
 //! these tests fail.
 
-use crate::{CORE_FIELDS, ESTIMATOR_FIELDS, MACHINE_FIELDS, ParamError, Problem, RawParams};
+use crate::{CORE_FIELDS, ESTIMATOR_FIELDS, MACHINE_FIELDS, PROBE_FIELDS, ParamError, Problem, RawParams};
 
 type Get = fn(&RawParams) -> f64;
 
@@ -48,9 +48,7 @@ const EVERY_FIELD: &[(&str, f64, Get)] = &[
     ("machine.leakage_reference", 3.5e-5, |r| machine(r).leakage_reference),
     ("machine.leakage_temperature", 41.0, |r| machine(r).leakage_temperature),
     ("estimator.tick_hz", 800.0, |r| r.estimator.tick_hz),
-    ("estimator.filter_time_constant", 0.25, |r| {
-        r.estimator.filter_time_constant
-    }),
+    ("estimator.max_oil_rate", 0.7, |r| r.estimator.max_oil_rate),
     ("estimator.spike_threshold", 4.5, |r| r.estimator.spike_threshold),
     ("estimator.spike_limit", 7.0, |r| r.estimator.spike_limit),
     ("estimator.valid_min", 24.0, |r| r.estimator.valid_min),
@@ -65,6 +63,11 @@ const EVERY_FIELD: &[(&str, f64, Get)] = &[
     ("estimator.rtd_a", 3.95e-3, |r| r.estimator.rtd_a),
     ("estimator.rtd_b", -5.8e-7, |r| r.estimator.rtd_b),
     ("estimator.rtd_c", -4.2e-12, |r| r.estimator.rtd_c),
+    ("probe.time_constant", 6.5, |r| r.probe.time_constant),
+    ("probe.well_time_constant", 21.0, |r| r.probe.well_time_constant),
+    ("probe.noise", 0.015, |r| r.probe.noise),
+    ("probe.tolerance_a", 0.15, |r| r.probe.tolerance_a),
+    ("probe.tolerance_b", 0.002, |r| r.probe.tolerance_b),
 ];
 
 /// [`EVERY_FIELD`]'s value for `section.key`, with `replaced` (a path and
@@ -92,11 +95,8 @@ fn assert_every_field_in_place(raw: &RawParams) {
 
 #[test]
 fn the_schema_lists_the_fields_of_the_hand_written_table_in_its_order() {
-    let tables = CORE_FIELDS
-        .iter()
-        .chain(MACHINE_FIELDS.iter())
-        .chain(ESTIMATOR_FIELDS.iter());
-    assert_eq!(tables.clone().count(), EVERY_FIELD.len());
+    let tables = every_schema_field();
+    assert_eq!(every_schema_field().count(), EVERY_FIELD.len());
     for (field, (path, v, _)) in tables.zip(EVERY_FIELD) {
         assert_eq!(field.path, *path);
         assert_eq!(field.path.split_once('.'), Some((field.section, field.key)));
@@ -137,8 +137,8 @@ fn every_missing_field_is_named() {
             }
         });
         match (path.split_once('.'), raw) {
-            // Estimator keys have defaults.
-            (Some(("estimator", _)), raw) => assert!(raw.is_ok(), "{path}: {raw:?}"),
+            // Estimator and probe keys have defaults.
+            (Some(("estimator" | "probe", _)), raw) => assert!(raw.is_ok(), "{path}: {raw:?}"),
             (_, Err(e)) => assert_eq!((e.field, e.problem), (*path, Problem::Missing)),
             (_, Ok(_)) => panic!("{path}: accepted without it"),
         }
@@ -179,11 +179,12 @@ fn every_field_round_trips_through_the_file_by_name() {
 }
 
 /// Every field of the schema, in file order.
-fn every_schema_field() -> impl Iterator<Item = &'static crate::Field> {
+fn every_schema_field() -> impl Iterator<Item = &'static crate::Field> + Clone {
     CORE_FIELDS
         .iter()
         .chain(MACHINE_FIELDS.iter())
         .chain(ESTIMATOR_FIELDS.iter())
+        .chain(PROBE_FIELDS.iter())
 }
 
 #[test]
@@ -331,7 +332,10 @@ fn file_errors_are_one_bounded_line_naming_the_key() {
     );
     let huge = format!("[plunger]\n{} = 1\n", "k".repeat(10_000_000));
     assert!(one_line(&huge).ends_with("…: unknown key"));
-    assert_eq!(one_line("[plunger]\n\"ma\\nss\" = 1\n"), "plunger.ma\\nss: unknown key");
+    assert_eq!(
+        one_line("[plunger]\n\"ma\\nss\" = 1\n"),
+        "plunger.ma\\nss: unknown key; did you mean plunger.mass?"
+    );
     assert_eq!(
         one_line("plunger = 1\n"),
         "plunger: expected a section [plunger], not a value"
@@ -340,4 +344,158 @@ fn file_errors_are_one_bounded_line_naming_the_key() {
     assert_eq!(e.field(), Some("plunger.mass"));
     assert_eq!(e.to_string(), "plunger.mass: expected a number, found a TOML array");
     assert!(matches!(e, LoadError::NotANumber { found: "array", .. }));
+}
+
+/// The `[tolerances]` section and `[[correlation]]` tables: read under the
+/// fields' names, written back, and refused by name when wrong.
+#[cfg(feature = "toml")]
+#[test]
+fn tolerances_and_correlations_round_trip_and_are_checked_by_name() {
+    use crate::file::{fmt_float, parse, to_toml};
+    use std::fmt::Write as _;
+
+    let mut base = String::new();
+    let mut section = "";
+    for (path, v, _) in EVERY_FIELD {
+        let (s, key) = path.split_once('.').unwrap();
+        if s != section {
+            let _ = writeln!(base, "[{s}]");
+            section = s;
+        }
+        let _ = writeln!(base, "{key} = {}", fmt_float(*v));
+    }
+    let with = |extra: &str| format!("{base}\n{extra}");
+    let text = with(
+        "[tolerances]\nlaminar_throttle.diameter = 5.8e-6\nplunger.spring_rate = 700.0\n\
+         [tolerances.machine]\nleakage_reference = 1e-6\n\
+         [[correlation]]\nfields = [\"plunger.spring_rate\", \"laminar_throttle.diameter\"]\ncoefficient = -0.25\n",
+    );
+    let raw = parse(&text).unwrap();
+    assert_eq!(raw.tolerances.core.laminar_diameter, 5.8e-6);
+    assert_eq!(raw.tolerances.core.spring_rate, 700.0);
+    assert_eq!(raw.tolerances.machine.leakage_reference, 1e-6);
+    assert_eq!(raw.tolerances.core.mass, 0.0);
+    assert_eq!(
+        raw.tolerances
+            .correlation("laminar_throttle.diameter", "plunger.spring_rate"),
+        -0.25
+    );
+    assert_eq!(raw.tolerances.correlation("plunger.mass", "plunger.spring_rate"), 0.0);
+    let back = parse(&to_toml(&raw)).unwrap();
+    assert_eq!(back, raw, "{}", to_toml(&raw));
+
+    let refused = |extra: &str| parse(&with(extra)).unwrap_err().to_string();
+    assert_eq!(
+        refused("[tolerances]\nplunger.sping_rate = 1.0\n"),
+        "tolerances.plunger.sping_rate: unknown key; did you mean tolerances.plunger.spring_rate?"
+    );
+    assert_eq!(
+        refused("[tolerances]\nestimator.tick_hz = 1.0\n"),
+        "tolerances.estimator.tick_hz: unknown key"
+    );
+    assert_eq!(
+        refused("[tolerances]\nplunger.mass = -1e-3\n"),
+        "tolerances.plunger.mass = -0.001: must be positive"
+    );
+    assert_eq!(
+        refused("[tolerances]\nplunger.mass = 0.5\n"),
+        "tolerances.plunger.mass = 0.5: must lie in [0, 0.007] (at most a third of the field's value)"
+    );
+    assert_eq!(
+        refused("[tolerances]\nplunger.mass = \"big\"\n"),
+        "tolerances.plunger.mass: expected a number, found a TOML string"
+    );
+    let two = "[tolerances]\nplunger.mass = 1e-3\nplunger.spring_rate = 700.0\nplunger.damping = 0.1\n";
+    assert_eq!(
+        refused(&format!(
+            "{two}[[correlation]]\nfields = [\"plunger.mass\", \"plunger.spring_rate\"]\ncoefficient = 1.5\n"
+        )),
+        "correlation of plunger.mass and plunger.spring_rate = 1.5: a correlation coefficient must lie in [-1, 1]"
+    );
+    assert_eq!(
+        refused(&format!(
+            "{two}[[correlation]]\nfields = [\"plunger.mass\", \"plunger.stroke\"]\ncoefficient = 0.5\n"
+        )),
+        "correlation of plunger.mass and plunger.stroke = 0.5: both fields need a tolerance in [tolerances]"
+    );
+    assert_eq!(
+        refused(&format!(
+            "{two}[[correlation]]\nfields = [\"plunger.mass\"]\ncoefficient = 0.5\n"
+        )),
+        "correlation 1: fields must name two fields, fields = [\"section.key\", \"section.key\"]"
+    );
+    // Three fields each correlated 0.9 with one and -0.9 with another:
+    // no population has that matrix.
+    let psd = format!(
+        "{two}[[correlation]]\nfields = [\"plunger.mass\", \"plunger.spring_rate\"]\ncoefficient = 0.9\n\
+         [[correlation]]\nfields = [\"plunger.mass\", \"plunger.damping\"]\ncoefficient = 0.9\n\
+         [[correlation]]\nfields = [\"plunger.spring_rate\", \"plunger.damping\"]\ncoefficient = -0.9\n"
+    );
+    assert!(
+        refused(&psd).contains("not a valid correlation matrix"),
+        "{}",
+        refused(&psd)
+    );
+    // A machine tolerance without a [machine] section is named.
+    let no_machine: String = base.split("[machine]").next().unwrap().to_string()
+        + &base
+            .split("[estimator]")
+            .nth(1)
+            .map(|r| format!("[estimator]{r}"))
+            .unwrap();
+    let e = parse(&format!("{no_machine}\n[tolerances]\nmachine.working_flow = 1e-9\n")).unwrap_err();
+    assert_eq!(e.field(), Some("tolerances.machine.working_flow"), "{e}");
+}
+
+#[test]
+fn every_field_is_reached_by_its_path_for_reading_and_writing() {
+    let raw = read(None).expect("the test's values are valid");
+    for (path, v, get) in EVERY_FIELD {
+        assert_eq!(raw.get(path), Ok(*v), "{path}");
+        let mut changed = raw;
+        changed.set(path, 0.5).unwrap();
+        assert_eq!(get(&changed), 0.5, "{path}: set wrote another field");
+        // Every other field is untouched.
+        for (other, w, get_other) in EVERY_FIELD {
+            if other != path {
+                assert_eq!(get_other(&changed), *w, "setting {path} changed {other}");
+            }
+        }
+    }
+    let mut no_machine = raw;
+    no_machine.machine = None;
+    let e = no_machine.get("machine.working_flow").unwrap_err();
+    assert_eq!(e.problem, crate::PathProblem::NoMachineSection);
+    assert!(no_machine.set("machine.working_flow", 1.0).is_err());
+    let e = raw.get("plunger.sping_rate").unwrap_err();
+    assert_eq!(e.problem, crate::PathProblem::Unknown);
+    assert_eq!(
+        e.to_string(),
+        "unknown parameter 'plunger.sping_rate' (a section.key of docs/parameters.md); did you mean plunger.spring_rate?"
+    );
+}
+
+#[test]
+fn misspelt_keys_and_sections_get_the_nearest_valid_name() {
+    use crate::file::{nearest_path, parse};
+    assert_eq!(nearest_path("plunger.sping_rate"), Some("plunger.spring_rate"));
+    assert_eq!(nearest_path("plungr.mass"), Some("plunger.mass"));
+    assert_eq!(nearest_path("plunger.bulk_modulus"), Some("fluid.bulk_modulus"));
+    assert_eq!(nearest_path("estimator.oil_mx"), Some("estimator.oil_max"));
+    assert_eq!(nearest_path("something.else"), None);
+    let preset = include_str!("../../presets/paper.toml");
+    let typo = preset.replace("spring_rate", "sping_rate");
+    assert_eq!(
+        parse(&typo).unwrap_err().to_string(),
+        "plunger.sping_rate: unknown key; did you mean plunger.spring_rate?"
+    );
+    let typo = preset.replace("[plunger]", "[plungr]");
+    let e = parse(&typo).unwrap_err().to_string();
+    assert!(e.ends_with("unknown key; did you mean [plunger]?"), "{e}");
+    // A section named otherwise: its keys are found where they belong.
+    let typo = preset.replace("[fluid]", "[oil]");
+    let e = parse(&typo).unwrap_err().to_string();
+    assert!(e.ends_with("; did you mean fluid.bulk_modulus?"), "{e}");
+    let e = parse("[plunger]\ncolour = 1\n").unwrap_err().to_string();
+    assert_eq!(e, "plunger.colour: unknown key");
 }

@@ -10,6 +10,18 @@
 //! `1e-5 dp`) and the oil's properties evaluated at the profile's
 //! temperature at every time (a ramp is followed exactly, not per tick).
 //!
+//! The port pressures `p_p`, `p_c` are the parameter file's, or a given
+//! history ([`Ports::Given`], piecewise linear: a changing pressure drop), or
+//! the outlet is the node of a circuit ([`Ports::Circuit`]: a line volume
+//! between the compensator and a load orifice to a tank),
+//!
+//! ```text
+//! C_line dp_c/dt = Q0 - Q_load(p_c),  Q0 = (p_a - p_c) / R_l + Q_t(p_b - p_c) + Q_w(x, p_p - p_c)
+//! Q_load(p) = K_load sign(p - p_tank) sqrt|p - p_tank|,  Q_w = eta pi d x sqrt(2 (p_p - p_c) / rho)
+//! ```
+//!
+//! integrated with the compensator as one stiff system.
+//!
 //! The end stops are events: in free motion the solver stops exactly where
 //! `x` reaches a stop (inelastic: `v = 0`, then held if the static force
 //! pushes into the stop); while held it stops where the force changes sign
@@ -93,6 +105,133 @@ impl Profile {
     }
 }
 
+/// One piece of a port-pressure history: supply and outlet pressure [Pa]
+/// linear in time from `t0` [s].
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Segment {
+    t0: f64,
+    supply: (f64, f64),
+    outlet: (f64, f64),
+}
+
+impl Segment {
+    fn at(&self, t: f64) -> (f64, f64) {
+        let dt = t - self.t0;
+        (self.supply.0 + self.supply.1 * dt, self.outlet.0 + self.outlet.1 * dt)
+    }
+}
+
+/// A piecewise-linear history `(time [s], value)`, held before its first
+/// and after its last point; two points at one time are a jump.
+fn segment_of(points: &[(f64, f64)], t: f64) -> (f64, f64, f64) {
+    let Some(&(t_first, v_first)) = points.first() else {
+        return (t, 0.0, 0.0);
+    };
+    if t < t_first {
+        return (t_first, v_first, 0.0);
+    }
+    for w in points.windows(2) {
+        let ((ta, va), (tb, vb)) = (w[0], w[1]);
+        if t >= ta && t < tb {
+            return (ta, va, (vb - va) / (tb - ta));
+        }
+    }
+    let &(tl, vl) = points.last().unwrap_or(&(t, 0.0));
+    (tl, vl, 0.0)
+}
+
+/// The load of [`Ports::Circuit`]: a line volume after the compensator,
+/// drained by an orifice to a tank.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Load {
+    /// Hydraulic capacitance of the line `V / beta` [m^3/Pa].
+    pub capacitance: f64,
+    /// Orifice coefficient `K`: `Q = K sqrt(p - p_tank)` [m^3/s/sqrt(Pa)].
+    pub coefficient: f64,
+    /// Tank pressure [Pa].
+    pub tank: f64,
+}
+
+impl Load {
+    /// Flow through the load orifice at line pressure `p` [Pa] (signed,
+    /// regularised below `transition` [Pa]).
+    pub fn flow(&self, p: f64, transition: f64) -> f64 {
+        let d = p - self.tank;
+        self.coefficient * d / (d * d + transition * transition).powf(0.25)
+    }
+}
+
+/// The pressures at the compensator's ports over time.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Ports {
+    /// The parameter file's: `p_c = operating.outlet_pressure`, `p_p = p_c
+    /// + operating.pressure_drop`.
+    Fixed,
+    /// Supply and outlet pressure given as `(time [s], p_p [Pa], p_c [Pa])`,
+    /// linear between the points, held outside them (two points at one
+    /// time: a jump).
+    Given(Vec<(f64, f64, f64)>),
+    /// The supply given as `(time [s], p_p [Pa])`, the outlet the line of
+    /// a [`Load`] (a state, starting where the circuit is at rest).
+    Circuit {
+        /// Supply pressure history.
+        supply: Vec<(f64, f64)>,
+        /// The line and its load orifice.
+        load: Load,
+    },
+}
+
+impl Ports {
+    /// The piece of the history in force from `t` [s] (for a circuit, the
+    /// outlet part is unused).
+    fn segment(&self, p: &RawCore, t: f64) -> Segment {
+        match self {
+            Ports::Fixed => Segment {
+                t0: t,
+                supply: (p.outlet_pressure + p.pressure_drop, 0.0),
+                outlet: (p.outlet_pressure, 0.0),
+            },
+            Ports::Given(points) => {
+                let sp: Vec<(f64, f64)> = points.iter().map(|q| (q.0, q.1)).collect();
+                let op: Vec<(f64, f64)> = points.iter().map(|q| (q.0, q.2)).collect();
+                let (ts, s0, ss) = segment_of(&sp, t);
+                let (to, o0, os) = segment_of(&op, t);
+                Segment {
+                    t0: t,
+                    supply: (s0 + ss * (t - ts), ss),
+                    outlet: (o0 + os * (t - to), os),
+                }
+            }
+            Ports::Circuit { supply, .. } => {
+                let (ts, s0, ss) = segment_of(supply, t);
+                Segment {
+                    t0: t,
+                    supply: (s0 + ss * (t - ts), ss),
+                    outlet: (0.0, 0.0),
+                }
+            }
+        }
+    }
+
+    /// Times in `(0, t_end)` where the history's slope changes (phase
+    /// boundaries).
+    fn kinks(&self, t_end: f64) -> Vec<f64> {
+        let times: Vec<f64> = match self {
+            Ports::Fixed => vec![],
+            Ports::Given(points) => points.iter().map(|q| q.0).collect(),
+            Ports::Circuit { supply, .. } => supply.iter().map(|q| q.0).collect(),
+        };
+        times.into_iter().filter(|k| *k > 0.0 && *k < t_end).collect()
+    }
+
+    fn load(&self) -> Option<Load> {
+        match self {
+            Ports::Circuit { load, .. } => Some(*load),
+            _ => None,
+        }
+    }
+}
+
 /// Motion state of the plunger.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mode {
@@ -104,13 +243,23 @@ pub enum Mode {
     Open,
 }
 
-/// The model at a fixed mode.
+/// The model at a fixed mode, over one piece of the port pressures. The
+/// state is `(x, v, p_a, p_b, p_c)`: the outlet pressure is a state in a
+/// circuit and follows the given history otherwise (its derivative zero,
+/// the history read instead).
 #[derive(Clone, Copy, Debug)]
 pub struct Fsi {
     p: RawCore,
     profile: Profile,
     mode: Mode,
+    segment: Segment,
+    load: Option<Load>,
 }
+
+/// State `(x [m], v [m/s], p_a [Pa], p_b [Pa])`, and `p_c` [Pa] fifth in
+/// a circuit (`N = 5`; otherwise `N = 4`, so that the solver's error norm
+/// and steps are those of the compensator alone).
+type State<const N: usize> = [f64; N];
 
 impl Fsi {
     fn area(&self) -> f64 {
@@ -125,17 +274,40 @@ impl Fsi {
     }
 
     /// Net static force on the plunger, positive towards `x_max` [N].
-    pub fn force(&self, y: &[f64; 4]) -> f64 {
+    pub fn force(&self, y: &[f64]) -> f64 {
         self.area() * (y[3] - y[2]) - self.p.spring_rate * (self.p.preload + y[0])
     }
-}
 
-impl ODE<f64, [f64; 4]> for Fsi {
-    fn diff(&self, t: f64, y: &[f64; 4], d: &mut [f64; 4]) {
+    /// Supply and outlet pressure [Pa] at `t` [s] in state `y`.
+    fn ports(&self, t: f64, y: &[f64]) -> (f64, f64) {
+        let (pp, pc) = self.segment.at(t);
+        match (self.load, y.get(4)) {
+            (Some(_), Some(&line)) => (pp, line),
+            _ => (pp, pc),
+        }
+    }
+
+    /// The flow leaving the compensator [m^3/s] (capillary of (a), orifice
+    /// of (b), window) at `t` [s] in state `y`.
+    pub fn outflow(&self, t: f64, y: &[f64]) -> f64 {
+        if y.len() < 4 {
+            return f64::NAN;
+        }
         let p = &self.p;
         let (nu, rho) = statics::oil(p, self.profile.temperature(t));
         let r_l = 128.0 * nu * rho * p.laminar_length / (PI * p.laminar_diameter.powi(4));
-        let (pc, pp) = (p.outlet_pressure, p.outlet_pressure + p.pressure_drop);
+        let (pp, pc) = self.ports(t, y);
+        let window = p.slot_discharge * PI * p.slot_diameter * y[0].max(0.0) * (2.0 * (pp - pc).max(0.0) / rho).sqrt();
+        (y[2] - pc) / r_l + self.orifice(y[3] - pc, rho) + window
+    }
+}
+
+impl<const N: usize> ODE<f64, State<N>> for Fsi {
+    fn diff(&self, t: f64, y: &State<N>, d: &mut State<N>) {
+        let p = &self.p;
+        let (nu, rho) = statics::oil(p, self.profile.temperature(t));
+        let r_l = 128.0 * nu * rho * p.laminar_length / (PI * p.laminar_diameter.powi(4));
+        let (pp, pc) = self.ports(t, y);
         let area = self.area();
         let (x, v) = match self.mode {
             Mode::Free => (y[0], y[1]),
@@ -153,25 +325,31 @@ impl ODE<f64, [f64; 4]> for Fsi {
             d[0] = 0.0;
             d[1] = 0.0;
         }
+        if let (Some(load), Some(&line)) = (self.load, y.get(4)) {
+            let q_load = load.flow(line, TRANSITION_FRACTION * p.pressure_drop);
+            let mut held = *y;
+            held[0] = x;
+            d[4] = (self.outflow(t, &held) - q_load) / load.capacitance;
+        }
     }
 }
 
 /// Output handler of one phase: records samples on the output grid from
 /// the dense output, and stops exactly at the phase's event.
-struct Phase<'a> {
+struct Phase<'a, const N: usize> {
     sys: &'a Fsi,
     grid: &'a [f64],
     next: usize,
-    samples: Vec<(f64, [f64; 4])>,
+    samples: Vec<(f64, State<N>)>,
     g_prev: Option<f64>,
-    event: Option<(f64, [f64; 4])>,
+    event: Option<(f64, State<N>)>,
     phase_end: f64,
-    end_state: Option<[f64; 4]>,
+    end_state: Option<State<N>>,
 }
 
-impl Phase<'_> {
+impl<const N: usize> Phase<'_, N> {
     /// Event function and the crossing direction that ends the phase.
-    fn g(&self, y: &[f64; 4]) -> (f64, f64) {
+    fn g(&self, y: &State<N>) -> (f64, f64) {
         match self.sys.mode {
             Mode::Free => (y[0].min(self.sys.p.stroke - y[0]), -1.0),
             Mode::Closed => (self.sys.force(y), 1.0),
@@ -180,18 +358,18 @@ impl Phase<'_> {
     }
 }
 
-impl Solout<f64, [f64; 4]> for Phase<'_> {
+impl<const N: usize> Solout<f64, State<N>> for Phase<'_, N> {
     fn solout<I>(
         &mut self,
         t_curr: f64,
         t_prev: f64,
-        y_curr: &[f64; 4],
-        _y_prev: &[f64; 4],
+        y_curr: &State<N>,
+        _y_prev: &State<N>,
         interp: &mut I,
-        _sol: &mut Solution<f64, [f64; 4]>,
-    ) -> ControlFlag<f64, [f64; 4]>
+        _sol: &mut Solution<f64, State<N>>,
+    ) -> ControlFlag<f64, State<N>>
     where
-        I: Interpolation<f64, [f64; 4]> + ?Sized,
+        I: Interpolation<f64, State<N>> + ?Sized,
     {
         let (gc, dir) = self.g(y_curr);
         // Seeded from the phase's initial state: a crossing within the
@@ -299,6 +477,11 @@ pub struct Trajectory {
     pub time: Vec<f64>,
     /// States `(x [m], v [m/s], p_a [Pa], p_b [Pa])` at the sample times.
     pub state: Vec<[f64; 4]>,
+    /// Supply and outlet pressure `(p_p, p_c)` [Pa] at the sample times.
+    pub ports: Vec<(f64, f64)>,
+    /// The flow leaving the compensator `Q0` [m^3/s] at the sample times
+    /// (capillary of (a), orifice of (b), window).
+    pub outflow: Vec<f64>,
     /// Mode changes `(time [s], new mode)`.
     pub events: Vec<(f64, Mode)>,
     /// Accepted steps of the integrator.
@@ -307,12 +490,26 @@ pub struct Trajectory {
 
 /// The equilibrium state `(x, 0, p_a, p_b)` at temperature `t` [C] and its mode.
 pub fn equilibrium(p: &RawCore, t: f64) -> ([f64; 4], Mode) {
-    let e = statics::equilibrium(p, t);
-    let y = [e.x, 0.0, e.p_a, e.p_b];
+    let (y, mode) = equilibrium_at(p, t, p.outlet_pressure + p.pressure_drop, p.outlet_pressure);
+    ([y[0], y[1], y[2], y[3]], mode)
+}
+
+/// The equilibrium state `(x, 0, p_a, p_b, p_c)` at temperature `t` [C]
+/// with supply and outlet pressures `pp`, `pc` [Pa] (`pp > pc`), and its mode.
+fn equilibrium_at(p: &RawCore, t: f64, pp: f64, pc: f64) -> ([f64; 5], Mode) {
+    let at = RawCore {
+        pressure_drop: pp - pc,
+        outlet_pressure: pc,
+        ..*p
+    };
+    let e = statics::equilibrium(&at, t);
+    let y = [e.x, 0.0, e.p_a, e.p_b, pc];
     let sys = Fsi {
         p: *p,
         profile: Profile::Step { from: t, to: t },
         mode: Mode::Free,
+        segment: Ports::Fixed.segment(p, 0.0),
+        load: None,
     };
     let f = sys.force(&y);
     let mode = if e.x <= 0.0 && f <= 0.0 {
@@ -337,6 +534,68 @@ pub fn simulate(
     method: Method,
     rtol: f64,
 ) -> Result<Trajectory, String> {
+    simulate_with(p, profile, &Ports::Fixed, t_end, dt, method, rtol)
+}
+
+/// The outlet pressure [Pa] where a circuit ([`Ports::Circuit`]) with
+/// supply `pp` [Pa] is at rest at `t` [C]: the compensator's equilibrium
+/// flow equals the load's (bisection on the line pressure between the
+/// tank and the supply).
+///
+/// # Errors
+///
+/// A supply not above the tank, or a flow balance without a root there.
+pub fn circuit_rest(p: &RawCore, t: f64, pp: f64, load: &Load) -> Result<f64, String> {
+    if !(pp > load.tank) {
+        return Err(format!("supply {pp} Pa is not above the tank's {} Pa", load.tank));
+    }
+    let balance = |pc: f64| {
+        let at = RawCore {
+            pressure_drop: pp - pc,
+            outlet_pressure: pc,
+            ..*p
+        };
+        statics::equilibrium(&at, t).q_total - load.flow(pc, TRANSITION_FRACTION * p.pressure_drop)
+    };
+    let (lo, hi) = (load.tank, load.tank + 0.999 * (pp - load.tank));
+    if !(balance(lo) >= 0.0 && balance(hi) <= 0.0) {
+        return Err("the circuit's flow balance has no root between the tank and the supply".into());
+    }
+    Ok(statics::bisect_decreasing(balance, lo, hi))
+}
+
+/// As [`simulate`], with the port pressures of `ports`: from the
+/// equilibrium at the profile's start temperature and the ports' pressures
+/// at `t = 0` (a circuit: where it is at rest, [`circuit_rest`]).
+///
+/// # Errors
+///
+/// As [`simulate`], and a start where the supply is not above the outlet.
+pub fn simulate_with(
+    p: &RawCore,
+    profile: Profile,
+    ports: &Ports,
+    t_end: f64,
+    dt: f64,
+    method: Method,
+    rtol: f64,
+) -> Result<Trajectory, String> {
+    if ports.load().is_some() {
+        run::<5>(p, profile, ports, t_end, dt, method, rtol)
+    } else {
+        run::<4>(p, profile, ports, t_end, dt, method, rtol)
+    }
+}
+
+fn run<const N: usize>(
+    p: &RawCore,
+    profile: Profile,
+    ports: &Ports,
+    t_end: f64,
+    dt: f64,
+    method: Method,
+    rtol: f64,
+) -> Result<Trajectory, String> {
     if !(t_end > 0.0 && dt > 0.0 && rtol > 0.0) {
         return Err("t_end, dt and rtol must be positive".into());
     }
@@ -353,23 +612,48 @@ pub fn simulate(
     }
     let t_end = n as f64 * dt;
     let grid: Vec<f64> = (0..=n).map(|k| k as f64 * dt).collect();
-    let (mut y, mut mode) = equilibrium(p, profile.start());
+    let start = ports.segment(p, 0.0).at(0.0);
+    let outlet0 = match ports.load() {
+        Some(load) => circuit_rest(p, profile.start(), start.0, &load)?,
+        None => start.1,
+    };
+    if !(start.0 > outlet0) {
+        return Err(format!(
+            "at t = 0 the supply {} Pa is not above the outlet {outlet0} Pa",
+            start.0
+        ));
+    }
+    let (y5, mut mode) = equilibrium_at(p, profile.start(), start.0, outlet0);
+    let mut y: State<N> = [0.0; N];
+    for (a, b) in y.iter_mut().zip(y5) {
+        *a = b;
+    }
+    let sample = |sys: &Fsi, t: f64, y: &[f64]| -> ((f64, f64), f64) { (sys.ports(t, y), sys.outflow(t, y)) };
+    let first = Fsi {
+        p: *p,
+        profile,
+        mode,
+        segment: ports.segment(p, 0.0),
+        load: ports.load(),
+    };
+    let (ports0, q0) = sample(&first, 0.0, &y);
     let mut out = Trajectory {
         time: vec![0.0],
-        state: vec![y],
+        state: vec![[y[0], y[1], y[2], y[3]]],
+        ports: vec![ports0],
+        outflow: vec![q0],
         events: vec![],
         steps: 0,
     };
     let mut next = 1;
     let mut t = 0.0;
-    let atol = [
-        rtol * p.stroke,
-        rtol * p.stroke * 1e3,
-        rtol * p.pressure_drop,
-        rtol * p.pressure_drop,
-    ];
-    // Phases end at events and at the profile's kinks.
+    let mut atol = [rtol * p.pressure_drop; N];
+    atol[0] = rtol * p.stroke;
+    atol[1] = rtol * p.stroke * 1e3;
+    // Phases end at events and at the profile's and the ports' kinks.
     let mut boundaries: Vec<f64> = profile.kinks().into_iter().filter(|k| *k > 0.0 && *k < t_end).collect();
+    boundaries.extend(ports.kinks(t_end));
+    boundaries.sort_by(f64::total_cmp);
     boundaries.push(t_end);
     let mut guard = 0;
     while t < t_end {
@@ -378,7 +662,13 @@ pub fn simulate(
             return Err("too many phases (chattering at a stop?)".into());
         }
         let phase_end = boundaries.iter().copied().find(|b| *b > t).unwrap_or(t_end);
-        let sys = Fsi { p: *p, profile, mode };
+        let sys = Fsi {
+            p: *p,
+            profile,
+            mode,
+            segment: ports.segment(p, t),
+            load: ports.load(),
+        };
         let mut phase = Phase {
             sys: &sys,
             grid: &grid,
@@ -403,7 +693,7 @@ pub fn simulate(
                 y,
                 &mut phase,
                 ImplicitRungeKutta::radau5()
-                    .rtol([rtol; 4])
+                    .rtol([rtol; N])
                     .atol(atol)
                     .h_max(h_max)
                     .max_steps(budget),
@@ -425,8 +715,11 @@ pub fn simulate(
         };
         out.steps += steps;
         for (ts, ys) in phase.samples.drain(..) {
+            let (pts, q) = sample(&sys, ts, &ys);
             out.time.push(ts);
-            out.state.push(ys);
+            out.state.push([ys[0], ys[1], ys[2], ys[3]]);
+            out.ports.push(pts);
+            out.outflow.push(q);
         }
         next = phase.next;
         if let Some((te, mut ye)) = phase.event {
@@ -460,17 +753,17 @@ pub fn simulate(
     Ok(out)
 }
 
-fn solve<M>(
+fn solve<M, const N: usize>(
     sys: &Fsi,
     t0: f64,
     t1: f64,
-    y0: [f64; 4],
-    phase: &mut Phase<'_>,
+    y0: State<N>,
+    phase: &mut Phase<'_, N>,
     mut method: M,
     budget: usize,
 ) -> Result<usize, String>
 where
-    M: OrdinaryNumericalMethod<f64, [f64; 4]> + Interpolation<f64, [f64; 4]>,
+    M: OrdinaryNumericalMethod<f64, State<N>> + Interpolation<f64, State<N>>,
 {
     let sol = solve_ode(&mut method, sys, t0, t1, &y0, phase).map_err(|e| match e {
         Error::MaxSteps { t, .. } => format!(

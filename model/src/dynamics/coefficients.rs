@@ -93,6 +93,14 @@ pub struct Coefficients<T> {
     pub q_t: T,
     /// `g_l = dp / (R_l(t) Q*)` (temperature-dependent).
     pub g_l: T,
+    /// The pressure drop across the compensator in units of the model's
+    /// `dp`: `D = (p_p - p_c) / dp`, one unless a changing drop is set
+    /// ([`super::Twin::set_pressures`]; the model's units stay those of
+    /// `dp`). It enters as the supply pressure `pi_p = D` above the outlet
+    /// (the orifice drop of chamber (a) is `D - pi_a`) and through the
+    /// chambers' drive `g_l D - sigma w`. Fixed point: `D <= 1` keeps the
+    /// ranges of `docs/dynamics.md`.
+    pub drop: T,
     /// The flow unit is `2^flow_shift Q*` ([`flow_shift`]): `q_t`, `g_l`
     /// and `sigma` above are divided by `2^flow_shift`, `omega_a0`,
     /// `omega_b0` multiplied by it (`inv_omega_a0`, `inv_omega_b0`
@@ -253,6 +261,7 @@ impl<F: Float> Model<F> {
             u_tr: c(TRANSITION_FRACTION, "u_tr")?,
             q_t: represent(q_t / s, "q_t")?,
             g_l: represent(g_l / s, "g_l")?,
+            drop: T::ONE,
             flow_shift: shift,
         })
     }
@@ -269,6 +278,30 @@ impl<F: Float> Model<F> {
 }
 
 impl<T: Real> Coefficients<T> {
+    /// The same coefficients in `f32` (rounded where `T` is wider; exact
+    /// from fixed point, whose 32-bit words `f32` holds to 24 bits).
+    pub fn to_f32(&self) -> Coefficients<f32> {
+        Coefficients {
+            a_x: self.a_x.to_f32(),
+            inv_a_x: self.inv_a_x.to_f32(),
+            phi_over_a_x: self.phi_over_a_x.to_f32(),
+            two_zeta: self.two_zeta.to_f32(),
+            xi0: self.xi0.to_f32(),
+            omega_a0: self.omega_a0.to_f32(),
+            inv_omega_a0: self.inv_omega_a0.to_f32(),
+            eps_a: self.eps_a.to_f32(),
+            omega_b0: self.omega_b0.to_f32(),
+            inv_omega_b0: self.inv_omega_b0.to_f32(),
+            eps_b: self.eps_b.to_f32(),
+            sigma: self.sigma.to_f32(),
+            u_tr: self.u_tr.to_f32(),
+            q_t: self.q_t.to_f32(),
+            g_l: self.g_l.to_f32(),
+            drop: self.drop.to_f32(),
+            flow_shift: self.flow_shift,
+        }
+    }
+
     /// Net static force on the plunger in units of the spring force at one
     /// stroke, divided by `a_x`: positive opens (towards `x_max`).
     #[inline]
@@ -286,20 +319,29 @@ impl<T: Real> Coefficients<T> {
 
     /// What drives each chamber's orifice at plunger velocity `w`: the
     /// capillary's full-drop flow less the flow the plunger displaces,
-    /// `g_l - sigma w` (both chambers' rows read `u' = -omega (q_t r(u) +
-    /// g_l u - (g_l - sigma w))` in their orifice drops `u = 1 - pi_a`,
-    /// `u = pi_b`).
+    /// `g_l D - sigma w` (both chambers' rows read `u' = -omega (q_t r(u) +
+    /// g_l u - (g_l D - sigma w))` in their orifice drops `u = D - pi_a`,
+    /// `u = pi_b`; `D` is [`Coefficients::drop`], one at the design's drop).
     #[inline]
     pub fn drive(&self, w: T) -> T {
-        self.g_l - self.sigma * w
+        self.g_l * self.drop - self.sigma * w
+    }
+
+    /// The supply pressure above the outlet in model units, `pi_p = D`
+    /// ([`Coefficients::drop`]): chamber (a)'s orifice drop is
+    /// `supply() - pi_a`.
+    #[inline]
+    pub fn supply(&self) -> T {
+        self.drop
     }
 
     /// The chambers' net inflows `(F_a, F_b)` at `y`, for the orifice flows
-    /// `ra = r(1 - pi_a)`, `rb = r(pi_b)`:
+    /// `ra = r(D - pi_a)`, `rb = r(pi_b)` (`D` the drop,
+    /// [`Coefficients::drop`]):
     ///
     /// ```text
-    /// F_a = q_t r(1 - pi_a) - g_l pi_a + sigma w
-    /// F_b = g_l (1 - pi_b) - q_t r(pi_b) - sigma w
+    /// F_a = q_t r(D - pi_a) - g_l pi_a + sigma w
+    /// F_b = g_l (D - pi_b) - q_t r(pi_b) - sigma w
     /// ```
     ///
     /// The pressure rows of the model are `pi_a' = omega_a F_a`,
@@ -316,7 +358,7 @@ impl<T: Real> Coefficients<T> {
         let sw = self.sigma * y[1];
         (
             self.q_t * ra - self.g_l * y[2] + sw,
-            self.g_l * (T::ONE - y[3]) - self.q_t * rb - sw,
+            self.g_l * (self.drop - y[3]) - self.q_t * rb - sw,
         )
     }
 
@@ -333,9 +375,9 @@ impl<T: Real> Coefficients<T> {
 
     /// The chambers' quasi-steady state at plunger velocity `w` (their
     /// inflows zero, the limit `C_a, C_b -> 0` of [`super::reduced`]):
-    /// `s = sqrt(1 - pi_a) = sqrt(pi_b)` and `ds/dw`. Both chambers give
-    /// the same quadratic, `g_l s^2 + q_t s - (g_l - sigma w) = 0`; beyond
-    /// `sigma w >= g_l` (the plunger outruns the capillaries) `s` is held
+    /// `s = sqrt(D - pi_a) = sqrt(pi_b)` and `ds/dw`. Both chambers give
+    /// the same quadratic, `g_l s^2 + q_t s - (g_l D - sigma w) = 0`; beyond
+    /// `sigma w >= g_l D` (the plunger outruns the capillaries) `s` is held
     /// at zero.
     #[inline]
     pub fn quasi_steady(&self, w: T) -> (T, T) {
@@ -352,14 +394,14 @@ impl<T: Real> Coefficients<T> {
 
     /// The static force with the chambers at their quasi-steady pressures
     /// for the current temperature (what the force settles to within tens
-    /// of microseconds at rest): `phi' (2 s0^2 - 1) - (xi0 + xi) / a_x`,
+    /// of microseconds at rest): `phi' (2 s0^2 - D) - (xi0 + xi) / a_x`,
     /// `s0` the quasi-steady root at rest ([`Coefficients::quasi_steady`]
     /// at `w = 0`).
     #[inline]
     pub fn quasi_steady_force(&self, xi: T) -> T {
         let two = T::ONE + T::ONE;
-        let s0 = self.quasi_steady_root(self.g_l);
-        self.phi_over_a_x * (two * s0 * s0 - T::ONE) - (self.xi0 + xi) * self.inv_a_x
+        let s0 = self.quasi_steady_root(self.drive(T::ZERO));
+        self.phi_over_a_x * (two * s0 * s0 - self.drop) - (self.xi0 + xi) * self.inv_a_x
     }
 
     /// Sets the temperature-dependent `q_t`, `g_l` for a fluid state, and
@@ -415,6 +457,7 @@ pub(crate) mod tests {
             u_tr,
             q_t: 1.02,
             g_l: 1.4,
+            drop: 1.0,
             flow_shift: 0,
         }
     }

@@ -19,8 +19,9 @@
 //!
 //! ```text
 //! K u + q_t r(u) = c,   K = k + g_l,  k = (1 - eps xi) / (omega_0 h gamma)
-//! chamber (a): u = 1 - pi_a,  c = k (1 - Z_a) + g_l - sigma w
-//! chamber (b): u = pi_b,      c = k Z_b       + g_l - sigma w
+//! chamber (a): u = D - pi_a,  c = k (D - Z_a) + g_l D - sigma w
+//! chamber (b): u = pi_b,      c = k Z_b       + g_l D - sigma w
+//! (D the pressure drop in units of dp, one at the design's: Coefficients::drop)
 //! s = 2 |c| / (q_t + R),  R = sqrt(q_t^2 + 4 K |c|),  u = sign(c) s^2
 //! ```
 //!
@@ -132,16 +133,70 @@ pub struct Dirk<T> {
     stages: usize,
     /// `a_ij / gamma`.
     alpha: [[T; MAX_STAGES]; MAX_STAGES],
-    /// `h gamma` for the full step (model time units).
-    h_gamma: T,
     /// The weights `b` (the last row of `A`) times `h` (model time units).
     h_b: [T; MAX_STAGES],
+    /// What the whole step's stages share.
+    full: StepFactors<T>,
+}
+
+/// What the stages of a step of one length share: `h gamma` and the
+/// products and reciprocals that follow from it and the model's constant
+/// coefficients, formed once per step instead of once per stage and
+/// chamber (each stage then multiplies where it divided).
+#[derive(Clone, Copy, Debug)]
+struct StepFactors<T> {
+    /// `h gamma` (model time units).
+    hg: T,
+    /// `1 / hg` where it is resolved (`hg >= 2^-10`: `1 / hg <= 1024`),
+    /// else zero and the stiff chamber's `tau / hg` is divided.
+    inv_hg: T,
+    /// `h gamma a_x`.
+    hg_a_x: T,
+    /// `1 + 2 zeta hg + hg^2`, the momentum row's own slope.
+    base: T,
+    /// `hg phi'`, the hydraulic coupling over the stage.
+    hp: T,
+    /// `1 / hp` and `base / hp` (zero unless `hp > 1` in a saturating
+    /// type: the Newton step's scaled form, [`Dirk::free_stage`]).
+    inv_hp: T,
+    base_over_hp: T,
+}
+
+impl<T: Real> StepFactors<T> {
+    fn new(hg: T, c: &Coefficients<T>) -> Self {
+        // 2^-10: 1 / hg stays within half of Q12.20's range (a float's
+        // reciprocal always is).
+        let resolved = !T::SATURATES || hg >= T::from_f64(1.0 / 1024.0);
+        let hp = hg * c.phi_over_a_x;
+        let base = T::ONE + hg * c.two_zeta + hg * hg;
+        let scaled = T::SATURATES && hp > T::ONE;
+        let inv_hp = if scaled { T::ONE / hp } else { T::ZERO };
+        StepFactors {
+            hg,
+            inv_hg: if resolved { T::ONE / hg } else { T::ZERO },
+            hg_a_x: hg * c.a_x,
+            base,
+            hp,
+            inv_hp,
+            base_over_hp: if scaled { base * inv_hp } else { T::ZERO },
+        }
+    }
+
+    /// `tau / hg`, multiplied where `1 / hg` is resolved.
+    #[inline]
+    fn over_hg(&self, tau: T) -> T {
+        if !T::SATURATES || self.inv_hg > T::ZERO {
+            tau * self.inv_hg
+        } else {
+            tau / self.hg
+        }
+    }
 }
 
 /// One chamber's stage solution.
 #[derive(Clone, Copy, Debug)]
 struct Chamber<T> {
-    /// Orifice drop `u` (`1 - pi_a` or `pi_b`).
+    /// Orifice drop `u` (`D - pi_a` or `pi_b`).
     u: T,
     /// `du/dw`, the chamber's response to the stage's plunger velocity.
     du_dw: T,
@@ -150,55 +205,59 @@ struct Chamber<T> {
 /// `K u + q sign(u) sqrt|u| = c` for `u` (unique: the left side is
 /// strictly increasing in `u`), and `du/dc`.
 ///
-/// `K > 0` and `q >= 0` come from [`chamber`]: `q <= 1.05` always, and where
-/// `K > 1` the equation is first divided by `K`, so that every intermediate
-/// stays within a few units (what fixed point needs for both range and
-/// resolution). Then `s = 2 |c| / (q + R)`, `R = sqrt(q^2 + 4 K |c|)`,
-/// `u = sign(c) s^2` and `du/dc = 2 s / (R K)`; `s` is formed by a division
-/// whose result is of order one, never by multiplying with a small
-/// reciprocal.
+/// With `R = sqrt(q^2 + 4 K |c|)`: `s = 2 |c| / (q + R)` (never the
+/// cancelling `(R - q) / 2K`), `u = sign(c) s^2` and `du/dc = 2 s / R`
+/// (`R = 2 K s + q`). `K > 0` and `q >= 0` come from [`chamber`]: `K <=
+/// 1 + g_l`, `q <= 1.1` and `|c|` of the order of `K`, so every result
+/// stays within a few hundred; only `R^2`, up to `4 K^2`, may exceed
+/// fixed point's range, and [`Real::sqrt_sum_products`] forms it from
+/// exact products (`q q + 2K 2|c|`). One division, and one square root
+/// with its reciprocal ([`Real::sqrt_recip_sum_products`]).
 #[inline]
 fn root<T: Real>(k: T, q: T, c: T) -> (T, T) {
-    let (q, c, kk) = if k > T::ONE { (q / k, c / k, T::ONE) } else { (q, c, k) };
     let ac = c.abs();
-    let r = (q * q + kk * (ac + ac + ac + ac)).sqrt();
+    let (r, inv_r) = T::sqrt_recip_sum_products(q, q, k + k, ac + ac);
     let s = (ac + ac) / (q + r).max(T::tiny());
     let u = s * s;
-    // du/dc = 2 s / R for the divided equation, times d c'/d c = 1 / K.
-    let d = (s + s) / (r * k.max(T::ONE)).max(T::tiny());
+    // The root's reciprocal, divided where the type cannot hold it.
+    let d = if !T::SATURATES || inv_r > T::ZERO {
+        (s + s) * inv_r
+    } else {
+        (s + s) / r.max(T::tiny())
+    };
     (if c < T::ZERO { -u } else { u }, d)
 }
 
 /// A chamber's stage equation in its orifice drop `u` (both chambers have
-/// the same form, `u' = -omega (q_t r(u) + g_l u - e)`, `e = g_l - sigma w`):
+/// the same form, `u' = -omega (q_t r(u) + g_l u - e)`, `e = g_l D - sigma w`
+/// the drive [`Coefficients::drive`], shared by both chambers):
 ///
 /// ```text
 /// u - u_z = -beta (q_t r(u) + g_l u - e),  beta = h gamma omega = h gamma / tau
 /// ```
 ///
 /// written with bounded coefficients whatever the stiffness: divided by
-/// `beta` (`k = tau / (h gamma) <= 1`) for a stiff chamber, as it stands
-/// (`beta < 1`) for a slow one or a short step. `tau = 1 / omega(xi)` is the
+/// `beta` (`k = tau / (h gamma) <= 1`, a product by the step's `1 / hg`)
+/// for a stiff chamber, as it stands (`beta < 1`, one division) for a
+/// slow one or a short step. `tau = 1 / omega(xi)` is the
 /// chamber's time constant. `du/dw` is the chamber's response to the
 /// stage's velocity at fixed `tau` (the volume's own dependence on `xi(w)`,
 /// `eps = A_p L / V` of a few percent, is left to the Newton iteration:
 /// leaving it out of the derivative changes no survey figure).
 #[inline]
-fn chamber<T: Real>(c: &Coefficients<T>, tau: T, hg: T, u_z: T, w: T) -> Chamber<T> {
-    let e = c.drive(w);
+fn chamber<T: Real>(c: &Coefficients<T>, tau: T, f: &StepFactors<T>, u_z: T, e: T) -> Chamber<T> {
     // du/dw = -D n sigma, n = 1 (k-form) or beta.
-    let (u, d, n) = if tau <= hg {
-        let k = tau / hg;
-        let (u, d) = root(k + c.g_l, c.q_t, k * u_z + e);
-        (u, d, T::ONE)
+    let (u, d) = if tau <= f.hg {
+        let k = f.over_hg(tau);
+        root(k + c.g_l, c.q_t, k * u_z + e)
     } else {
-        let beta = hg / tau;
+        let beta = f.hg / tau;
         let (u, d) = root(T::ONE + beta * c.g_l, beta * c.q_t, u_z + beta * e);
-        (u, d, beta)
+        (u, d * beta)
     };
     Chamber {
         u,
-        du_dw: -(d * n * c.sigma),
+        du_dw: -(d * c.sigma),
     }
 }
 
@@ -206,8 +265,11 @@ fn chamber<T: Real>(c: &Coefficients<T>, tau: T, hg: T, u_z: T, w: T) -> Chamber
 type State<T> = [T; 4];
 
 impl<T: Real> Dirk<T> {
-    /// Prepares `tableau` for step `h` (model time units).
-    pub fn new(tableau: &Tableau, h: f64) -> Self {
+    /// Prepares `tableau` for step `h` (model time units) of the model
+    /// whose coefficients are `c`: only the constant ones are read (`a_x`,
+    /// `2 zeta`, `phi / a_x`, which no temperature changes), and
+    /// [`Dirk::step`] must be given coefficients with the same.
+    pub fn new(tableau: &Tableau, h: f64, c: &Coefficients<T>) -> Self {
         let mut alpha = [[T::ZERO; MAX_STAGES]; MAX_STAGES];
         for i in 0..MAX_STAGES {
             for j in 0..MAX_STAGES {
@@ -229,7 +291,7 @@ impl<T: Real> Dirk<T> {
             stages,
             alpha,
             h_b,
-            h_gamma: T::from_f64(h * tableau.gamma),
+            full: StepFactors::new(T::from_f64(h * tableau.gamma), c),
         }
     }
 
@@ -243,13 +305,17 @@ impl<T: Real> Dirk<T> {
     /// [`Real::dot_add_compensated`] and `xi_carry`: a plunger creeping by
     /// less than the resolution per step still arrives.
     pub fn step(&self, c: &Coefficients<T>, y: &State<T>, frac: T, contact: Contact, xi_carry: &mut T) -> State<T> {
-        let hg = if frac == T::ONE {
-            self.h_gamma
+        // A whole step shares the prepared factors; a piece of one (a
+        // graded substep, an event) forms its own.
+        let piece;
+        let f = if frac == T::ONE {
+            &self.full
         } else {
-            self.h_gamma * frac
+            piece = StepFactors::new(self.full.hg * frac, c);
+            &piece
         };
         if contact != Contact::Free {
-            return self.held(c, y, hg);
+            return self.held(c, y, f);
         }
         // Stage increments `Y_j - Z_j`: `Z_i = y + sum_j alpha_ij (Y_j - Z_j)`.
         let mut d = [[T::ZERO; 4]; MAX_STAGES];
@@ -272,7 +338,7 @@ impl<T: Real> Dirk<T> {
                 LATER_STAGE_ITERATIONS
             };
             // The velocity guess: the previous stage's.
-            yi = self.free_stage(c, &z, hg, yi[1], iterations);
+            yi = self.free_stage(c, &z, f, yi[1], iterations);
             for k in 0..4 {
                 d[i][k] = yi[k] - z[k];
             }
@@ -290,12 +356,14 @@ impl<T: Real> Dirk<T> {
 
     /// A held step: `xi` kept, `w = 0`, each chamber's pressure alone (the
     /// stages in the chambers' orifice drops).
-    fn held(&self, c: &Coefficients<T>, y: &State<T>, hg: T) -> State<T> {
+    fn held(&self, c: &Coefficients<T>, y: &State<T>, f: &StepFactors<T>) -> State<T> {
         let (ta, tb) = time_constants(c, y[0]);
-        let (ua0, ub0) = (T::ONE - y[2], y[3]);
+        let (ua0, ub0) = (c.supply() - y[2], y[3]);
         let (mut ua, mut ub) = (ua0, ub0);
         let mut da = [T::ZERO; MAX_STAGES];
         let mut db = [T::ZERO; MAX_STAGES];
+        // At rest the drive is the capillary's full-drop flow.
+        let e = c.drive(T::ZERO);
         for i in 0..self.stages.min(MAX_STAGES) {
             let (mut za, mut zb) = (ua0, ub0);
             for j in 0..i {
@@ -303,22 +371,20 @@ impl<T: Real> Dirk<T> {
                 za += a * da[j];
                 zb += a * db[j];
             }
-            ua = chamber(c, ta, hg, za, T::ZERO).u;
-            ub = chamber(c, tb, hg, zb, T::ZERO).u;
+            ua = chamber(c, ta, f, za, e).u;
+            ub = chamber(c, tb, f, zb, e).u;
             da[i] = ua - za;
             db[i] = ub - zb;
         }
-        [y[0], T::ZERO, T::ONE - ua, ub]
+        [y[0], T::ZERO, c.supply() - ua, ub]
     }
 
     /// The free stage `Y = Z + h gamma f(Y)`: `iterations` Newton
     /// iterations on `w` from `w0`. The state after the last one follows
     /// from the last evaluation by the derivatives (its error is second
     /// order in the last correction) instead of a further evaluation.
-    fn free_stage(&self, c: &Coefficients<T>, z: &State<T>, hg: T, w0: T, iterations: u8) -> State<T> {
-        let u_za = T::ONE - z[2];
-        let hg_a_x = hg * c.a_x;
-        let base = T::ONE + hg * c.two_zeta + hg * hg;
+    fn free_stage(&self, c: &Coefficients<T>, z: &State<T>, f: &StepFactors<T>, w0: T, iterations: u8) -> State<T> {
+        let u_za = c.supply() - z[2];
         let mut w = w0;
         let mut out = [T::ZERO; 4];
         // The chambers' time constants at the stage's known displacement:
@@ -326,24 +392,30 @@ impl<T: Real> Dirk<T> {
         // and by far less over a stage.
         let (ta, tb) = time_constants(c, z[0]);
         for _ in 0..iterations.max(1) {
-            let xi = z[0] + hg_a_x * w;
-            let a = chamber(c, ta, hg, u_za, w);
-            let b = chamber(c, tb, hg, z[3], w);
-            let force = c.phi_over_a_x * (b.u - (T::ONE - a.u)) - (c.xi0 + xi) * c.inv_a_x;
-            let g = w - z[1] - hg * (force - c.two_zeta * w);
+            let xi = z[0] + f.hg_a_x * w;
+            let e = c.drive(w);
+            let a = chamber(c, ta, f, u_za, e);
+            let b = chamber(c, tb, f, z[3], e);
+            let force = c.phi_over_a_x * (b.u - (c.supply() - a.u)) - (c.xi0 + xi) * c.inv_a_x;
+            let g = w - z[1] - f.hg * (force - c.two_zeta * w);
             // d(pi_b - pi_a)/dw = du_b/dw + du_a/dw < 0 (hydraulic damping):
             // g' = base + hp s. On strongly damped designs hp s (the
             // hydraulic damping over a step) reaches 1,850 (survey, 10,000
-            // designs): a saturating type divides g and g' by hp first
-            // (`docs/dynamics.md`, "Fixed-point ranges").
-            let (hp, s) = (hg * c.phi_over_a_x, -(b.du_dw + a.du_dw));
-            let dw = if T::SATURATES && hp > T::ONE && s > T::ONE {
-                -((g / hp) / (base / hp + s))
+            // designs): a saturating type divides g and g' by hp first,
+            // with the step's 1 / hp (`docs/dynamics.md`, "Fixed-point ranges").
+            let s = -(b.du_dw + a.du_dw);
+            let dw = if T::SATURATES && f.hp > T::ONE && s > T::ONE {
+                -((g * f.inv_hp) / (f.base_over_hp + s))
             } else {
-                -(g / (base + hp * s))
+                -(g / (f.base + f.hp * s))
             };
             w += dw;
-            out = [xi + hg_a_x * dw, w, T::ONE - (a.u + a.du_dw * dw), b.u + b.du_dw * dw];
+            out = [
+                xi + f.hg_a_x * dw,
+                w,
+                c.supply() - (a.u + a.du_dw * dw),
+                b.u + b.du_dw * dw,
+            ];
         }
         out
     }

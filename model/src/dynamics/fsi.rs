@@ -19,10 +19,13 @@
 //! ```text
 //! xi'   = a_x w
 //! w'    = (phi (pi_b - pi_a) - xi0 - xi) / a_x - 2 zeta w
-//! pi_a' = omega_a(xi) (q_t r(1 - pi_a) - g_l pi_a + sigma w)
-//! pi_b' = omega_b(xi) (g_l (1 - pi_b) - q_t r(pi_b) - sigma w)
+//! pi_a' = omega_a(xi) (q_t r(D - pi_a) - g_l pi_a + sigma w)
+//! pi_b' = omega_b(xi) (g_l (D - pi_b) - q_t r(pi_b) - sigma w)
 //! omega_a = omega_a0 / (1 - eps_a xi),  omega_b = omega_b0 / (1 + eps_b xi)
 //! ```
+//!
+//! `D = (p_p - p_c) / dp` is the drop across the compensator in units of the
+//! design's ([`Coefficients::drop`]): one unless a changing drop is set.
 //!
 //! The coefficients, their flow unit and the formulas every integrator
 //! shares (static force, chamber volumes, net inflows, quasi-steady root)
@@ -56,7 +59,7 @@ struct Local<T> {
     /// Their `xi` derivatives.
     doa: T,
     dob: T,
-    /// Orifice slopes `r'(1 - pi_a)`, `r'(pi_b)`.
+    /// Orifice slopes `r'(D - pi_a)`, `r'(pi_b)`.
     sa: T,
     sb: T,
     /// Net inflows `F_a`, `F_b` ([`Coefficients::inflows`]).
@@ -76,7 +79,7 @@ impl<T: Real> Fsi<'_, T> {
         let c = self.coefficients;
         let (da, db) = c.relative_volumes(y[0]);
         let (oa, ob) = (c.omega_a0 / da, c.omega_b0 / db);
-        let (ra, sa) = regularised_root(T::ONE - y[2], c.u_tr);
+        let (ra, sa) = regularised_root(c.supply() - y[2], c.u_tr);
         let (rb, sb) = regularised_root(y[3], c.u_tr);
         let (fa, fb) = c.inflows(y, ra, rb);
         Local {
@@ -97,7 +100,7 @@ impl<T: Real> Fsi<'_, T> {
     #[inline]
     fn inflow_values(&self, y: &[T; 4]) -> (T, T) {
         let c = self.coefficients;
-        let ra = regularised_root_value(T::ONE - y[2], c.u_tr);
+        let ra = regularised_root_value(c.supply() - y[2], c.u_tr);
         let rb = regularised_root_value(y[3], c.u_tr);
         c.inflows(y, ra, rb)
     }
@@ -230,7 +233,7 @@ impl<T: Real> OdeSystem<T, 4> for Fsi<'_, T> {
     fn linearise(&self, y: &[T; 4], shift: T) -> Option<([T; 4], FsiFactor<T>)> {
         let c = self.coefficients;
         let (da, db) = c.relative_volumes(y[0]);
-        let (ra, sa) = regularised_root(T::ONE - y[2], c.u_tr);
+        let (ra, sa) = regularised_root(c.supply() - y[2], c.u_tr);
         let (rb, sb) = regularised_root(y[3], c.u_tr);
         let (fa, fb) = c.inflows(y, ra, rb);
         // Scaled rows: D f = (xi', w', F_a, F_b).

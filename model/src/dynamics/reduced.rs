@@ -58,7 +58,7 @@ impl<T: Real> OdeSystem<T, 2> for ReducedFsi<'_, T> {
         }
         let c = self.coefficients;
         let (s, _) = c.quasi_steady(y[1]);
-        let force = c.phi_over_a_x * (s * s + s * s - T::ONE) - (c.xi0 + y[0]) * c.inv_a_x;
+        let force = c.phi_over_a_x * (s * s + s * s - c.supply()) - (c.xi0 + y[0]) * c.inv_a_x;
         [c.a_x * y[1], force - c.two_zeta * y[1]]
     }
 
@@ -157,7 +157,7 @@ impl<F: Float, T: Real> ReducedTwin<F, T> {
         let pb = s * s;
         self.model
             .scales
-            .to_si(&[self.state[0], self.state[1], T::ONE - pb, pb])
+            .to_si(&[self.state[0], self.state[1], self.coefficients.supply() - pb, pb])
     }
 }
 

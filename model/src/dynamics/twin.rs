@@ -26,7 +26,7 @@ use super::schemes::{Scheme, StepError, Stepper};
 use super::stops::{Contact, away_from};
 use super::units::DynamicState;
 use crate::equilibrium::equilibrium;
-use crate::error::ModelError;
+use crate::error::{ModelError, finite, represent};
 use crate::fluid::FluidState;
 use crate::params::Params;
 use crate::scalar::{Float, Real};
@@ -134,6 +134,52 @@ pub const ABRUPT_CHANGE: f64 = 0.01;
 /// substep's end, a release at its start).
 pub const EVENTS_PER_SUBSTEP: u8 = 1;
 
+/// Largest pressure drop [`Twin::set_pressures`] takes, in units of the
+/// design's `dp` (either sign).
+pub const MAX_DROP: f64 = 64.0;
+
+/// The chamber-pressure bounds for drop `d` (model units): [`PRESSURE_MARGIN`]
+/// beyond `[min(0, d), max(0, d)]`.
+fn pressure_bounds<T: Real>(d: T) -> (T, T) {
+    let m = T::from_f64(PRESSURE_MARGIN);
+    (d.min(T::ZERO) - m, d.max(T::ZERO) + m)
+}
+
+/// `v` in `T`, as [`represent`], zero included.
+fn represent_or_zero<F: Float, T: Real>(v: F, what: &'static str) -> Result<T, ModelError> {
+    if v == F::ZERO { Ok(T::ZERO) } else { represent(v, what) }
+}
+
+/// What the tick's length decides: the scheme's prepared step, the step
+/// times `a_x` and the graded substep's pieces.
+struct Timing<T> {
+    engine: Engine<T>,
+    fine_dirk: Dirk<T>,
+    h_a_x: T,
+    graded_pieces: u8,
+}
+
+impl<T: Real> Timing<T> {
+    fn new(config: &TwinConfig, time_unit: f64, c: &Coefficients<T>) -> Self {
+        let h = config.step(time_unit);
+        let engine = match config.scheme.dirk() {
+            Some(tableau) => Engine::Dirk(Dirk::new(tableau, h, c)),
+            None => Engine::Generic(Stepper::new(config.scheme, h)),
+        };
+        let substep = config.tick / config.substeps as f64;
+        let mut graded_pieces = 1u8;
+        while graded_pieces < MAX_GRADED_PIECES && substep / (1u64 << (graded_pieces - 1)) as f64 > GRADED_FIRST {
+            graded_pieces += 1;
+        }
+        Timing {
+            engine,
+            fine_dirk: Dirk::new(&super::dirk::FINE, h, c),
+            h_a_x: T::from_f64(h) * c.a_x,
+            graded_pieces,
+        }
+    }
+}
+
 /// The integrator behind a twin.
 #[derive(Clone, Copy, Debug)]
 enum Engine<T> {
@@ -157,7 +203,8 @@ pub struct Twin<F, T> {
     h_a_x: T,
     /// [`ABRUPT_CHANGE`] in `T`.
     abrupt_threshold: T,
-    /// Pressure bounds `[-PRESSURE_MARGIN, 1 + PRESSURE_MARGIN]`.
+    /// Pressure bounds `[min(0, D) - PRESSURE_MARGIN, max(0, D) + PRESSURE_MARGIN]`
+    /// (`D` the drop, one at the design's).
     pressure_bounds: (T, T),
     state: [T; 4],
     /// What rounding has left out of `xi` so far ([`Real::mul_add_compensated`]).
@@ -185,35 +232,97 @@ impl<F: Float, T: Real> Twin<F, T> {
         config.validate()?;
         let model = Model::new(params)?;
         let eq = equilibrium(params, temperature)?;
-        let h = config.step(model.scales.time.to_f64());
-        let engine = match config.scheme.dirk() {
-            Some(tableau) => Engine::Dirk(Dirk::new(tableau, h)),
-            None => Engine::Generic(Stepper::new(config.scheme, h)),
-        };
         let coefficients: Coefficients<T> = model.coefficients(&eq.fluid)?;
-        let fine_dirk = Dirk::new(&super::dirk::FINE, h);
+        let timing = Timing::new(&config, model.scales.time.to_f64(), &coefficients);
         Ok(Twin {
-            fine_dirk,
-            h_a_x: T::from_f64(h) * coefficients.a_x,
+            fine_dirk: timing.fine_dirk,
+            h_a_x: timing.h_a_x,
             abrupt_threshold: T::from_f64(ABRUPT_CHANGE),
             coefficients,
-            engine,
+            engine: timing.engine,
             substeps: config.substeps,
-            pressure_bounds: (T::from_f64(-PRESSURE_MARGIN), T::from_f64(1.0 + PRESSURE_MARGIN)),
+            pressure_bounds: pressure_bounds(T::ONE),
             state: model.equilibrium_state(&eq),
             xi_carry: T::ZERO,
             abrupt: false,
-            graded_pieces: {
-                let substep = config.tick / config.substeps as f64;
-                let mut n = 1u8;
-                while n < MAX_GRADED_PIECES && substep / (1u64 << (n - 1)) as f64 > GRADED_FIRST {
-                    n += 1;
-                }
-                n
-            },
+            graded_pieces: timing.graded_pieces,
             model,
             config,
         })
+    }
+
+    /// Changes the tick to `tick` [s], keeping the scheme, the substeps per
+    /// tick, the state and the coefficients: a tick that adapts, for a
+    /// caller whose steps are not whole ticks (an FMU's communication
+    /// steps). A shorter tick is at least as accurate as the configured
+    /// one (the same substeps, each shorter); the result equals a twin
+    /// built with `tick` from the start and given the same state. Costs a
+    /// few `f64` operations (the scheme's step prepared again), nothing
+    /// per tick.
+    ///
+    /// # Errors
+    ///
+    /// `OutOfRange("tick")` for a tick that is not a positive, finite
+    /// duration; nothing changes then.
+    pub fn set_tick(&mut self, tick: f64) -> Result<(), ModelError> {
+        let config = TwinConfig { tick, ..self.config };
+        config.validate()?;
+        let timing = Timing::new(&config, self.model.scales.time.to_f64(), &self.coefficients);
+        self.engine = timing.engine;
+        self.fine_dirk = timing.fine_dirk;
+        self.h_a_x = timing.h_a_x;
+        self.graded_pieces = timing.graded_pieces;
+        self.config = config;
+        Ok(())
+    }
+
+    /// Sets the supply and outlet pressures `p_p`, `p_c` [Pa] for the
+    /// following ticks: the drop across the compensator changes from the
+    /// design's `dp` (`operating.pressure_drop`, the model's pressure
+    /// unit, which stays). Per call: two divisions and the chamber
+    /// pressures re-referred to the new outlet (they are continuous: the
+    /// state in SI units does not move); per tick nothing changes
+    /// ([`Coefficients::drop`] enters the stage equations as the supply
+    /// pressure and the chambers' drive, where the design's drop had one).
+    /// A change of the drop or of the outlet by more than
+    /// [`ABRUPT_CHANGE`] of `dp` makes the next tick start graded (the
+    /// chambers' pressures re-equilibrate in microseconds).
+    ///
+    /// The drop may be any within `[-MAX_DROP, MAX_DROP]` times `dp`: the
+    /// throttle laws are odd in their drops, so a reversed drop reverses
+    /// the flows. Fixed point keeps its documented ranges only for drops
+    /// up to the design's (`D <= 1`).
+    ///
+    /// # Errors
+    ///
+    /// `NonFinite` naming the pressure for a value that is not finite,
+    /// `OutOfRange("pressure drop")` beyond [`MAX_DROP`] times `dp`, and
+    /// `NotRepresentable` when `T` cannot hold the drop or the shifted
+    /// chamber pressures. Nothing changes then.
+    pub fn set_pressures(&mut self, supply: F, outlet: F) -> Result<(), ModelError> {
+        let scales = &self.model.scales;
+        let drop = finite(
+            finite(supply, "supply pressure")? - finite(outlet, "outlet pressure")?,
+            "pressure drop",
+        )? / scales.pressure;
+        if !(drop.abs() <= F::from_f64(MAX_DROP)) {
+            return Err(ModelError::OutOfRange("pressure drop"));
+        }
+        let shift = (scales.outlet_pressure - outlet) / scales.pressure;
+        let d: T = represent_or_zero(drop, "pressure drop")?;
+        let s: T = represent_or_zero(shift, "outlet pressure")?;
+        let (pa, pb) = (self.state[2] + s, self.state[3] + s);
+        if !(pa.is_finite() && pb.is_finite()) {
+            return Err(ModelError::NotRepresentable("outlet pressure"));
+        }
+        let change = (d - self.coefficients.drop).abs() + s.abs();
+        self.abrupt |= change > self.abrupt_threshold;
+        self.coefficients.drop = d;
+        self.state[2] = pa;
+        self.state[3] = pb;
+        self.model.scales.outlet_pressure = outlet;
+        self.pressure_bounds = pressure_bounds(d);
+        Ok(())
     }
 
     /// The model (scales, parameters).
@@ -544,7 +653,8 @@ impl<F: Float, T: Real> Twin<F, T> {
     }
 
     /// What the next ticks depend on besides the configuration and the
-    /// coefficients (which follow from the last temperature set): the state
+    /// coefficients (which follow from the last temperature and pressures
+    /// set): the state
     /// in model units, the compensated carry of `xi` and whether the next
     /// tick is graded. With [`Twin::restore`] it saves and restores a twin
     /// exactly (an FMU's state, rolled back by a co-simulation master).
@@ -557,7 +667,7 @@ impl<F: Float, T: Real> Twin<F, T> {
     }
 
     /// Puts back what [`Twin::memory`] saved: the twin, with the same
-    /// parameters, configuration and last temperature, then ticks exactly
+    /// parameters, configuration, last temperature and last pressures, then ticks exactly
     /// as the one it was saved from.
     pub fn restore(&mut self, memory: &TwinMemory<T>) {
         self.state = memory.state;

@@ -1,9 +1,14 @@
-//! The estimator's settings, from the parameter file's `[estimator]`
-//! section.
+//! The estimator's settings: the `[estimator]` section's, the observer's
+//! design from the `[probe]` section, and the uncertainty table from the
+//! `[tolerances]`.
 
-use super::filter::FilterSettings;
+use super::observer::{DesignError, ObserverDesign, ObserverSettings};
+use super::spike::SpikeSettings;
 use crate::dynamics::TwinConfig;
-use crate::params::{ParamError, RawEstimator};
+use crate::params::{ParamError, RawEstimator, RawParams};
+use crate::sensor::max31865::{Mains, resolution};
+use crate::uncertainty::{UncertaintyError, UncertaintyTable};
+use core::borrow::Borrow;
 
 /// A closed range of temperatures [C], `min..=max`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -27,19 +32,51 @@ impl TemperatureRange {
     }
 }
 
-/// Estimator settings in `f32` (from the `[estimator]` section).
+/// Why an estimator's settings cannot be built from a parameter set.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct EstimatorConfig {
+pub enum ConfigError {
+    /// A field is refused (named).
+    Params(ParamError),
+    /// No observer for the probe's settings.
+    Observer(DesignError),
+    /// No uncertainty table for the device's tolerances.
+    Uncertainty(UncertaintyError),
+}
+
+impl core::fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            ConfigError::Params(e) => write!(f, "{e}"),
+            ConfigError::Observer(e) => write!(f, "probe: {e}"),
+            ConfigError::Uncertainty(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl core::error::Error for ConfigError {}
+
+impl From<ParamError> for ConfigError {
+    fn from(e: ParamError) -> Self {
+        ConfigError::Params(e)
+    }
+}
+
+/// Estimator settings in `f32`, with the uncertainty table held as `U`: the
+/// table itself (the default, [`EstimatorConfig::new`]), or a reference to
+/// one in flash (`&'static UncertaintyTable`: the firmware's, which then
+/// keeps 0.75 KiB off its stack; [`EstimatorConfig::from_parts`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EstimatorConfig<U = UncertaintyTable> {
     /// The twin's integrator. Its tick is the estimator's (`1 / tick_hz`);
     /// scheme and steps per tick are [`TwinConfig::SHIPPED`]'s unless
     /// changed before [`Estimator::new`](super::Estimator::new).
     pub twin: TwinConfig,
-    /// Filter gain per tick, `1 - exp(-tick / tau)`.
-    pub filter_gain: f32,
-    /// Spike threshold [C].
-    pub spike_threshold: f32,
-    /// Consecutive rejected samples accepted as a real step.
-    pub spike_limit: u32,
+    /// The oil-temperature observer's design.
+    pub observer: ObserverDesign,
+    /// The spike gate in front of it.
+    pub spikes: SpikeSettings,
+    /// The uncertainty table over the oil range (or a reference to it).
+    pub uncertainty: U,
     /// Validated temperature range [C].
     pub valid: TemperatureRange,
     /// Range where the oil model is used at all [C].
@@ -50,14 +87,71 @@ pub struct EstimatorConfig {
     pub stale_after: u32,
 }
 
-impl EstimatorConfig {
-    /// From the parameter file's `[estimator]` section (validated).
+impl EstimatorConfig<UncertaintyTable> {
+    /// The settings for the parameter set `raw`, the probe read through a
+    /// MAX31865 (its conversion period and resolution): the observer
+    /// designed and the uncertainty table built here, in `f64` (a few
+    /// milliseconds on a host; the firmware gets both from its build
+    /// script and calls [`EstimatorConfig::from_parts`]).
+    ///
+    /// # Errors
+    ///
+    /// [`ConfigError::Params`] naming the first refused field,
+    /// [`ConfigError::Observer`] or [`ConfigError::Uncertainty`] when the
+    /// observer or the table cannot be built.
+    pub fn new(raw: &RawParams) -> Result<Self, ConfigError> {
+        Self::with_sample_period(raw, reading_period(&raw.estimator))
+    }
+
+    /// As [`EstimatorConfig::new`], for readings every `sample_period` [s]
+    /// (a recorded log's rate).
+    ///
+    /// # Errors
+    ///
+    /// As [`EstimatorConfig::new`].
+    pub fn with_sample_period(raw: &RawParams, sample_period: f64) -> Result<Self, ConfigError> {
+        raw.validate()?;
+        let e = &raw.estimator;
+        let observer = ObserverDesign::new(&observer_settings(raw, sample_period)).map_err(ConfigError::Observer)?;
+        let uncertainty =
+            UncertaintyTable::new(raw, e.oil_min, e.oil_max, |t| resolution(e, t)).map_err(ConfigError::Uncertainty)?;
+        Ok(Self::from_parts(e, observer, uncertainty)?)
+    }
+}
+
+impl<U: Borrow<UncertaintyTable> + Copy> EstimatorConfig<U> {
+    /// The settings for `raw` with an uncertainty table built beforehand
+    /// (by a build script: the table does not depend on the tick), the
+    /// observer designed here for `raw`'s tick and the MAX31865's
+    /// conversion period ([`reading_period`]), in `f64`: what a firmware
+    /// that sets its own tick rate calls.
+    ///
+    /// # Errors
+    ///
+    /// [`ConfigError::Params`] naming the first refused field,
+    /// [`ConfigError::Observer`] when the observer cannot be designed.
+    pub fn with_table(raw: &RawParams, uncertainty: U) -> Result<Self, ConfigError> {
+        raw.validate()?;
+        let observer = ObserverDesign::new(&observer_settings(raw, reading_period(&raw.estimator)))
+            .map_err(ConfigError::Observer)?;
+        Ok(Self::from_parts(&raw.estimator, observer, uncertainty)?)
+    }
+
+    /// The uncertainty table.
+    #[inline]
+    pub fn table(&self) -> &UncertaintyTable {
+        self.uncertainty.borrow()
+    }
+
+    /// From the `[estimator]` section and an observer and uncertainty table
+    /// designed for it (by [`EstimatorConfig::new`] on a host, or a build
+    /// script).
     ///
     /// # Errors
     ///
     /// A [`ParamError`] naming the first field of `raw` that breaks its
     /// rule (`RawEstimator::validate`).
-    pub fn new(raw: &RawEstimator) -> Result<Self, ParamError> {
+    pub fn from_parts(raw: &RawEstimator, observer: ObserverDesign, uncertainty: U) -> Result<Self, ParamError> {
         raw.validate()?;
         let tick = 1.0 / raw.tick_hz;
         let telemetry_every = if raw.telemetry_hz > 0.0 {
@@ -70,10 +164,13 @@ impl EstimatorConfig {
                 tick,
                 ..TwinConfig::SHIPPED
             },
-            filter_gain: FilterSettings::gain(tick, raw.filter_time_constant),
-            spike_threshold: raw.spike_threshold as f32,
-            // A whole number of at most 65,534 (validated).
-            spike_limit: raw.spike_limit as u32,
+            observer,
+            spikes: SpikeSettings {
+                threshold: raw.spike_threshold as f32,
+                // A whole number of at most 65,534 (validated).
+                limit: raw.spike_limit as u32,
+            },
+            uncertainty,
             valid: TemperatureRange::new(raw.valid_min as f32, raw.valid_max as f32),
             oil: TemperatureRange::new(raw.oil_min as f32, raw.oil_max as f32),
             telemetry_every,
@@ -87,21 +184,44 @@ impl EstimatorConfig {
         self.twin.tick as f32
     }
 
+    /// The period of the readings the observer is designed for [s].
+    pub fn sample_period(&self) -> f64 {
+        f64::from(self.observer.sample_period)
+    }
+
     /// Ticks between samples of a source that delivers one every `period`
     /// [s] (at least one).
     pub fn ticks_per(&self, period: f32) -> u32 {
         let n = period / self.tick() + 0.5;
         if n >= 1.0 { n as u32 } else { 1 }
     }
+}
 
-    /// The temperature filter's settings.
-    #[inline]
-    pub fn filter(&self) -> FilterSettings {
-        FilterSettings {
-            gain: self.filter_gain,
-            threshold: self.spike_threshold,
-            limit: self.spike_limit,
-        }
+/// The period of the MAX31865's readings at the estimator's tick [s]: its
+/// conversion period for the mains filter, rounded to a whole number of
+/// ticks (at least one; the converter is read on the tick its reading is
+/// due).
+pub fn reading_period(e: &RawEstimator) -> f64 {
+    let period = Mains::from_hz(e.mains_hz).unwrap_or(Mains::Hz50).conversion_period() as f64;
+    let ticks = libm::round(period * e.tick_hz).max(1.0);
+    ticks / e.tick_hz
+}
+
+/// The observer's settings for the parameter set `raw` with readings every
+/// `sample_period` [s] through a MAX31865 (its resolution at the middle of
+/// the validated range).
+pub fn observer_settings(raw: &RawParams, sample_period: f64) -> ObserverSettings {
+    let e = &raw.estimator;
+    let mid = 0.5 * (e.valid_min + e.valid_max);
+    ObserverSettings {
+        time_constant: raw.probe.time_constant,
+        well_time_constant: raw.probe.well_time_constant,
+        noise: raw.probe.noise,
+        resolution: resolution(e, mid),
+        max_rate: e.max_oil_rate,
+        tick: 1.0 / e.tick_hz,
+        sample_period,
+        span: e.oil_max - e.oil_min,
     }
 }
 

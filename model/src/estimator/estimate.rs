@@ -1,15 +1,18 @@
-//! The estimator's output for one tick, and the telemetry record it packs
-//! into (with the `defmt` feature).
+//! The estimator's output for one tick, and (with the `defmt` feature) its
+//! telemetry record's `defmt` format.
 
 use super::flags::Flags;
+use crate::uncertainty::Uncertainty;
 
 /// The estimator's output for one tick (SI units, `f32`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StateEstimate {
     /// Tick counter.
     pub tick: u32,
-    /// Filtered oil temperature [C].
+    /// Estimated oil temperature [C] (the observer's, inside the oil range).
     pub temperature: f32,
+    /// The probe's last accepted reading [C].
+    pub t_probe: f32,
     /// Plunger displacement [m].
     pub x: f32,
     /// Plunger velocity [m/s].
@@ -36,6 +39,13 @@ pub struct StateEstimate {
     /// closed-form equilibrium since start (saturating; 0 for a twin that
     /// never settled at a false state).
     pub reseats: u32,
+    /// Tick deadlines missed since start (saturating): the ticks that
+    /// elapsed while the controller was still busy with an earlier one
+    /// ([`Estimator::tick_after`](super::Estimator::tick_after)).
+    pub deadline_misses: u32,
+    /// Standard uncertainties of the estimate (`k = 1`), refreshed in the
+    /// job rotation.
+    pub uncertainty: Uncertainty,
     /// Conditions.
     pub flags: Flags,
 }
@@ -44,10 +54,11 @@ impl StateEstimate {
     /// An estimate at `temperature` [C] without physics: every state, flow
     /// and equilibrium field NaN (what the estimator reports, flagged, when
     /// the model refuses a temperature before it has had an estimate).
-    pub(super) const fn without_physics(tick: u32, temperature: f32, reseats: u32, flags: Flags) -> Self {
+    pub(super) const fn without_physics(tick: u32, temperature: f32, t_probe: f32, reseats: u32, flags: Flags) -> Self {
         StateEstimate {
             tick,
             temperature,
+            t_probe,
             x: f32::NAN,
             v: f32::NAN,
             p_a: f32::NAN,
@@ -60,6 +71,8 @@ impl StateEstimate {
             x_equilibrium: f32::NAN,
             dx_dt: f32::NAN,
             reseats,
+            deadline_misses: 0,
+            uncertainty: Uncertainty::UNKNOWN,
             flags,
         }
     }
@@ -86,27 +99,17 @@ impl StateEstimate {
     }
 }
 
-/// The telemetry record: the state estimate in engineering units. The
-/// equilibrium `x*` and `dx/dt` stay out of it (each float costs ~80
-/// instructions to pack); they are in the struct for whoever needs them.
+/// The telemetry record: the estimate's fields as the table in
+/// [`telemetry`](super::telemetry) lists them, packed by
+/// [`telemetry::encode`](super::telemetry::encode) and sent as one byte
+/// string (the host decodes it with
+/// [`telemetry::Record::decode`](super::telemetry::Record::decode)). One
+/// argument instead of one per field: defmt's per-argument cost was about
+/// 66 instructions.
 #[cfg(feature = "defmt")]
 impl defmt::Format for StateEstimate {
     fn format(&self, f: defmt::Formatter) {
-        defmt::write!(
-            f,
-            "t={=f32} C x={=f32} um v={=f32} mm/s p_a={=f32} p_b={=f32} kPa Q_a={=f32} Q_b={=f32} Q_throt={=f32} Q0={=f32} err={=f32} l/min reseats={=u32} [{}]",
-            self.temperature,
-            self.x * 1e6,
-            self.v * 1e3,
-            self.p_a * 1e-3,
-            self.p_b * 1e-3,
-            self.q_a * 6e4,
-            self.q_b * 6e4,
-            self.q_throt * 6e4,
-            self.q_total * 6e4,
-            self.compensation_error * 6e4,
-            self.reseats,
-            self.flags
-        )
+        let record = super::telemetry::encode(self);
+        defmt::write!(f, "telemetry {=[u8]}", &record[..]);
     }
 }

@@ -127,6 +127,15 @@ flag_table! {
     /// was re-seated on the equilibrium. Raised from the re-seat until a
     /// later check (one settling window on) finds the twin in agreement.
     7 TWIN_RESEATED "TWIN_RESEATED";
+    /// The tick started after the next one was due (the controller missed
+    /// a deadline): the twin advanced by the ticks that elapsed
+    /// ([`Estimator::tick_after`](super::Estimator::tick_after)), counted in
+    /// [`StateEstimate::deadline_misses`](super::StateEstimate::deadline_misses).
+    8 DEADLINE_MISSED "DEADLINE_MISSED";
+    /// The controller restarted because its watchdog reset it (the
+    /// reset-cause register read at start): raised by the firmware on the
+    /// first telemetry record after the restart, never by the estimator.
+    9 WATCHDOG_RESET "WATCHDOG_RESET";
 }
 
 #[cfg(test)]
@@ -135,7 +144,7 @@ mod tests {
 
     #[test]
     fn names_follow_the_bits() {
-        assert_eq!(Flags::NAMES.len(), 8);
+        assert_eq!(Flags::NAMES.len(), 10);
         let mut all = Flags::empty();
         for (i, name) in Flags::NAMES.iter().enumerate() {
             all.insert(Flags(1 << i));

@@ -14,9 +14,15 @@ use crate::equilibrium::{Stop, a_parameter, equilibrium_for};
 use crate::error::ModelError;
 use crate::fluid::FluidPoint;
 use crate::params::Params;
+use crate::scalar::Real;
 use crate::throttle::FlowLaws;
+use crate::uncertainty::{Uncertainty, UncertaintyTable};
+use core::borrow::Borrow;
 
-/// The temperature-only jobs, one per tick in turn.
+use super::{EstimatorConfig, OilObserver};
+
+/// The temperature-only jobs, one per tick in turn (the uncertainty's
+/// depends on the observer's variance too).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Job {
     /// Oil properties (one Walther evaluation) for the twin and the flows:
@@ -32,11 +38,20 @@ pub(super) enum Job {
     Stability,
     /// The machine's losses (compensation error).
     Losses,
+    /// The uncertainty of the estimate at the observer's temperature and
+    /// variance ([`crate::uncertainty::UncertaintyTable::at`]).
+    Uncertainty,
 }
 
 impl Job {
     /// Every job, in rotation order.
-    pub(super) const ALL: [Job; 4] = [Job::Fluid, Job::Equilibrium, Job::Stability, Job::Losses];
+    pub(super) const ALL: [Job; 5] = [
+        Job::Fluid,
+        Job::Equilibrium,
+        Job::Stability,
+        Job::Losses,
+        Job::Uncertainty,
+    ];
 
     /// The job after this one in the rotation.
     pub(super) fn next(self) -> Job {
@@ -44,7 +59,8 @@ impl Job {
             Job::Fluid => Job::Equilibrium,
             Job::Equilibrium => Job::Stability,
             Job::Stability => Job::Losses,
-            Job::Losses => Job::Fluid,
+            Job::Losses => Job::Uncertainty,
+            Job::Uncertainty => Job::Fluid,
         }
     }
 
@@ -119,6 +135,8 @@ pub(super) struct Statics {
     pub(super) settle_ticks: u32,
     /// Machine losses at the last refreshed temperature [m^3/s].
     pub(super) losses: f32,
+    /// The uncertainty of the estimate at the last Uncertainty job.
+    pub(super) uncertainty: Uncertainty,
     /// The last Fluid job moved the twin's oil by its whole slew limit
     /// ([`TWIN_SLEW`]): the twin is still on its way to the filtered
     /// temperature, and the next job is the Fluid job again.
@@ -146,19 +164,23 @@ impl Statics {
             slowest_time_constant: f32::INFINITY,
             settle_ticks: u32::MAX,
             losses: f32::NAN,
+            uncertainty: Uncertainty::UNKNOWN,
             slewing: false,
         }
     }
 }
 
-/// Runs `job` at the filtered temperature `t` [C], updating `statics`. On
-/// an error the job's previous results stay in force.
-pub(super) fn run(
+/// Runs `job` at the estimated oil temperature `t` [C], updating
+/// `statics`. On an error the job's previous results stay in force.
+#[allow(clippy::too_many_arguments, reason = "the tick's state, borrowed apart")]
+pub(super) fn run<T: Real, U: Borrow<UncertaintyTable> + Copy>(
     job: Job,
     p: &Params<f32>,
-    twin: &mut Twin<f32, f32>,
+    config: &EstimatorConfig<U>,
+    twin: &mut Twin<f32, T>,
     design: Design,
     t: f32,
+    observer: &OilObserver,
     statics: &mut Statics,
 ) -> Result<(), ModelError> {
     match job {
@@ -200,8 +222,17 @@ pub(super) fn run(
             statics.on_closed_stop = eq.stop == Stop::Closed;
         }
         Job::Stability => {
+            // In f32 whatever the twin's scalar: the linearisation reads
+            // the chamber rates, which fixed point stores saturated
+            // (`Coefficients::omega_a0`), so a fixed-point twin's are
+            // formed again from the model.
+            let coefficients = if T::SATURATES {
+                twin.model().coefficients::<f32>(&statics.point.state)?
+            } else {
+                twin.coefficients().to_f32()
+            };
             let sys = Fsi {
-                coefficients: twin.coefficients(),
+                coefficients: &coefficients,
                 contact: Contact::Free,
             };
             let poly = characteristic_polynomial(&sys.jacobian(&statics.y_equilibrium));
@@ -236,6 +267,9 @@ pub(super) fn run(
                 Some(m) => compensation::losses_for(m, design.machine_mu_ref, statics.point.state.dynamic_viscosity)?,
                 None => f32::NAN,
             };
+        }
+        Job::Uncertainty => {
+            statics.uncertainty = config.table().at(t, observer.variance(&config.observer));
         }
     }
     Ok(())

@@ -1,41 +1,47 @@
-//! The state estimator the firmware runs every tick: temperature sample ->
-//! filtered temperature -> fluid properties -> FSI twin step ->
-//! closed-form equilibrium, sensitivity and stability -> [`StateEstimate`].
+//! The state estimator the firmware runs every tick: probe reading ->
+//! oil-temperature observer -> fluid properties -> FSI twin step ->
+//! closed-form equilibrium, sensitivity, stability and uncertainty ->
+//! [`StateEstimate`].
 //!
 //! Per tick, in this order:
-//! 1. the latest sample (if any) is checked: not finite or outside the oil's
-//!    range is a fault; further than `spike_threshold` from the filtered
-//!    value is a spike and rejected, unless it is the `spike_limit + 1`-th
-//!    consecutive out-of-band sample agreeing (within the threshold) with
-//!    the one before: then it is a real step and the filter jumps to it;
-//! 2. a first-order filter (time constant `filter_time_constant`) follows
-//!    the last accepted sample;
+//! 1. the oil-temperature observer predicts to this tick ([`OilObserver`]:
+//!    a Kalman filter of the oil temperature, its rate and the probe's
+//!    lagging temperature);
+//! 2. the latest reading (if any) is checked: not finite or outside the
+//!    oil's range is a fault; further than `spike_threshold` from the
+//!    reading the observer expects is a spike and rejected, unless it is
+//!    the `spike_limit + 1`-th consecutive out-of-band reading agreeing
+//!    (within the threshold) with the one before: then it is a real step
+//!    and the observer restarts at it; else the observer updates with it;
 //! 3. the twin advances one tick (its coefficients from the last Fluid
-//!    job);
+//!    job), driven by the estimated oil temperature, not the reading;
 //! 4. one temperature-only job runs, in turn: the oil's properties (one
 //!    Walther evaluation, handed to the twin and the flow laws) at the
-//!    filtered temperature, reached at a bounded slew ([`TWIN_SLEW`]: the
+//!    estimated temperature, reached at a bounded slew ([`TWIN_SLEW`]: the
 //!    twin never sees an abrupt change, and while it is on its way every
 //!    job is this one); the closed-form equilibrium with `dx/dt` (Eq. 31);
 //!    the Routh-Hurwitz stability of the linearisation at that equilibrium;
-//!    the machine's losses. None runs on a telemetry tick (at most every
-//!    second tick), nor on a tick where the twin had an event (an impact, a
-//!    release: a few steps more), which also moves a due telemetry record
-//!    to the next tick. Each result is thus refreshed every four job ticks
-//!    (4 ms at the default 1 kHz and 2 Hz telemetry: fluid properties five
-//!    times the MAX31865's 50 Hz rate), while the oil's temperature changes
-//!    over seconds. A job the model refuses keeps its previous results and
-//!    flags the estimate `DEGRADED` until it succeeds again;
+//!    the machine's losses; the uncertainty of the estimate
+//!    ([`Uncertainty`]: the observer's variance, the probe's tolerance and
+//!    the device's parameter uncertainties, [`crate::uncertainty`]). None
+//!    runs on a telemetry tick (at most every second tick), nor on a tick
+//!    where the twin had an event (an impact, a release: a few steps
+//!    more), which also moves a due telemetry record to the next tick.
+//!    Each result is thus refreshed every five job ticks (5 ms at the
+//!    default 1 kHz and 2 Hz telemetry), while the oil's temperature
+//!    changes over seconds. A job the model refuses keeps its previous
+//!    results and flags the estimate `DEGRADED` until it succeeds again;
 //! 5. flows and the compensation error follow from the twin's state.
 //!
 //! The pieces, one concept per file: [`EstimatorConfig`] and its
-//! [`TemperatureRange`]s (`config`); the spike filter and low-pass of steps
-//! 1-2 ([`TemperatureFilter`], [`FilterSettings`], `filter`); the jobs of
-//! step 4 and the results they keep (`jobs`); the stability test and
-//! decay-rate bound of the Stability job ([`quartic_hurwitz`],
-//! [`slowest_decay_rate`], `stability`); the flags ([`Flags`], `flags`);
-//! the estimate and its telemetry record ([`StateEstimate`], `estimate`).
-//! The flows of step 5 are the throttle laws'
+//! [`TemperatureRange`]s (`config`); the oil-temperature observer
+//! ([`OilObserver`], [`ObserverDesign`], `observer`) and its spike gate
+//! ([`SpikeGate`], `spike`); the jobs of step 4 and the results they keep
+//! (`jobs`); the stability test and decay-rate bound of the Stability job
+//! ([`quartic_hurwitz`], [`slowest_decay_rate`], `stability`); the flags
+//! ([`Flags`], `flags`); the estimate ([`StateEstimate`], `estimate`) and
+//! its telemetry record, declared once as a table ([`telemetry`]). The
+//! flows of step 5 are the throttle laws'
 //! ([`FlowLaws`](crate::throttle::FlowLaws)). This module runs the tick:
 //! the sequence above, the rotation of the jobs and the consistency check.
 //!
@@ -51,29 +57,40 @@
 //! ([`StateEstimate::reseats`]) and flagged [`Flags::TWIN_RESEATED`]. The
 //! thresholds and their reasons are in the project's `docs/firmware.md`.
 //!
-//! The cost of a tick is bounded by the twin's step, the fluid properties
-//! and the larger of one job or the telemetry packing: what the firmware's
-//! budget measures. Nothing here allocates or panics; every failure becomes
-//! a flag.
+//! The cost of a tick is bounded by the observer's prediction, the twin's
+//! step, the fluid properties and the larger of one job or the telemetry
+//! packing: what the firmware's budget measures. Nothing here allocates or
+//! panics; every failure becomes a flag.
 
 mod config;
+mod deadline;
 mod estimate;
-mod filter;
 mod flags;
 mod jobs;
+mod observer;
+mod spike;
 mod stability;
+pub mod telemetry;
 
-pub use config::{EstimatorConfig, TemperatureRange};
+pub use config::{ConfigError, EstimatorConfig, TemperatureRange, observer_settings, reading_period};
+pub use deadline::MAX_CATCH_UP;
 pub use estimate::StateEstimate;
-pub use filter::{FilterSettings, TemperatureFilter, Verdict};
 pub use flags::Flags;
+pub use observer::{
+    CUSUM_DRIFT, CUSUM_THRESHOLD, DesignError, HOLD_RATIO, ModeGains, NO_LAG, ObserverDesign, ObserverSettings,
+    OilObserver,
+};
+pub use spike::{SpikeGate, SpikeSettings, Verdict};
 pub use stability::{quartic_hurwitz, slowest_decay_rate};
 
 use crate::asymptotic;
 use crate::dynamics::Twin;
 use crate::error::ModelError;
 use crate::params::Params;
+use crate::scalar::Real;
 use crate::sensor::SensorFault;
+use crate::uncertainty::{Uncertainty, UncertaintyTable};
+use core::borrow::Borrow;
 use jobs::{Design, Job, Statics};
 
 /// Largest relative change of the twin's capillary conductance (~ 1 / mu)
@@ -117,6 +134,10 @@ pub const STOP_SETTLE_TIME_CONSTANTS: f32 = 150.0;
 /// apply when longer.
 pub const MAX_STOP_SETTLE: f32 = 1.0;
 
+/// Event ticks in a row after which the job and the telemetry run on an
+/// event tick too ([`Estimator::tick`]: the twin's oil must keep moving).
+pub const MAX_DEFERRED: u32 = 3;
+
 /// Fewest steady ticks before the check (three rounds of the four jobs, so
 /// that the twin's fluid properties and the equilibrium it is compared with
 /// belong to the steady temperature).
@@ -132,14 +153,16 @@ pub const X_TOLERANCE: f32 = 1e-2;
 /// fraction of `dp` (as [`X_TOLERANCE`]).
 pub const P_TOLERANCE: f32 = 1e-2;
 
-/// The estimator.
+/// The estimator, its twin integrating in `T` (`f32` where there is an
+/// FPU, [`Fixed`](crate::scalar::Fixed) where there is none); everything
+/// else (observer, jobs, flows) is `f32`.
 #[derive(Clone, Copy, Debug)]
-pub struct Estimator {
+pub struct Estimator<T = f32, U = UncertaintyTable> {
     params: Params<f32>,
-    config: EstimatorConfig,
-    twin: Twin<f32, f32>,
-    /// The sample filter (steps 1-2 of the tick).
-    filter: TemperatureFilter,
+    config: EstimatorConfig<U>,
+    twin: Twin<f32, T>,
+    /// The oil-temperature observer (steps 1-2 of the tick).
+    observer: OilObserver,
     /// Jobs whose last run failed, one bit per [`Job`] (the oil model
     /// refused the temperature: the previous results stay in force). The
     /// estimate is degraded until each of them succeeds again.
@@ -172,9 +195,30 @@ pub struct Estimator {
     /// A publication was due on a tick the twin spent on an event: the
     /// next tick publishes.
     telemetry_pending: bool,
+    /// Tick deadlines missed so far (saturating; [`Estimator::tick_after`]).
+    deadline_misses: u32,
+    /// Ticks of real time the twin did not advance through (beyond
+    /// [`MAX_CATCH_UP`] per late tick; saturating).
+    lost_ticks: u32,
+    /// This tick started late (raises `DEADLINE_MISSED`).
+    late: bool,
+    /// Consecutive ticks the twin had an event on (saturating).
+    deferred: u32,
 }
 
-impl Estimator {
+impl<U: Borrow<UncertaintyTable> + Copy> Estimator<f32, U> {
+    /// An estimator with an `f32` twin at rest in the equilibrium of
+    /// `initial` [C]: [`Estimator::with_scalar`] for `f32`.
+    ///
+    /// # Errors
+    ///
+    /// As [`Estimator::with_scalar`].
+    pub fn new(params: &Params<f32>, config: EstimatorConfig<U>, initial: f32) -> Result<Self, ModelError> {
+        Self::with_scalar(params, config, initial)
+    }
+}
+
+impl<T: Real, U: Borrow<UncertaintyTable> + Copy> Estimator<T, U> {
     /// An estimator at rest in the equilibrium of `initial` [C], which must
     /// be a temperature the oil model accepts. Eq. (32) is checked once here
     /// over the validated range (201 samples; a range the oil model refuses
@@ -188,7 +232,7 @@ impl Estimator {
     ///   temperature ([`crate::fluid::Oil::state`]);
     /// * a temperature-only job fails at `initial` (the equilibrium, its
     ///   sensitivity or the machine's losses not finite).
-    pub fn new(params: &Params<f32>, config: EstimatorConfig, initial: f32) -> Result<Self, ModelError> {
+    pub fn with_scalar(params: &Params<f32>, config: EstimatorConfig<U>, initial: f32) -> Result<Self, ModelError> {
         let monotonic = asymptotic::monotonicity(params, config.valid.min, config.valid.max, 201)
             .map(|m| m.monotonic)
             .unwrap_or(false);
@@ -201,14 +245,24 @@ impl Estimator {
         let design = Design::new(params, machine_mu_ref);
         let mut statics = Statics::new(point, config.tick());
         let mut twin = twin;
+        let observer = OilObserver::new(initial);
         for job in Job::ALL {
-            jobs::run(job, params, &mut twin, design, initial, &mut statics)?;
+            jobs::run(
+                job,
+                params,
+                &config,
+                &mut twin,
+                design,
+                initial,
+                &observer,
+                &mut statics,
+            )?;
         }
         Ok(Estimator {
             params: *params,
             config,
             twin,
-            filter: TemperatureFilter::new(initial),
+            observer,
             failed_jobs: 0,
             since_sample: 0,
             tick: 0,
@@ -224,6 +278,10 @@ impl Estimator {
             reseated: false,
             publish: false,
             telemetry_pending: false,
+            deadline_misses: 0,
+            lost_ticks: 0,
+            late: false,
+            deferred: 0,
         })
     }
 
@@ -247,19 +305,31 @@ impl Estimator {
         self.statics.settle_ticks
     }
 
+    /// The oil-temperature observer.
+    pub fn observer(&self) -> &OilObserver {
+        &self.observer
+    }
+
+    /// The uncertainty of the estimate now, computed at once (the tick
+    /// refreshes it in the job rotation, [`StateEstimate::uncertainty`]).
+    pub fn uncertainty_now(&self) -> Uncertainty {
+        let t = self.observer.oil();
+        self.config.table().at(t, self.observer.variance(&self.config.observer))
+    }
+
     /// The settings.
-    pub fn config(&self) -> &EstimatorConfig {
+    pub fn config(&self) -> &EstimatorConfig<U> {
         &self.config
     }
 
     /// The twin.
-    pub fn twin(&self) -> &Twin<f32, f32> {
+    pub fn twin(&self) -> &Twin<f32, T> {
         &self.twin
     }
 
     /// The twin, mutable: to inject a fault (a wrong state, with
     /// [`Twin::set_state`]) and watch the consistency check undo it.
-    pub fn twin_mut(&mut self) -> &mut Twin<f32, f32> {
+    pub fn twin_mut(&mut self) -> &mut Twin<f32, T> {
         &mut self.twin
     }
 
@@ -269,11 +339,16 @@ impl Estimator {
         if !self.monotonic {
             flags.insert(Flags::NOT_UNIQUE);
         }
+        if core::mem::take(&mut self.late) {
+            flags.insert(Flags::DEADLINE_MISSED);
+        }
         self.tick = self.tick.wrapping_add(1);
         self.since_sample = self.since_sample.saturating_add(1);
+        let design = &self.config.observer;
+        self.observer.predict(design);
         match sample {
             Ok(Some(t)) if t.is_finite() && self.config.oil.contains(t) => {
-                match self.filter.offer(&self.config.filter(), t) {
+                match self.observer.offer(design, &self.config.spikes, t) {
                     Verdict::Accepted | Verdict::Step => self.since_sample = 0,
                     Verdict::Spike => flags.insert(Flags::SPIKE),
                 }
@@ -284,7 +359,9 @@ impl Estimator {
         if self.since_sample > self.config.stale_after {
             flags.insert(Flags::DEGRADED);
         }
-        let t = self.filter.advance(&self.config.filter());
+        // The estimated oil temperature, inside the range the oil model is
+        // used in (the observer may overshoot it for a moment).
+        let t = self.observer.oil().max(self.config.oil.min).min(self.config.oil.max);
         if !self.config.valid.contains(t) {
             flags.insert(Flags::OUT_OF_RANGE);
         }
@@ -297,12 +374,18 @@ impl Estimator {
                 // The model cannot evaluate this temperature: keep the last
                 // estimate's physics, flagged.
                 flags.insert(Flags::DEGRADED);
-                let mut e = self
-                    .last
-                    .unwrap_or(StateEstimate::without_physics(0, t, self.reseats, flags));
+                let mut e = self.last.unwrap_or(StateEstimate::without_physics(
+                    0,
+                    t,
+                    self.observer.last_reading(),
+                    self.reseats,
+                    flags,
+                ));
                 e.tick = self.tick;
                 e.temperature = t;
+                e.t_probe = self.observer.last_reading();
                 e.reseats = self.reseats;
+                e.deadline_misses = self.deadline_misses;
                 e.flags = flags;
                 e
             }
@@ -315,7 +398,7 @@ impl Estimator {
         // (both wait for the next tick), so that the worst tick stays the
         // twin's plain tick plus the larger of one job or the telemetry.
         let p = &self.params;
-        let eventful = match self.twin.tick() {
+        let event = match self.twin.tick() {
             Ok(report) => report.eventful(),
             Err(_) => {
                 // A failed step (never seen with valid parameters): restart
@@ -325,6 +408,15 @@ impl Estimator {
                 true
             }
         };
+        // A plunger resting on a stop where the force is nearly zero can
+        // have an event every tick (released and stopped again, within the
+        // tick), while the oil that would move it on is the Fluid job's to
+        // change: deferring every job to the next tick would freeze the
+        // twin's oil and with it the plunger, for good. After
+        // MAX_DEFERRED event ticks in a row the job (or the telemetry) runs
+        // anyway: the worst tick is then an event tick plus one job.
+        self.deferred = if event { self.deferred.saturating_add(1) } else { 0 };
+        let eventful = event && self.deferred <= MAX_DEFERRED;
         let due = self.telemetry_pending
             || (self.config.telemetry_every > 0 && self.tick.is_multiple_of(self.config.telemetry_every));
         self.publish = due && !eventful;
@@ -356,7 +448,16 @@ impl Estimator {
             // A temperature the model refuses leaves the job's previous
             // results in force; the estimate goes on, flagged, until the
             // job succeeds again.
-            match jobs::run(job, &self.params, &mut self.twin, self.design, t, &mut self.statics) {
+            match jobs::run(
+                job,
+                &self.params,
+                &self.config,
+                &mut self.twin,
+                self.design,
+                t,
+                &self.observer,
+                &mut self.statics,
+            ) {
                 Ok(()) => {
                     self.failed_jobs &= !job.bit();
                     if job == Job::Equilibrium {
@@ -378,7 +479,7 @@ impl Estimator {
         }
         let s = self.twin.state();
         let [xi, ..] = self.twin.raw_state();
-        if xi <= 0.0 || xi >= 1.0 {
+        if xi <= T::ZERO || xi >= T::ONE {
             flags.insert(Flags::AT_STOP);
         }
         let st = &self.statics;
@@ -393,6 +494,7 @@ impl Estimator {
         Ok(StateEstimate {
             tick: self.tick,
             temperature: t,
+            t_probe: self.observer.last_reading(),
             x: s.x,
             v: s.v,
             p_a: s.p_a,
@@ -405,6 +507,8 @@ impl Estimator {
             x_equilibrium: st.x_equilibrium,
             dx_dt: st.dx_dt,
             reseats: self.reseats,
+            deadline_misses: self.deadline_misses,
+            uncertainty: st.uncertainty,
             flags: *flags,
         })
     }
@@ -424,7 +528,7 @@ impl Estimator {
             return;
         }
         self.checks = self.checks.saturating_add(1);
-        let [xi, _, pi_a, pi_b] = self.twin.raw_state();
+        let [xi, _, pi_a, pi_b] = self.twin.raw_state().map(Real::to_f32);
         let [xi_eq, _, pi_a_eq, pi_b_eq] = st.y_equilibrium;
         // Written so that a NaN state fails the check too.
         let agrees = libm::fabsf(xi - xi_eq) <= X_TOLERANCE

@@ -297,6 +297,13 @@ pub struct Max31865<SPI> {
     suspect: Option<SensorFault>,
 }
 
+/// The converter's resolution at `t` [C per code]: one code, `R_ref /
+/// 2^15` ohm, over the RTD's slope `dR/dt` there (0.033 C at 40 C for a
+/// PT100 with 430 ohm), for the parameter file's `[estimator]` section.
+pub fn resolution(raw: &RawEstimator, t: f64) -> f64 {
+    raw.rtd_reference / 32768.0 / raw.rtd_slope(t)
+}
+
 /// The 15-bit code of resistance `r` [ohm] (rounded to the nearest code,
 /// as the converter's ADC does), saturated to the code range.
 pub fn code_of(settings: &Settings, r: f32) -> u16 {

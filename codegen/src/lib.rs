@@ -1,0 +1,207 @@
+//! # compensator-codegen
+//!
+//! What the firmware's build script generates from a parameter file, as
+//! functions that return text: the firmware's `build.rs` is a thin driver
+//! that reads the file, calls them and writes their output to `OUT_DIR`,
+//! and host tests call the same functions.
+//!
+//! * [`params_rs`]: the parameter set as constants (`RAW_PARAMS`, by field
+//!   name) and the twin's configuration for the design, chosen from its
+//!   own dynamics (`compensator::dynamics::config::choose`), so that the
+//!   cost per tick is decided before anything is flashed.
+//! * [`replay`]: the QEMU twin's replay schedule adapted to the device's
+//!   ranges ([`replay::adapt`]), its text form for the host-side replica
+//!   ([`replay::Schedule`]), and (feature `replay`) the bounds the twin
+//!   checks itself against and the on-target tests' expectations, computed
+//!   in `f64` by the independent reference (`compensator-reference`), never
+//!   by the core.
+//!
+//! The QEMU images' build enables `replay`; the board image's does not, and
+//! its build script compiles no reference.
+
+pub mod replay;
+
+use compensator_params::{Field, Named, RawCore, RawEstimator, RawMachine, RawParams, RawProbe};
+
+/// The generated `params.rs` and what the build should say about it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParamsRs {
+    /// The Rust source: `RAW_PARAMS`, `OBSERVER`, `OBSERVER_WITHOUT_LAG`,
+    /// `UNCERTAINTY`, `PARAMS_SOURCE`, `TWIN_SCHEME`, `TWIN_SUBSTEPS`,
+    /// `TWIN_ESTIMATED_ERROR_PCT`.
+    pub code: String,
+    /// Warnings for the build (the twin's accuracy target not met).
+    pub warnings: Vec<String>,
+}
+
+/// The twin's configuration for `raw` at its tick over its validated range
+/// and down to its coldest oil (`compensator::dynamics::config::choose`).
+///
+/// # Errors
+///
+/// The parameters do not make a model, or the chooser found no
+/// configuration (its message).
+pub fn twin_configuration(raw: &RawParams) -> Result<compensator::dynamics::config::Choice, String> {
+    let p = compensator::Params::<f64>::new(raw).map_err(|e| e.to_string())?;
+    let e = &raw.estimator;
+    compensator::dynamics::config::choose(&p, 1.0 / e.tick_hz, (e.valid_min, e.valid_max)).map_err(|e| e.to_string())
+}
+
+/// A struct literal by field name (`spring_rate: 25684.5`): the constants
+/// do not depend on the order of the fields.
+fn literal(ty: &str, fields: &[(Field, Named)]) -> String {
+    let body = fields
+        .iter()
+        .map(|(f, n)| format!("{}: {:?}", f.name, n.value))
+        .collect::<Vec<_>>()
+        .join(", ");
+    format!("::compensator::params::{ty} {{ {body} }}")
+}
+
+/// A struct's `Debug` text as a Rust expression: its type names taken from
+/// the crate (`ObserverDesign { .. }` as `::compensator::estimator::
+/// ObserverDesign { .. }`), `NaN` and `inf` as `f32` constants. The
+/// structs are plain data of `f32`s, `bool`s and arrays, whose derived
+/// `Debug` is their literal (every `f32` in its shortest round-trip form).
+pub fn rust_literal(debug: &str) -> String {
+    let mut out = String::new();
+    let mut word = String::new();
+    let flush = |word: &mut String, out: &mut String| {
+        let w = std::mem::take(word);
+        out.push_str(match w.as_str() {
+            "NaN" => "f32::NAN",
+            "inf" => "f32::INFINITY",
+            "ObserverDesign" => "::compensator::estimator::ObserverDesign",
+            "ModeGains" => "::compensator::estimator::ModeGains",
+            "UncertaintyTable" => "::compensator::uncertainty::UncertaintyTable",
+            _ => &w,
+        });
+    };
+    for c in debug.chars() {
+        if c.is_alphanumeric() || c == '_' || c == '.' {
+            word.push(c);
+        } else {
+            flush(&mut word, &mut out);
+            out.push(c);
+        }
+    }
+    flush(&mut word, &mut out);
+    out
+}
+
+/// The firmware's constants for the validated parameter set `raw`, read
+/// from `path` (shown in the generated comment) named `source` (its file
+/// name, what the firmware prints).
+///
+/// The estimator's observer and uncertainty table are designed here, in
+/// `f64` (the firmware links no `f64` design code): `OBSERVER` for the
+/// file's probe, `OBSERVER_WITHOUT_LAG` for the soak image (its walk reads
+/// the oil directly), `UNCERTAINTY` from the file's tolerances.
+///
+/// # Errors
+///
+/// No twin configuration for the design ([`twin_configuration`]), no
+/// observer or no uncertainty table for it (the message names the field).
+pub fn params_rs(raw: &RawParams, path: &str, source: &str) -> Result<ParamsRs, String> {
+    let choice = twin_configuration(raw).map_err(|e| format!("no twin configuration: {e}"))?;
+    let mut warnings = Vec::new();
+    if !choice.goal_met {
+        warnings.push(format!(
+            "the twin's {} substeps per tick are estimated {:.3} % of a step off (target {} %)",
+            choice.config.substeps,
+            choice.estimated_error_pct,
+            compensator::dynamics::config::TARGET_PCT
+        ));
+    }
+    let core = literal("RawCore", &RawCore::FIELD.zip(raw.core.named()).into_array());
+    let machine = match &raw.machine {
+        Some(m) => format!(
+            "Some({})",
+            literal("RawMachine", &RawMachine::FIELD.zip(m.named()).into_array())
+        ),
+        None => "None".to_string(),
+    };
+    let estimator = literal(
+        "RawEstimator",
+        &RawEstimator::FIELD.zip(raw.estimator.named()).into_array(),
+    );
+    let probe = literal("RawProbe", &RawProbe::FIELD.zip(raw.probe.named()).into_array());
+    let config = compensator::estimator::EstimatorConfig::new(raw).map_err(|e| e.to_string())?;
+    let direct = compensator::estimator::observer_settings(raw, config.sample_period()).without_lag();
+    let direct = compensator::estimator::ObserverDesign::new(&direct).map_err(|e| format!("probe without lag: {e}"))?;
+    let observer = rust_literal(&format!("{:?}", config.observer));
+    let direct = rust_literal(&format!("{direct:?}"));
+    let uncertainty = rust_literal(&format!("{:?}", config.uncertainty));
+    let code = format!(
+        "// Generated by build.rs (compensator-codegen) from {path}\n\
+         /// The parameter set the firmware was built with (validated at build time;\n\
+         /// its tolerances are in `UNCERTAINTY`).\n\
+         pub const RAW_PARAMS: ::compensator::params::RawParams = ::compensator::params::RawParams {{\n    \
+         core: {core},\n    \
+         machine: {machine},\n    \
+         estimator: {estimator},\n    \
+         probe: {probe},\n    \
+         tolerances: ::compensator::params::RawTolerances::NONE,\n}};\n\
+         /// The oil-temperature observer designed at build time for the file's probe.\n\
+         pub const OBSERVER: ::compensator::estimator::ObserverDesign = {observer};\n\
+         /// The observer for a probe without lag (the soak image's walk reads the oil).\n\
+         pub const OBSERVER_WITHOUT_LAG: ::compensator::estimator::ObserverDesign = {direct};\n\
+         /// The uncertainty table built at build time from the file's tolerances.\n\
+         pub static UNCERTAINTY: ::compensator::uncertainty::UncertaintyTable = {uncertainty};\n\
+         /// Where the parameters came from.\n\
+         pub const PARAMS_SOURCE: &str = {source:?};\n\
+         /// The twin's scheme, by name (`compensator::dynamics::Scheme::from_name`),\n\
+         /// chosen at build time for this parameter file.\n\
+         pub const TWIN_SCHEME: &str = {:?};\n\
+         /// The twin's steps per tick, chosen at build time for this parameter\n\
+         /// file from its own dynamics (`compensator::dynamics::config::choose`).\n\
+         pub const TWIN_SUBSTEPS: u8 = {};\n\
+         /// The chooser's estimate of the twin's error [% of a step].\n\
+         pub const TWIN_ESTIMATED_ERROR_PCT: f32 = {:?};\n",
+        choice.config.scheme.name(),
+        choice.config.substeps,
+        choice.estimated_error_pct as f32,
+    );
+    Ok(ParamsRs { code, warnings })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn paper() -> RawParams {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../presets/paper.toml");
+        compensator_params::file::load(std::path::Path::new(path)).unwrap()
+    }
+
+    #[test]
+    fn the_constants_name_every_field_and_the_chosen_twin() {
+        let raw = paper();
+        let g = params_rs(&raw, "presets/paper.toml", "paper.toml").unwrap();
+        assert!(g.warnings.is_empty(), "{:?}", g.warnings);
+        assert!(g.code.contains("pub const PARAMS_SOURCE: &str = \"paper.toml\";"));
+        assert!(g.code.contains("pub const TWIN_SCHEME: &str = \"sdirk3\";"));
+        assert!(g.code.contains("pub const TWIN_SUBSTEPS: u8 = 1;"));
+        for f in RawCore::FIELD.into_array() {
+            assert!(g.code.contains(&format!("{}: ", f.name)), "{}", f.name);
+        }
+        assert!(g.code.contains(&format!("spring_rate: {:?}", raw.core.spring_rate)));
+        assert!(
+            g.code
+                .contains(&format!("time_constant: {:?}", raw.probe.time_constant))
+        );
+        assert!(g.code.contains(
+            "pub const OBSERVER: ::compensator::estimator::ObserverDesign = ::compensator::estimator::ObserverDesign {"
+        ));
+        assert!(g.code.contains("hold: ::compensator::estimator::ModeGains {"));
+        assert!(g.code.contains("pub static UNCERTAINTY: ::compensator::uncertainty::UncertaintyTable = ::compensator::uncertainty::UncertaintyTable {"));
+    }
+
+    #[test]
+    fn not_a_number_and_infinities_become_constants() {
+        assert_eq!(
+            rust_literal("T { a: NaN, b: [-inf, 1.5e-7, inf], c: NaN_x }"),
+            "T { a: f32::NAN, b: [-f32::INFINITY, 1.5e-7, f32::INFINITY], c: NaN_x }"
+        );
+    }
+}
