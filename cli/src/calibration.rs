@@ -36,7 +36,7 @@ use crate::lsq::{self, Fit, Uncertainty, least_squares};
 use crate::params_file;
 use compensator::Params;
 use compensator::equilibrium::{a_parameter, equilibrium, geometry_factor, pressure_difference};
-use compensator::params::{RawCore, RawParams};
+use compensator::params::{RawCore, RawParams, RawTolerances};
 use nalgebra::DMatrix;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -236,10 +236,15 @@ pub struct Stage {
 /// Outcome of [`fit`].
 #[derive(Debug, Clone)]
 pub struct Calibration {
-    /// The calibrated parameter set (base with fitted fields).
+    /// The calibrated parameter set (base with fitted fields; its
+    /// tolerances still the base's: [`Calibration::written`] gives the
+    /// calibrated file's).
     pub params: RawParams,
     /// The fitted parameters, pressure stage first.
     pub estimates: Vec<Estimate>,
+    /// Covariance matrix of the estimates (same order), in the fields'
+    /// units: the fit's, both stages together (module docs).
+    pub covariance: DMatrix<f64>,
     /// Correlation matrix of the estimates (same order).
     pub correlation: DMatrix<f64>,
     /// Pressure stage: residuals in Pa.
@@ -416,12 +421,14 @@ pub fn fit(
         if let Some(i) = data.iter().position(|p| !(lo..=hi).contains(&p.x_m)) {
             return Err(CliError::Input(format!(
                 "--displacement-data: data row {}, column x_m: {} m is outside the plunger's travel \
-                 [{}, {}] m (0 to plunger.stroke = {stroke} m, with {} % slack)",
+                 [{}, {}] m (0 to plunger.stroke = {} m, with {} % slack){}",
                 i + 1,
-                num(data[i].x_m),
-                num(lo),
-                num(hi),
-                X_SLACK * 100.0
+                crate::display::sig(data[i].x_m, 6),
+                crate::display::sig(lo, 4),
+                crate::display::sig(hi, 4),
+                crate::display::sig(stroke, 6),
+                X_SLACK * 100.0,
+                crate::data::column("x_m").map_or(String::new(), |c| crate::data::unit_hint(c, data[i].x_m, lo, hi))
             )));
         }
         let v0 = [area / base.core.spring_rate * 1e9, base.core.preload * 1e5];
@@ -506,13 +513,8 @@ pub fn fit(
     let p = d.len();
     let cov_named = DMatrix::from_fn(p, p, |i, j| d[i] * cov[(i, j)] * d[j]);
     let fields = [f.walther_a, f.walther_b, f.laminar_length, f.spring_rate, f.preload];
-    let values = [
-        core.walther_a,
-        core.walther_b,
-        core.laminar_length,
-        core.spring_rate,
-        core.preload,
-    ];
+    // By name, from the schema's access by path.
+    let values = fields.map(|f| core.value(f.path).unwrap_or(f64::NAN));
     let estimates: Vec<Estimate> = (0..p)
         .map(|i| Estimate {
             path: fields[i].path,
@@ -546,6 +548,7 @@ pub fn fit(
         params,
         estimates,
         correlation: lsq::correlation(&cov_named),
+        covariance: cov_named,
         pressure: Stage {
             fit: fit1,
             uncertainty: unc1,
@@ -553,6 +556,242 @@ pub fn fit(
         displacement: displacement_stage,
         warnings,
     })
+}
+
+/// Largest standard uncertainty a parameter file accepts, as a fraction of
+/// the field's value (`RawTolerances::validate`: a device three standard
+/// deviations away must still be a device).
+pub const TOLERANCE_LIMIT: f64 = 1.0 / 3.0;
+
+/// Correlation magnitude up to which a pair of fitted fields gets no
+/// `[[correlation]]` entry. Leaving out a coefficient `r` changes a
+/// propagated variance `sum_ij g_i g_j r_ij u_i u_j` by `2 r g_i u_i g_j u_j`,
+/// at most `|r|` times the two fields' own contributions `(g_i u_i)^2 +
+/// (g_j u_j)^2`: any standard uncertainty by at most `|r| / 2` = 0.5 %
+/// (GUM 5.2.2: a correlation may be neglected where its term is small
+/// beside the uncertainty's own rounding to two digits). A pair
+/// is written anyway when leaving the small ones out would make the
+/// correlation matrix indefinite (a nearly singular fit's).
+pub const CORR_WRITE_MIN: f64 = 0.01;
+
+/// A fitted field whose standard error exceeds what a parameter file holds
+/// ([`TOLERANCE_LIMIT`] of its value): the data do not determine it. Its
+/// uncertainty is the base file's tolerance instead (a drawing's, Type B),
+/// at the fitted value, and the other fitted fields' covariance is the
+/// fit's conditioned on it (see [`Calibration::written`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Held {
+    /// Parameter path.
+    pub path: &'static str,
+    /// Unit.
+    pub unit: &'static str,
+    /// Fitted value [unit].
+    pub value: f64,
+    /// The fit's standard error [unit].
+    pub std_error: f64,
+    /// The base file's tolerance, written in its place [unit].
+    pub tolerance: f64,
+    /// The base file's value [unit].
+    pub base_value: f64,
+    /// `|value - base_value| / std_error`: how far the data place the
+    /// fitted value from the base's, in the fit's standard errors. The
+    /// written covariance is the fit's conditioned on the field lying
+    /// within its tolerance of the fitted value, where the Gaussian update
+    /// by the base's value would also move the estimate, by this fraction
+    /// of the fit's standard error along the direction the data barely
+    /// see: no output then moves by more than `shift` of its standard
+    /// uncertainty under the fit's covariance. Above [`HELD_SHIFT_WARN`]
+    /// `calibrate` warns.
+    pub shift: f64,
+}
+
+/// [`Held::shift`] above which `calibrate` warns that the data place a
+/// field they do not determine far from the base file's value (the
+/// written band then leans on a value the base file does not support).
+pub const HELD_SHIFT_WARN: f64 = 0.5;
+
+/// What `calibrate` writes into the calibrated file's `[tolerances]` and
+/// `[[correlation]]` ([`Calibration::written`]).
+#[derive(Debug, Clone)]
+pub struct Written {
+    /// The calibrated file's tolerances: the fitted fields' from the fit,
+    /// every other field's (and the correlations between two of them) from
+    /// the base file.
+    pub tolerances: RawTolerances,
+    /// Covariance of the fitted fields as written, in the estimates' order
+    /// [their units]: the fit's, conditioned on the held fields.
+    pub covariance: DMatrix<f64>,
+    /// The fields the data do not determine (empty for a well-posed fit).
+    pub held: Vec<Held>,
+    /// Pairs of fitted fields left without an entry (`|r| <=`
+    /// [`CORR_WRITE_MIN`]).
+    pub omitted: usize,
+}
+
+/// The covariance `c` (fields' units) with the fields `held` given the
+/// variances `u2` instead of the fit's and the others conditioned on them
+/// (the two-step estimator's formula, `cli/src/calibration.rs` module
+/// docs): with `M = C_fh C_hh^-1` the regression of the free fields on the
+/// held ones, `C_ff - M C_hf + M U M^T`, `C_fh = M U`, `C_hh = U`. `None`
+/// when `C_hh` is singular.
+fn hold(c: &DMatrix<f64>, held: &[usize], u2: &[f64]) -> Option<DMatrix<f64>> {
+    let p = c.nrows();
+    let free: Vec<usize> = (0..p).filter(|i| !held.contains(i)).collect();
+    let sub = |rows: &[usize], cols: &[usize]| DMatrix::from_fn(rows.len(), cols.len(), |i, j| c[(rows[i], cols[j])]);
+    let c_hh_inv = sub(held, held).try_inverse()?;
+    let c_fh = sub(&free, held);
+    let m = &c_fh * c_hh_inv;
+    let u = DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(u2));
+    let c_ff = sub(&free, &free) - &m * c_fh.transpose() + &m * &u * m.transpose();
+    let c_fh = &m * &u;
+    let mut out = DMatrix::zeros(p, p);
+    for (a, &i) in free.iter().enumerate() {
+        for (b, &j) in free.iter().enumerate() {
+            out[(i, j)] = c_ff[(a, b)];
+        }
+        for (b, &j) in held.iter().enumerate() {
+            out[(i, j)] = c_fh[(a, b)];
+            out[(j, i)] = c_fh[(a, b)];
+        }
+    }
+    for (a, &i) in held.iter().enumerate() {
+        out[(i, i)] = u2[a];
+    }
+    Some(out)
+}
+
+impl Calibration {
+    /// The tolerances the calibrated file gets, `base` being the file the
+    /// fit started from.
+    ///
+    /// Each fitted field's standard uncertainty is its standard error (the
+    /// fit's covariance, both stages, [`Calibration::covariance`]) and each
+    /// pair of fitted fields correlated beyond [`CORR_WRITE_MIN`] gets a
+    /// `[[correlation]]`; the base's tolerances of the fitted fields and
+    /// its correlations involving one are replaced, every other tolerance
+    /// and correlation is kept.
+    ///
+    /// A fitted field whose standard error exceeds [`TOLERANCE_LIMIT`] of
+    /// its value is not determined by the data, and a file cannot hold
+    /// that tolerance: it is [`Held`], given the base file's tolerance (at
+    /// the fitted value, which the data cannot tell from the base's), and
+    /// the other fields' covariance is conditioned on it ([`hold`]),
+    /// repeated until every written tolerance fits.
+    ///
+    /// # Errors
+    ///
+    /// [`CliError::Input`] naming the field when a field the data do not
+    /// determine has no tolerance in the base file (the calibrated file
+    /// would otherwise claim it exactly known, or hold a tolerance no file
+    /// accepts); [`CliError::Failed`] when the tolerances are refused by
+    /// the parameter file's checks (more correlations than a file holds).
+    pub fn written(&self, base: &RawParams) -> Result<Written, CliError> {
+        let p = self.estimates.len();
+        let limit = |i: usize| TOLERANCE_LIMIT * self.estimates[i].value.abs();
+        let mut held: Vec<usize> = Vec::new();
+        let mut cov = self.covariance.clone();
+        loop {
+            let more: Vec<usize> = (0..p)
+                .filter(|i| !held.contains(i) && !(cov[(*i, *i)].max(0.0).sqrt() <= limit(*i)))
+                .collect();
+            if more.is_empty() {
+                break;
+            }
+            for &i in &more {
+                let e = &self.estimates[i];
+                let u = base.tolerances.get(e.path).unwrap_or(0.0);
+                if !(u > 0.0) {
+                    return Err(CliError::Input(format!(
+                        "--write-preset: {}: the {} data do not determine it (standard error {:.3e} {}, {:.0} %                          of its value {:.4e}; a tolerance may be at most a third of the value), and the --params                          file gives it no tolerance: give its standard uncertainty in that file's [tolerances] (a                          drawing's, docs/parameters.md), or data that determine it",
+                        e.path,
+                        e.data,
+                        self.covariance[(i, i)].max(0.0).sqrt(),
+                        e.unit,
+                        100.0 * self.covariance[(i, i)].max(0.0).sqrt() / e.value.abs(),
+                        e.value
+                    )));
+                }
+                held.push(i);
+            }
+            let u2: Vec<f64> = held
+                .iter()
+                .map(|&i| base.tolerances.get(self.estimates[i].path).unwrap_or(0.0).powi(2))
+                .collect();
+            cov = hold(&self.covariance, &held, &u2)
+                .ok_or_else(|| CliError::Failed("the fit's covariance of the held fields is singular".into()))?;
+        }
+        let fitted: Vec<&str> = self.estimates.iter().map(|e| e.path).collect();
+        let mut tol = RawTolerances {
+            core: base.tolerances.core,
+            machine: base.tolerances.machine,
+            ..RawTolerances::NONE
+        };
+        for c in base.tolerances.correlations() {
+            if !fitted.contains(&c.a) && !fitted.contains(&c.b) {
+                tol.push_correlation(c.a, c.b, c.coefficient)
+                    .map_err(|e| CliError::Failed(format!("calibrated tolerances: {e}")))?;
+            }
+        }
+        for (i, e) in self.estimates.iter().enumerate() {
+            if let Some(s) = tol.get_mut(e.path) {
+                *s = cov[(i, i)].max(0.0).sqrt();
+            }
+        }
+        let corr = lsq::correlation(&cov);
+        let pairs = |min: f64| -> Vec<(usize, usize)> {
+            (0..p)
+                .flat_map(|i| (i + 1..p).map(move |j| (i, j)))
+                .filter(|&(i, j)| corr[(i, j)].abs() > min)
+                .collect()
+        };
+        let with = |pairs: &[(usize, usize)]| -> Result<RawTolerances, CliError> {
+            let mut t = tol;
+            for &(i, j) in pairs {
+                t.push_correlation(fitted[i], fitted[j], corr[(i, j)])
+                    .map_err(|e| CliError::Failed(format!("calibrated tolerances: {e}")))?;
+            }
+            Ok(t)
+        };
+        // The parameter file's own reader is the judge of the matrix.
+        let accepted = |t: &RawTolerances| {
+            let mut raw = self.params;
+            raw.tolerances = *t;
+            params_file::parse(&params_file::to_toml(&raw))
+        };
+        let some = pairs(CORR_WRITE_MIN);
+        let all = pairs(0.0);
+        let (tolerances, omitted) = match with(&some)? {
+            t if accepted(&t).is_ok() => (t, all.len() - some.len()),
+            _ => {
+                let t = with(&all)?;
+                accepted(&t).map_err(|e| CliError::Failed(format!("calibrated tolerances: {e}")))?;
+                (t, 0)
+            }
+        };
+        let held = held
+            .iter()
+            .map(|&i| {
+                let e = &self.estimates[i];
+                let std_error = self.covariance[(i, i)].max(0.0).sqrt();
+                let base_value = base.core.value(e.path).unwrap_or(f64::NAN);
+                Held {
+                    path: e.path,
+                    unit: e.unit,
+                    value: e.value,
+                    std_error,
+                    tolerance: cov[(i, i)].sqrt(),
+                    base_value,
+                    shift: (e.value - base_value).abs() / std_error,
+                }
+            })
+            .collect();
+        Ok(Written {
+            tolerances,
+            covariance: cov,
+            held,
+            omitted,
+        })
+    }
 }
 
 impl Calibration {
@@ -638,8 +877,10 @@ impl Calibration {
         out
     }
 
-    /// The calibrated parameter file: TOML with the fit in comments.
-    pub fn preset(&self, command: &str) -> String {
+    /// The calibrated parameter file: TOML with the fit in comments, its
+    /// `[tolerances]` and `[[correlation]]` those of `written`
+    /// ([`Calibration::written`]).
+    pub fn preset(&self, command: &str, written: &Written) -> String {
         let mut out = String::new();
         let _ = writeln!(out, "# Calibrated from measured static data.");
         let _ = writeln!(out, "# Generated by: {command}");
@@ -656,8 +897,25 @@ impl Calibration {
         for w in &self.warnings {
             let _ = writeln!(out, "# WARNING: {w}");
         }
+        let _ = writeln!(
+            out,
+            "# [tolerances]: the fitted fields' standard errors; [[correlation]]: their pairs beyond |r| = {CORR_WRITE_MIN} \
+             (left out: {} pairs); the other fields' tolerances are the base file's.",
+            written.omitted
+        );
+        for h in &written.held {
+            let _ = writeln!(
+                out,
+                "# {}: not determined by the data (standard error {:.3e} {}, above a third of its value): its \
+                 tolerance {:.3e} {} is the base file's (value {}, {:.2} standard errors from the fit's), the \
+                 others' covariance the fit's conditioned on it.",
+                h.path, h.std_error, h.unit, h.tolerance, h.unit, h.base_value, h.shift
+            );
+        }
         out.push('\n');
-        out.push_str(&params_file::to_toml(&self.params));
+        let mut raw = self.params;
+        raw.tolerances = written.tolerances;
+        out.push_str(&params_file::to_toml(&raw));
         out
     }
 
@@ -690,9 +948,12 @@ impl Calibration {
                     .map(|p| (p.t_c, p.dp_ab_pa * 1e-5))
                     .collect();
                 pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+                // One legend entry per drop (the circles share the line's
+                // colour): six entries would push the curves into a third
+                // of the panel.
                 series.push(Series {
                     color: Some(i),
-                    ..Series::points(format!("measured, dp = {} bar", bar(dp)), pts)
+                    ..Series::points(String::new(), pts)
                 });
                 let model = grid
                     .iter()
@@ -707,7 +968,7 @@ impl Calibration {
                     .collect();
                 series.push(Series {
                     color: Some(i),
-                    ..Series::line(format!("fitted, dp = {} bar", bar(dp)), model)
+                    ..Series::line(format!("dp = {} bar", bar(dp)), model)
                 });
             }
         } else {
@@ -755,7 +1016,7 @@ impl Calibration {
             });
         }
         Figure {
-            title: "Calibration: measured data and the fitted model".into(),
+            title: "Calibration: measured (circles) and fitted (lines)".into(),
             x_desc: "temperature [C]".into(),
             panels,
         }
@@ -820,7 +1081,7 @@ pub fn calibrate(opts: &Options) -> Result<Output, CliError> {
         ));
     }
     let base = match &opts.base {
-        Some(path) => crate::input::load_raw(path, "--base")?,
+        Some(path) => crate::input::load_raw(path, "--params")?,
         None => params_file::parse(crate::input::MODEL_EXAMPLE)?,
     };
     let shown = |p: &Option<PathBuf>, d: &str| p.as_ref().map_or(d.to_string(), |p| p.display().to_string());
@@ -848,7 +1109,27 @@ pub fn calibrate(opts: &Options) -> Result<Output, CliError> {
         }
         None => None,
     };
+    // Every temperature inside the base file's oil model (refused naming
+    // the row otherwise); rows outside the validated range are counted.
+    let params = compensator::Params::<f64>::new(&base).map_err(|e| CliError::Input(format!("--params: {e}")))?;
+    let env = crate::envelope::Envelope::of(&base, &params);
+    let mut outside = 0;
+    for (flag, temps) in [
+        ("--pressure-data", pressure.iter().map(|p| p.t_c).collect::<Vec<_>>()),
+        (
+            "--displacement-data",
+            displacement.iter().flatten().map(|p| p.t_c).collect::<Vec<_>>(),
+        ),
+    ] {
+        for (i, &t) in temps.iter().enumerate() {
+            let at = format!("{flag}: data row {}, column t_c", i + 1);
+            if env.check(t, &at)? == crate::envelope::Zone::OilModel {
+                outside += 1;
+            }
+        }
+    }
     let cal = fit(&base, &pressure, displacement.as_deref())?;
+    let mut held = Vec::new();
     let mut command = format!(
         "compensator calibrate --base {} --pressure-data {p_name}",
         shown(&opts.base, "presets/model-example.toml")
@@ -861,14 +1142,36 @@ pub fn calibrate(opts: &Options) -> Result<Output, CliError> {
         );
     }
     if let Some(path) = &opts.write_preset {
-        std::fs::write(path, cal.preset(&command))
+        let written = cal.written(&base)?;
+        std::fs::write(path, cal.preset(&command, &written))
             .map_err(|e| CliError::Input(format!("--write-preset: {}: {e}", path.display())))?;
+        held = written.held;
     }
     if let Some(path) = &opts.plot {
         crate::plot::write(path, &cal.figure(&pressure, displacement.as_deref()))?;
     }
     let mut notes = cal.summary();
+    if outside > 0 {
+        notes.push(format!(
+            "WARNING: {outside} data rows lie outside the validated range {} (the fit extrapolates there)",
+            env.validated_range()
+        ));
+    }
     notes.extend(cal.warnings.iter().map(|w| format!("WARNING: {w}")));
+    for h in &held {
+        notes.push(format!(
+            "--write-preset: {}: its tolerance is the base file's, {:.3e} {} (the fit's standard error, {:.3e} {}, \
+             is above a third of the value); the other fitted fields' covariance is conditioned on it",
+            h.path, h.tolerance, h.unit, h.std_error, h.unit
+        ));
+        if h.shift > HELD_SHIFT_WARN {
+            notes.push(format!(
+                "WARNING: {}: the fitted value {} lies {:.2} standard errors from the base file's {}: the written \
+                 band assumes a value the base file does not support",
+                h.path, h.value, h.shift, h.base_value
+            ));
+        }
+    }
     Ok(Output {
         table: cal.table(),
         notes,

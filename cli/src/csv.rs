@@ -4,10 +4,13 @@
 /// A CSV table built in memory and printed only when complete, so that a
 /// failure half-way leaves standard output empty.
 ///
-/// A row that could not be computed ([`Table::row_error`]) keeps its
-/// leading cells (the temperature, say), leaves the others empty and says
-/// why in a last column `error`, which the table gains with its first
-/// such row (a table without failures has no `error` column).
+/// A table whose rows can fail ([`Table::new`]) ends with an `error`
+/// column, empty where the row was computed: a row that could not be
+/// ([`Table::row_error`]) keeps its leading cells (the temperature, say),
+/// leaves the others empty and says why there. The header is the same
+/// whether rows fail or not. A table whose rows cannot fail one by one
+/// (a time series: the run fails whole) has no such column
+/// ([`Table::complete`]).
 #[derive(Debug, Default, Clone)]
 pub struct Table {
     text: String,
@@ -37,8 +40,17 @@ pub fn error_cell(message: &str) -> String {
 }
 
 impl Table {
-    /// A table with the given header.
+    /// A table with the given header and an `error` column after it.
     pub fn new(header: &[&str]) -> Self {
+        let mut t = Table::complete(header);
+        t.has_error = true;
+        t.text.insert_str(t.text.len() - 1, &format!(",{ERROR_COLUMN}"));
+        t
+    }
+
+    /// A table with the given header and no `error` column: every row is
+    /// computed or the command fails.
+    pub fn complete(header: &[&str]) -> Self {
         let mut t = Table {
             text: String::new(),
             columns: header.len(),
@@ -78,29 +90,25 @@ impl Table {
 
     /// Appends a row that could not be computed: its first cells `leading`
     /// (e.g. the temperature), empty cells for the rest, and `message` in
-    /// the `error` column (added to the header and to the rows so far
-    /// with this first failure).
+    /// the `error` column (a table made by [`Table::complete`] has none:
+    /// a bug, caught in debug builds; the message then goes in the last cell).
     pub fn row_error(&mut self, leading: &[f64], message: &str) {
         debug_assert!(leading.len() <= self.columns);
-        if !self.has_error {
-            self.has_error = true;
-            let mut text = String::with_capacity(self.text.len() + 16);
-            for (i, line) in self.text.lines().enumerate() {
-                text.push_str(line);
-                text.push_str(if i == 0 { ",error\n" } else { ",\n" });
-            }
-            self.text = text;
-        }
+        debug_assert!(self.has_error, "row_error on a table without an error column");
         let mut cells: Vec<String> = leading.iter().map(|v| format!("{v}")).collect();
         cells.resize(self.columns, String::new());
-        cells.push(error_cell(message));
+        if self.has_error {
+            cells.push(error_cell(message));
+        } else if let Some(last) = cells.last_mut() {
+            *last = error_cell(message);
+        }
         self.text.push_str(&cells.join(","));
         self.text.push('\n');
     }
 
     /// Whether some row could not be computed.
     pub fn has_errors(&self) -> bool {
-        self.has_error
+        failed_rows(&self.text).0 > 0
     }
 
     /// The CSV text.
@@ -240,8 +248,8 @@ fn read(text: &str, finite_only: bool, wanted: Option<&[&str]>) -> Result<Numeri
             .iter()
             .zip(&out.header)
             .zip(&parsed_column)
-            .map(|((cell, name), &wanted)| {
-                if !wanted {
+            .map(|((cell, name), &parse)| {
+                if !parse {
                     return Ok(f64::NAN);
                 }
                 let parsed = cell.parse::<f64>().or_else(|e| {
@@ -252,6 +260,11 @@ fn read(text: &str, finite_only: bool, wanted: Option<&[&str]>) -> Result<Numeri
                     }
                 });
                 match parsed {
+                    Ok(v) if wanted.is_some() && v.is_finite() => match crate::data::column(name) {
+                        Some(col) => crate::data::check(col, v, &format!("row {row_no} (line {line}), column {name}"))
+                            .map(|()| v),
+                        None => Ok(v),
+                    },
                     Ok(v) if v.is_finite() || !finite_only => Ok(v),
                     Ok(_) => Err(format!(
                         "row {row_no} (line {line}), column {name}: '{cell}' is not a finite number"
@@ -285,7 +298,8 @@ pub enum Format {
     Csv,
     /// A JSON array of objects, one per row, keyed by column name.
     Json,
-    /// Right-aligned columns separated by two spaces.
+    /// Aligned columns for reading, each number rounded to what its
+    /// quantity resolves (csv and json keep every digit).
     Table,
 }
 
@@ -363,19 +377,7 @@ pub fn render(text: &str, format: Format) -> String {
         }
         Format::Table => {
             let (header, rows) = cells(text);
-            let mut width: Vec<usize> = header.iter().map(|h| h.len()).collect();
-            for row in &rows {
-                for (w, c) in width.iter_mut().zip(row) {
-                    *w = (*w).max(c.len());
-                }
-            }
-            let mut out = String::new();
-            for row in std::iter::once(&header).chain(&rows) {
-                let line: Vec<String> = row.iter().zip(&width).map(|(c, w)| format!("{c:>w$}")).collect();
-                out.push_str(&line.join("  "));
-                out.push('\n');
-            }
-            out
+            crate::display::table(&header, &rows)
         }
     }
 }

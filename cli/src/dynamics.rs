@@ -2,8 +2,8 @@
 //! step-response indicators of the paper's Table 3.
 
 use crate::csv::Table;
-use crate::error::{CliError, load_params};
-use crate::temps;
+use crate::error::CliError;
+use crate::input::load_params;
 use compensator::ModelError;
 use compensator::dynamics::config::{Choice, TARGET_PCT, choose};
 use compensator::dynamics::linear::linearise;
@@ -298,6 +298,10 @@ pub fn resolve_config(
 pub struct StepOutput {
     /// CSV `time_s,x_m,v_m_s,p_a_pa,p_b_pa`.
     pub csv: String,
+    /// What the command prints: CSV
+    /// `time_s,t_c,x_m,v_m_s,p_a_pa,p_b_pa,envelope` (the temperature each
+    /// tick ran at, and its zone of the file's envelope).
+    pub table: String,
     /// The configuration used, in one line.
     pub note: String,
 }
@@ -317,8 +321,10 @@ pub fn step(
     scheme: Option<Scheme>,
     substeps: Option<u8>,
 ) -> Result<StepOutput, CliError> {
-    let (raw, _) = load_params::<f64>(path)?;
+    let (raw, _, env) = crate::input::load_with_envelope(path)?;
     let prof = profile(from, to, ramp)?;
+    env.check(from, "--from")?;
+    env.check(to, "--to")?;
     let n = tick_count(t_end.unwrap_or_else(|| default_t_end(&prof)), dt)?;
     check_substeps(substeps)?;
     let (config, note) = if precision == Precision::Reference {
@@ -351,12 +357,22 @@ pub fn step(
         (config, format!("{model}: {line}"))
     };
     let r = simulate(&raw, precision, config, &prof, n)?;
-    let mut table = Table::new(&["time_s", "x_m", "v_m_s", "p_a_pa", "p_b_pa"]);
+    let mut table = Table::complete(&["time_s", "x_m", "v_m_s", "p_a_pa", "p_b_pa"]);
+    let mut with_t = Table::complete(&["time_s", "t_c", "x_m", "v_m_s", "p_a_pa", "p_b_pa"]);
     for (t, s) in r.time.iter().zip(&r.state) {
+        // The temperature the tick that ended here ran at (its midpoint,
+        // as `run` sets it), the start's at t = 0: what `identify` reads.
+        let t_c = if *t == 0.0 {
+            prof.start()
+        } else {
+            prof.temperature(*t - 0.5 * dt)
+        };
         table.row(&[*t, s.x, s.v, s.p_a, s.p_b]);
+        with_t.row(&[*t, t_c, s.x, s.v, s.p_a, s.p_b]);
     }
     Ok(StepOutput {
         csv: table.as_str().to_string(),
+        table: env.mark(with_t.as_str(), &["t_c"]),
         note,
     })
 }
@@ -385,15 +401,17 @@ pub fn twin_config(path: &Path, dt: f64) -> Result<String, CliError> {
 
 /// `eigen`: eigenvalues of the linearisation per temperature.
 pub fn eigen(path: &Path, temps_spec: &str) -> Result<String, CliError> {
-    let temps = temps::parse(temps_spec)?;
-    let (_, p) = load_params::<f64>(path)?;
-    Ok(eigen_table(&p, &temps).as_str().to_string())
+    let (_, p, env) = crate::input::load_with_envelope(path)?;
+    let temps: Vec<f64> = env.temps(temps_spec)?.into_iter().map(|(t, _)| t).collect();
+    Ok(env.mark(eigen_table(&p, &temps).as_str(), &["t_c"]))
 }
 
 /// The `eigen` table of a parameter set at `temps` [C]: eigenvalues
-/// [1/s] of the linearisation (Eq. 37), the dominant pair's damping ratio
-/// and natural frequency [rad/s]; a temperature the model cannot evaluate
-/// gets an `error` cell.
+/// [1/s] of the linearisation (Eq. 37), the dominant mode's damping ratio
+/// and natural frequency [rad/s] (1 and |lambda| for a real mode), and
+/// the plunger's damping ratio with the chambers' hydraulic damping,
+/// `(b + b_hyd) / (2 sqrt(c m))` (above 1: overdamped); a temperature the
+/// model cannot evaluate gets an `error` cell.
 pub fn eigen_table(p: &Params<f64>, temps: &[f64]) -> Table {
     let mut table = Table::new(&[
         "t_c",
@@ -407,6 +425,7 @@ pub fn eigen_table(p: &Params<f64>, temps: &[f64]) -> Table {
         "im_4",
         "zeta_dominant",
         "omega_n_dominant",
+        "zeta_plunger",
     ]);
     for &t in temps {
         let l = match linearise(p, t) {
@@ -423,6 +442,7 @@ pub fn eigen_table(p: &Params<f64>, temps: &[f64]) -> Table {
         }
         row.push(l.damping_ratio[0]);
         row.push(l.natural_frequency[0]);
+        row.push(l.plunger_damping_ratio);
         table.row(&row);
     }
     table
@@ -514,8 +534,11 @@ pub fn parse_steps(spec: &str) -> Result<Vec<(f64, f64)>, CliError> {
 
 /// `indicators`: the Table 3 columns per step.
 pub fn indicators(path: &Path, steps_spec: &str, dt: f64, t_end: f64) -> Result<String, CliError> {
-    let (raw, p) = load_params::<f64>(path)?;
+    let (raw, p, env) = crate::input::load_with_envelope(path)?;
     let steps = parse_steps(steps_spec)?;
+    for (from, to) in &steps {
+        env.check_all(&[*from, *to], "--steps")?;
+    }
     tick_count(t_end, dt)?;
     let mut table = Table::new(&[
         "from_c",
@@ -542,7 +565,7 @@ pub fn indicators(path: &Path, steps_spec: &str, dt: f64, t_end: f64) -> Result<
             ind.dominant_re,
         ]);
     }
-    Ok(table.as_str().to_string())
+    Ok(env.mark(table.as_str(), &["from_c", "to_c"]))
 }
 
 /// Ticks per output row for `step --sample S` at tick `dt`: round(S / dt),

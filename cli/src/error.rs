@@ -1,13 +1,12 @@
-//! A command's failure and the exit status it maps to, with the helpers
-//! every command uses to turn bad input into one: loading a parameter file.
-//! (A temperature the model cannot evaluate is not bad input: the tables
-//! give its row an `error` cell, `crate::csv::Table::row_error`.)
+//! A command's failure and the exit status it maps to: bad input (exit
+//! status 2) or a computation that failed (1). The library's errors that
+//! are bad input convert into it. (This module depends on no other of the
+//! crate but the error types it converts; reading files is
+//! [`crate::input`]'s.)
 
 use crate::params_file::LoadError;
 use crate::temps;
-use compensator::{Float, Params, RawParams};
 use std::fmt;
-use std::path::Path;
 
 /// A command's failure: bad input (exit status 2) or a computation that
 /// could not be completed (exit status 1). `Display` is one line.
@@ -47,11 +46,4 @@ impl From<temps::TempsError> for CliError {
     fn from(e: temps::TempsError) -> Self {
         CliError::Input(e.to_string())
     }
-}
-
-/// Loads a parameter file (`-`: standard input) and converts it to `T`.
-pub fn load_params<T: Float>(path: &Path) -> Result<(RawParams, Params<T>), CliError> {
-    let raw = crate::input::load_raw(path, "--params")?;
-    let params = Params::<T>::new(&raw).map_err(|e| CliError::Input(e.to_string()))?;
-    Ok((raw, params))
 }

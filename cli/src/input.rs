@@ -4,7 +4,7 @@
 
 use crate::error::CliError;
 use crate::params_file;
-use compensator::RawParams;
+use compensator::{Float, Params, RawParams};
 use std::io::Read;
 use std::path::Path;
 
@@ -31,15 +31,32 @@ pub const PAPER_DISPLACEMENT_PATH: &str = "data/calibration/paper-displacement.c
 /// `calibrate --displacement-data`, built in.
 pub const PAPER_DISPLACEMENT_CSV: &str = include_str!("../../data/calibration/paper-displacement.csv");
 
-/// Reads at most `MAX_PARAMS_BYTES` from `r`; more is bad input of `flag`.
-fn read_bounded(r: impl Read, flag: &str, what: &str) -> Result<String, CliError> {
+/// Largest sensor log `estimate --sensor-data` reads [bytes]: 64 MiB (a
+/// day of telemetry at 2 Hz is 45 MB; a log at 50 Hz of one reading per
+/// line, 20 bytes a line, is 3.4 million lines, beyond
+/// [`crate::estimate::MAX_ROWS`] first).
+pub const MAX_LOG_BYTES: u64 = 64 << 20;
+
+/// `limit` bytes in words: `1 MiB`, `64 MiB`, or the count.
+fn bytes_in_words(limit: u64) -> String {
+    if limit >= 1 << 20 && limit.is_multiple_of(1 << 20) {
+        format!("{} MiB", limit >> 20)
+    } else {
+        format!("{limit} bytes")
+    }
+}
+
+/// Reads at most `limit` bytes from `r`; more is bad input of `flag`
+/// (with `advice` after the limit).
+fn read_bounded(r: impl Read, flag: &str, what: &str, limit: u64, advice: &str) -> Result<String, CliError> {
     let mut buf = Vec::new();
-    r.take(MAX_PARAMS_BYTES + 1)
+    r.take(limit + 1)
         .read_to_end(&mut buf)
         .map_err(|e| CliError::Input(format!("{flag}: {what}: {e}")))?;
-    if buf.len() as u64 > MAX_PARAMS_BYTES {
+    if buf.len() as u64 > limit {
         return Err(CliError::Input(format!(
-            "{flag}: {what}: larger than the limit of {MAX_PARAMS_BYTES} bytes"
+            "{flag}: {what}: larger than the limit of {}{advice}",
+            bytes_in_words(limit)
         )));
     }
     String::from_utf8(buf).map_err(|_| CliError::Input(format!("{flag}: {what}: not UTF-8 text")))
@@ -50,29 +67,65 @@ fn read_bounded(r: impl Read, flag: &str, what: &str) -> Result<String, CliError
 /// before opening, so that `/dev/zero` or a FIFO without a writer is
 /// refused rather than read without end or waited on).
 pub fn params_text(path: &Path, flag: &str) -> Result<String, CliError> {
+    bounded_text(path, flag, MAX_PARAMS_BYTES, "")
+}
+
+/// The text of a file given to `flag`, as [`params_text`] with the limit
+/// `limit` [bytes]; a larger file's message ends with `advice` (`: split
+/// the log`).
+pub fn bounded_text(path: &Path, flag: &str, limit: u64, advice: &str) -> Result<String, CliError> {
     if path.as_os_str() == "-" {
-        return read_bounded(std::io::stdin().lock(), flag, "standard input");
+        return read_bounded(std::io::stdin().lock(), flag, "standard input", limit, advice);
     }
     let shown = path.display();
     let meta = match std::fs::metadata(path) {
         Ok(m) => m,
         // The loader's own message for a file that cannot be read.
-        Err(e) => return Err(params_file::LoadError::Io(shown.to_string(), e).into()),
+        Err(e) => {
+            return Err(CliError::Input(format!(
+                "{flag}: {}",
+                params_file::LoadError::Io(shown.to_string(), e)
+            )));
+        }
     };
     if !meta.is_file() {
         return Err(CliError::Input(format!("{flag}: {shown}: not a regular file")));
     }
-    if meta.len() > MAX_PARAMS_BYTES {
+    if meta.len() > limit {
         return Err(CliError::Input(format!(
-            "{flag}: {shown}: {} bytes, larger than the limit of {MAX_PARAMS_BYTES} bytes",
-            meta.len()
+            "{flag}: {shown}: {} bytes, larger than the limit of {}{advice}",
+            meta.len(),
+            bytes_in_words(limit)
         )));
     }
     let file = std::fs::File::open(path).map_err(|e| params_file::LoadError::Io(shown.to_string(), e))?;
-    read_bounded(file, flag, &shown.to_string())
+    read_bounded(file, flag, &shown.to_string(), limit, advice)
 }
 
 /// Reads and validates the parameter file given to `flag` (see [`params_text`]).
 pub fn load_raw(path: &Path, flag: &str) -> Result<RawParams, CliError> {
     Ok(params_file::parse(&params_text(path, flag)?)?)
+}
+
+/// Loads a parameter file given to `--params` (`-`: standard input) and
+/// converts it to `T`.
+///
+/// # Errors
+///
+/// As [`load_raw`]; a set the model refuses in `T` (naming the field).
+pub fn load_params<T: Float>(path: &Path) -> Result<(RawParams, Params<T>), CliError> {
+    let raw = load_raw(path, "--params")?;
+    let params = Params::<T>::new(&raw).map_err(|e| CliError::Input(e.to_string()))?;
+    Ok((raw, params))
+}
+
+/// [`load_params`] in `f64` with the file's temperature envelope.
+///
+/// # Errors
+///
+/// As [`load_params`].
+pub fn load_with_envelope(path: &Path) -> Result<(RawParams, Params<f64>, crate::envelope::Envelope), CliError> {
+    let (raw, p) = load_params::<f64>(path)?;
+    let env = crate::envelope::Envelope::of(&raw, &p);
+    Ok((raw, p, env))
 }

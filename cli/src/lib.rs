@@ -4,7 +4,7 @@
 //! * commands: [`statics`] (equilibrium, asymptotic, sensitivity),
 //!   [`dynamics`] (step, twin-config, eigen, indicators), [`sizing`]
 //!   (compensation, size), [`calibration`] (calibrate), [`identify`]
-//!   (identify), [`paper`] (the paper report, with the paper's tables in
+//!   (identify), [`estimate`] (the firmware's estimator over a probe log), [`paper`] (the paper report, with the paper's tables in
 //!   [`paper::tables`]), [`report`] (the paper's tables and figures as
 //!   files) and [`sweep`] (design variants on a grid or within tolerances);
 //! * their plumbing: [`error`] (a command's failure and exit status,
@@ -12,16 +12,30 @@
 //!   the built-in presets and paper data), [`temps`] (temperature lists), [`csv`] (output),
 //!   [`units`] (`--units si|eng`), [`plot`] (`--plot FILE.svg|FILE.png`: a
 //!   command's output as a figure),
-//!   [`lsq`] (least squares with standard errors, for calibrate and identify).
+//!   [`lsq`] (least squares with standard errors, for calibrate and identify),
+//!   [`data`] (the measured data columns and their plausible ranges),
+//!   [`envelope`] (the temperatures a file's model takes, checked on every
+//!   command), [`display`] (rounding for people: `--format table`, messages).
 //!
-//! Each command is a function returning its complete standard output; the
-//! binary (`src/main.rs`) is a thin argument parser over them, so that the
-//! tests can call the same code.
+//! * the command line: [`commands`] (one module per command: its clap
+//!   `Args` and `run`), [`args`] (the arguments several commands share,
+//!   declared once), [`app`] (parsing, the one error path, writing the
+//!   output); `src/main.rs` calls [`app::main`].
+//!
+//! Each computation is a function returning its complete output, so that
+//! the tests can call the same code as the binary.
 
+pub mod app;
+pub mod args;
 pub mod calibration;
+pub mod commands;
 pub mod csv;
+pub mod data;
+pub mod display;
 pub mod dynamics;
+pub mod envelope;
 pub mod error;
+pub mod estimate;
 pub mod identify;
 pub mod input;
 pub mod lsq;

@@ -36,6 +36,10 @@ pub struct Series {
     /// Colour index (default: the series' place in its panel), so that a
     /// curve and its data points can share one.
     pub color: Option<usize>,
+    /// A band shaded in the series' colour behind its line: (x, low, high)
+    /// points (an uncertainty band; empty: none). Non-finite ones are
+    /// skipped.
+    pub band: Vec<(f64, f64, f64)>,
 }
 
 impl Series {
@@ -48,6 +52,7 @@ impl Series {
             marks: false,
             line: true,
             color: None,
+            band: Vec::new(),
         }
     }
 
@@ -60,6 +65,7 @@ impl Series {
             marks: true,
             line: false,
             color: None,
+            band: Vec::new(),
         }
     }
 }
@@ -155,6 +161,17 @@ fn finite(points: &[(f64, f64)], log_y: bool) -> Vec<(f64, f64)> {
         .copied()
         .filter(|(x, y)| x.is_finite() && y.is_finite() && (!log_y || *y > 0.0))
         .collect()
+}
+
+/// The outline of a band, its upper edge left to right and its lower edge
+/// back, each thinned as a curve ([`thin`]); a stretch of non-finite
+/// points is skipped.
+fn band_polygon(band: &[(f64, f64, f64)], log_y: bool) -> Vec<(f64, f64)> {
+    let ok =
+        |&&(x, lo, hi): &&(f64, f64, f64)| x.is_finite() && lo.is_finite() && hi.is_finite() && (!log_y || lo > 0.0);
+    let upper = thin(band.iter().filter(ok).map(|&(x, _, hi)| (x, hi)).collect());
+    let lower = thin(band.iter().filter(ok).map(|&(x, lo, _)| (x, lo)).collect());
+    upper.into_iter().chain(lower.into_iter().rev()).collect()
 }
 
 /// Points per curve beyond which a curve is thinned.
@@ -310,6 +327,13 @@ where
     }
     for (i, s) in panel.series.iter().enumerate() {
         let color = COLORS[s.color.unwrap_or(i) % COLORS.len()];
+        let band = band_polygon(&s.band, panel.log_y);
+        if band.len() >= 3 {
+            chart.draw_series(std::iter::once(Polygon::new(band, color.mix(0.22).filled())))?;
+        }
+    }
+    for (i, s) in panel.series.iter().enumerate() {
+        let color = COLORS[s.color.unwrap_or(i) % COLORS.len()];
         let style = color.stroke_width(2);
         let points = thin(finite(&s.points, panel.log_y));
         if !s.line {
@@ -423,7 +447,16 @@ where
             panel
                 .series
                 .iter()
-                .flat_map(|s| finite(&s.points, panel.log_y))
+                .flat_map(|s| {
+                    let band = s
+                        .band
+                        .iter()
+                        .flat_map(|&(x, lo, hi)| [(x, lo), (x, hi)])
+                        .collect::<Vec<_>>();
+                    finite(&s.points, panel.log_y)
+                        .into_iter()
+                        .chain(finite(&band, panel.log_y))
+                })
                 .map(|p| p.1)
         };
         let (lo, mut hi) = padded(ys(), panel.log_y);
@@ -472,12 +505,13 @@ struct Columns {
 }
 
 impl Columns {
-    /// The numeric columns of a command's CSV output; the `error` column
-    /// is dropped and an empty cell (a row that could not be computed) is
+    /// The numeric columns of a command's CSV output; the `error` and
+    /// `envelope` columns are dropped and an empty cell (a row that could not be computed) is
     /// NaN, which the curves skip.
     fn parse(text: &str) -> Result<Self, CliError> {
         let (header, rows) = csv::cells(text);
-        let keep: Vec<usize> = (0..header.len()).filter(|&i| header[i] != csv::ERROR_COLUMN).collect();
+        let text = [csv::ERROR_COLUMN, crate::envelope::ENVELOPE_COLUMN];
+        let keep: Vec<usize> = (0..header.len()).filter(|&i| !text.contains(&header[i])).collect();
         let rows = rows
             .iter()
             .enumerate()
@@ -518,6 +552,7 @@ impl Columns {
             marks: self.rows.len() <= 30,
             line: true,
             color: None,
+            band: Vec::new(),
         })
     }
 }
@@ -605,6 +640,7 @@ pub fn asymptotic(csv: &str, order: usize, u: Units) -> Result<Figure, CliError>
         marks: qs.marks,
         line: true,
         color: None,
+        band: Vec::new(),
     };
     Ok(Figure {
         title: format!("Asymptotic displacement (order {order}) and the quasi-static one"),
@@ -677,7 +713,10 @@ pub fn eigen(csv: &str) -> Result<Figure, CliError> {
             panel("oscillation Im(lambda) [rad/s]", im),
             panel(
                 "damping ratio [-]",
-                vec![c.series("t_c", "zeta_dominant", ONE, "zeta, dominant mode")?],
+                vec![
+                    c.series("t_c", "zeta_plunger", ONE, "zeta, plunger with hydraulic damping")?,
+                    c.series("t_c", "zeta_dominant", ONE, "zeta, dominant mode")?,
+                ],
             ),
         ],
     })
@@ -708,6 +747,61 @@ pub fn compensation(csv: &str, u: Units) -> Result<Figure, CliError> {
                 &desc("x", len),
                 vec![c.series("t_c", "x_m", len, "spool displacement x")?, required],
             ),
+        ],
+    })
+}
+
+/// Coverage factor of the bands `estimate` draws: 1.96 standard
+/// uncertainties, the 95 % interval of a normal error (GUM 6.2).
+pub const BAND_K: f64 = 1.96;
+
+/// `estimate`: over time, the probe's reading and the estimated oil
+/// temperature with its band, and the displacement with its band (clipped
+/// to the plunger's travel `0..=stroke` [m], where the true displacement
+/// lies: `docs/firmware.md`, reading the band).
+pub fn estimate(csv: &str, stroke: f64, title: &str, u: Units) -> Result<Figure, CliError> {
+    let c = Columns::parse(csv)?;
+    let len = u.length();
+    let time = c.col("time_s")?;
+    let band = |y: &str, sd: &str, scale: Scale, clip: (f64, f64)| -> Result<Vec<(f64, f64, f64)>, CliError> {
+        let (y, sd) = (c.col(y)?, c.col(sd)?);
+        Ok(time
+            .iter()
+            .zip(y.iter().zip(&sd))
+            .map(|(&t, (&v, &s))| {
+                let (lo, hi) = ((v - BAND_K * s).max(clip.0), (v + BAND_K * s).min(clip.1));
+                (t, scale.apply(lo), scale.apply(hi))
+            })
+            .collect())
+    };
+    let plain = |mut s: Series| {
+        s.marks = false;
+        s
+    };
+    let reading = plain(c.series("time_s", "t_probe_c", ONE, "probe reading")?);
+    let oil = Series {
+        band: band("t_oil_c", "t_oil_sd_c", ONE, (f64::NEG_INFINITY, f64::INFINITY))?,
+        ..plain(c.series("time_s", "t_oil_c", ONE, "oil, estimated (band: +-1.96 u, 95 %)")?)
+    };
+    let x = Series {
+        band: band("x_m", "x_sd_m", len, (0.0, stroke))?,
+        ..plain(c.series("time_s", "x_m", len, "x, estimated (band: +-1.96 u within the stroke)")?)
+    };
+    Ok(Figure {
+        title: title.to_string(),
+        x_desc: "time [s]".into(),
+        panels: vec![
+            panel(
+                "temperature [C]",
+                vec![
+                    Series {
+                        color: Some(1),
+                        ..reading
+                    },
+                    Series { color: Some(0), ..oil },
+                ],
+            ),
+            panel(&desc("x", len), vec![x]),
         ],
     })
 }

@@ -12,7 +12,8 @@
 
 use crate::csv::{self, Table};
 use crate::dynamics::{Precision, eigen_table, simulate, step_indicators};
-use crate::error::{CliError, load_params};
+use crate::error::CliError;
+use crate::input::load_params;
 use crate::paper::tables::{BAR, load_tables, table1_residuals, table2_residuals};
 use crate::paper::{self, asymptotic_search};
 use crate::plot::{self, Figure, Series, panel};
@@ -151,7 +152,7 @@ fn markdown(csv_text: &str) -> String {
 }
 
 fn write_file(path: &Path, text: &str) -> Result<(), CliError> {
-    std::fs::write(path, text).map_err(|e| CliError::Input(format!("--out: {}: {e}", path.display())))
+    std::fs::write(path, text).map_err(|e| CliError::Input(format!("--dir: {}: {e}", path.display())))
 }
 
 /// A sampled response: times [s] and displacements [m].
@@ -181,7 +182,7 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
     let (raw, p) = load(opts.params)?;
     let (t1, t2) = load_tables(opts.data).map_err(CliError::Input)?;
     let t3 = Table3::load(opts.data).map_err(CliError::Input)?;
-    std::fs::create_dir_all(opts.out).map_err(|e| CliError::Input(format!("--out: {}: {e}", opts.out.display())))?;
+    std::fs::create_dir_all(opts.out).map_err(|e| CliError::Input(format!("--dir: {}: {e}", opts.out.display())))?;
     let mut written: Vec<PathBuf> = Vec::new();
     let shown = opts
         .params
@@ -455,12 +456,12 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
     let mut figure_links = String::new();
     for (name, caption, fig) in &figures {
         let svg = opts.out.join(format!("{name}.svg"));
-        plot::write(&svg, fig).map_err(|e| CliError::Input(e.to_string().replace("--plot", "--out")))?;
+        plot::write(&svg, fig).map_err(|e| CliError::Input(e.to_string().replace("--plot", "--dir")))?;
         written.push(svg);
         let _ = write!(figure_links, "\n{caption}.\n\n![{name}]({name}.svg)");
         if opts.png {
             let png = opts.out.join(format!("{name}.png"));
-            plot::write(&png, fig).map_err(|e| CliError::Input(e.to_string().replace("--plot", "--out")))?;
+            plot::write(&png, fig).map_err(|e| CliError::Input(e.to_string().replace("--plot", "--dir")))?;
             written.push(png);
             let _ = write!(figure_links, " ([PNG]({name}.png))");
         }
@@ -477,7 +478,7 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
     let _ = writeln!(
         md,
         "Parameters: {shown}. Tables in {units_note}; each model value beside the paper's. \
-         Regenerate with `compensator report --out DIR{}{}`.\n",
+         Regenerate with `compensator report --dir DIR{}{}`.\n",
         opts.params
             .map_or(String::new(), |p| format!(" --params {}", p.display())),
         match (u, opts.png) {

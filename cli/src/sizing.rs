@@ -14,8 +14,8 @@
 //! error per temperature) and [`size`] (`size`: either fit, as TOML).
 
 use crate::csv::Table;
-use crate::error::{CliError, load_params};
-use crate::{params_file, temps};
+use crate::error::CliError;
+use crate::params_file;
 use compensator::Params;
 use compensator::compensation::compensation;
 use compensator::equilibrium::equilibrium;
@@ -143,15 +143,15 @@ pub fn fit_slot(p: &Params<f64>, temps: &[f64]) -> Result<Fit, String> {
 
 /// `compensation`: demand, supply, error and the Eq. (9) window per temperature.
 pub fn compensation_table(path: &Path, temps_spec: &str) -> Result<String, CliError> {
-    let temps = temps::parse(temps_spec)?;
-    let (_, p) = load_params::<f64>(path)?;
+    let (_, p, env) = crate::input::load_with_envelope(path)?;
+    let temps: Vec<f64> = env.temps(temps_spec)?.into_iter().map(|(t, _)| t).collect();
     if p.machine.is_none() {
         return Err(CliError::Input(format!(
             "{}: no [machine] section (see `compensator size --for machine`)",
             path.display()
         )));
     }
-    Ok(compensation_of(&p, &temps).as_str().to_string())
+    Ok(env.mark(compensation_of(&p, &temps).as_str(), &["t_c"]))
 }
 
 /// The `compensation` table of a parameter set with a `[machine]` at
@@ -203,8 +203,9 @@ fn finite(quantities: &[(&str, f64)]) -> Result<(), CliError> {
 
 /// `size`: the machine a compensator serves best, or the window a machine needs.
 pub fn size(path: &Path, what: &str, temps_spec: &str, reference: f64) -> Result<String, CliError> {
-    let temps = temps::parse(temps_spec)?;
-    let (_, p) = load_params::<f64>(path)?;
+    let (_, p, env) = crate::input::load_with_envelope(path)?;
+    let temps: Vec<f64> = env.temps(temps_spec)?.into_iter().map(|(t, _)| t).collect();
+    env.check(reference, "--reference")?;
     let mut o = String::new();
     match what {
         "machine" => {

@@ -5,8 +5,9 @@
 //! with an `error` cell instead of failing the whole table.
 
 use crate::csv::Table;
-use crate::error::{CliError, load_params};
-use crate::temps;
+use crate::envelope::Envelope;
+use crate::error::CliError;
+use crate::input::load_with_envelope;
 use compensator::asymptotic::{Expansion, Reading, sensitivity as sens};
 use compensator::equilibrium::{self as eq, balance_temperature};
 use compensator::{Params, RawParams};
@@ -19,8 +20,9 @@ fn widen(v: f32) -> f64 {
 }
 
 /// `equilibrium`: the quasi-static operating point per temperature.
-pub fn equilibrium_table(path: &Path, temps_spec: &str, single: bool) -> Result<Table, CliError> {
-    let temps = temps::parse(temps_spec)?;
+pub fn equilibrium_table(path: &Path, temps_spec: &str, single: bool) -> Result<(Table, Envelope), CliError> {
+    let (raw, p64, env) = load_with_envelope(path)?;
+    let temps: Vec<f64> = env.temps(temps_spec)?.into_iter().map(|(t, _)| t).collect();
     let mut table = Table::new(&[
         "t_c",
         "a_sqrt_pa",
@@ -31,9 +33,10 @@ pub fn equilibrium_table(path: &Path, temps_spec: &str, single: bool) -> Result<
         "q_branch_m3s",
         "q_throt_m3s",
         "q_total_m3s",
+        "nu_m2s",
     ]);
     if single {
-        let (_, p) = load_params::<f32>(path)?;
+        let p = Params::<f32>::new(&raw).map_err(|e| CliError::Input(e.to_string()))?;
         for &t in &temps {
             let e = match eq::equilibrium(&p, t as f32) {
                 Ok(e) => e,
@@ -52,10 +55,11 @@ pub fn equilibrium_table(path: &Path, temps_spec: &str, single: bool) -> Result<
                 widen(e.q_branch),
                 widen(e.q_throt),
                 widen(e.q_total),
+                widen(e.fluid.kinematic_viscosity),
             ]);
         }
     } else {
-        let (_, p) = load_params::<f64>(path)?;
+        let p = p64;
         for &t in &temps {
             let e = match eq::equilibrium(&p, t) {
                 Ok(e) => e,
@@ -64,15 +68,27 @@ pub fn equilibrium_table(path: &Path, temps_spec: &str, single: bool) -> Result<
                     continue;
                 }
             };
-            table.row(&[t, e.a, e.p_a, e.p_b, e.dp_ab, e.x, e.q_branch, e.q_throt, e.q_total]);
+            table.row(&[
+                t,
+                e.a,
+                e.p_a,
+                e.p_b,
+                e.dp_ab,
+                e.x,
+                e.q_branch,
+                e.q_throt,
+                e.q_total,
+                e.fluid.kinematic_viscosity,
+            ]);
         }
     }
-    Ok(table)
+    Ok((table, env))
 }
 
 /// `equilibrium` as text.
 pub fn equilibrium(path: &Path, temps_spec: &str, single: bool) -> Result<String, CliError> {
-    Ok(equilibrium_table(path, temps_spec, single)?.as_str().to_string())
+    let (table, env) = equilibrium_table(path, temps_spec, single)?;
+    Ok(env.mark(table.as_str(), &["t_c"]))
 }
 
 /// Balance temperature (Eq. 2) searched over the estimator's oil range:
@@ -108,8 +124,8 @@ pub fn find_balance(raw: &RawParams, p: &Params<f64>) -> Result<f64, CliError> {
 
 /// `asymptotic`: quasi-static and series displacement per temperature.
 pub fn asymptotic(path: &Path, order: usize, reading: Reading, t0: &str, temps_spec: &str) -> Result<String, CliError> {
-    let temps = temps::parse(temps_spec)?;
-    let (raw, p) = load_params::<f64>(path)?;
+    let (raw, p, env) = load_with_envelope(path)?;
+    let temps: Vec<f64> = env.temps(temps_spec)?.into_iter().map(|(t, _)| t).collect();
     let t0 = if t0.trim() == "balance" {
         find_balance(&raw, &p)?
     } else {
@@ -120,6 +136,7 @@ pub fn asymptotic(path: &Path, order: usize, reading: Reading, t0: &str, temps_s
         if !v.is_finite() {
             return Err(CliError::Input(format!("--t0: '{t0}' is not finite")));
         }
+        env.check(v, "--t0")?;
         v
     };
     let e = Expansion::new(&p, t0, reading).map_err(|e| CliError::Input(format!("--t0: {t0} C: {e}")))?;
@@ -130,14 +147,14 @@ pub fn asymptotic(path: &Path, order: usize, reading: Reading, t0: &str, temps_s
             Err(e) => table.row_error(&[t], &e.to_string()),
         }
     }
-    Ok(table.as_str().to_string())
+    Ok(env.mark(table.as_str(), &["t_c"]))
 }
 
 /// `sensitivity`: Eqs. (30)-(31) per temperature, then the Eq. (32)
 /// verdict over the listed range as a trailing comment line.
 pub fn sensitivity(path: &Path, temps_spec: &str) -> Result<String, CliError> {
-    let temps = temps::parse(temps_spec)?;
-    let (_, p) = load_params::<f64>(path)?;
+    let (_, p, env) = load_with_envelope(path)?;
+    let temps: Vec<f64> = env.temps(temps_spec)?.into_iter().map(|(t, _)| t).collect();
     let mut table = Table::new(&["t_c", "dx_dt_branch_m_k", "dx_dt_m_k", "dq_throt_dt_m3s_k"]);
     for &t in &temps {
         match sens(&p, t) {
@@ -145,5 +162,5 @@ pub fn sensitivity(path: &Path, temps_spec: &str) -> Result<String, CliError> {
             Err(e) => table.row_error(&[t], &e.to_string()),
         }
     }
-    Ok(table.as_str().to_string())
+    Ok(env.mark(table.as_str(), &["t_c"]))
 }

@@ -23,50 +23,46 @@
 //! value outside its field's plausible range, a design whose equilibrium
 //! fails) keeps its parameter values and says why in the `error` column.
 
-use crate::csv::Table;
 use crate::dynamics::{parse_steps, step_indicators, tick_count};
 use crate::error::CliError;
 use crate::temps;
-use compensator::asymptotic::monotonicity;
 use compensator::compensation::compensation;
+use compensator::dynamics::linear::linearise;
 use compensator::equilibrium::equilibrium;
-use compensator::params::{CORE_FIELDS, ESTIMATOR_FIELDS, Field, MACHINE_FIELDS};
+use compensator::params::Field;
 use compensator::{Params, RawParams};
 use rand::{RngExt, SeedableRng, rngs::Xoshiro256PlusPlus};
-use rayon::prelude::*;
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-/// Most variants of one sweep.
-pub const MAX_VARIANTS: usize = 1_000_000;
+pub mod cache;
+pub mod step_response;
+pub mod stream;
+
+/// Most variants of one sweep: rows stream out as they are computed, so
+/// memory does not grow with the count; at 5,000 variants per second per
+/// core 1e10 is a cluster's week.
+pub const MAX_VARIANTS: usize = 10_000_000_000;
+
+/// Most values of one `--set` axis (each is held in memory).
+pub const MAX_AXIS_VALUES: usize = 1_000_000;
 
 /// A parameter file's field by its `section.key` name.
 pub fn field(name: &str) -> Option<&'static Field> {
-    CORE_FIELDS
-        .iter()
-        .chain(MACHINE_FIELDS.iter())
-        .chain(ESTIMATOR_FIELDS.iter())
-        .find(|f| f.path == name)
+    compensator_params::field_by_path(name)
 }
 
-/// `raw` with the field `path` set to `value` (not validated).
+/// `raw` with the field `path` set to `value` (not validated), by the
+/// schema's access by name ([`RawParams::set`]).
 ///
 /// # Errors
 ///
-/// A `[machine]` field when `raw` has no `[machine]` section.
+/// An unknown name (with the nearest valid one), a `[machine]` field when
+/// `raw` has no `[machine]` section.
 pub fn with_value(raw: &RawParams, path: &str, value: f64) -> Result<RawParams, String> {
-    let set = |n: compensator::params::Named| if n.path == path { value } else { n.value };
     let mut out = *raw;
-    out.core = raw.core.map(set);
-    out.estimator = raw.estimator.map(set);
-    match &raw.machine {
-        Some(m) => out.machine = Some(m.map(set)),
-        None if path.starts_with("machine.") => {
-            return Err(format!("{path}: the parameter file has no [machine] section"));
-        }
-        None => {}
-    }
+    out.set(path, value).map_err(|e| e.to_string())?;
     Ok(out)
 }
 
@@ -99,9 +95,11 @@ fn name_and_spec<'a>(flag: &str, arg: &'a str) -> Result<(&'static Field, &'a st
         .ok_or_else(|| CliError::Input(format!("{flag}: '{arg}' is not of the form section.key=...")))?;
     let name = name.trim();
     let f = field(name).ok_or_else(|| {
-        CliError::Input(format!(
-            "{flag}: unknown parameter '{name}' (the names are section.key of docs/parameters.md)"
-        ))
+        let e = compensator_params::PathError {
+            path: name,
+            problem: compensator_params::PathProblem::Unknown,
+        };
+        CliError::Input(format!("{flag}: {e}"))
     })?;
     Ok((f, spec.trim()))
 }
@@ -130,10 +128,10 @@ pub fn parse_set(arg: &str) -> Result<GridAxis, CliError> {
             .trim()
             .parse()
             .ok()
-            .filter(|n| (1..=MAX_VARIANTS).contains(n))
+            .filter(|n| (1..=MAX_AXIS_VALUES).contains(n))
             .ok_or_else(|| {
                 CliError::Input(format!(
-                    "--set: {}: count '{}' is not a whole number in 1..={MAX_VARIANTS}",
+                    "--set: {}: count '{}' is not a whole number in 1..={MAX_AXIS_VALUES}",
                     f.path, parts[2]
                 ))
             })?;
@@ -169,7 +167,7 @@ pub fn parse_vary(arg: &str) -> Result<Tolerance, CliError> {
 }
 
 /// What a sweep computes for each variant.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Metrics {
     /// Temperatures of the displacement columns [C].
     pub temps: Vec<f64>,
@@ -179,10 +177,14 @@ pub struct Metrics {
     pub dt: f64,
     /// Simulated time of the step [s].
     pub t_end: f64,
+    /// The settling time from the reference solver (Radau5, sampled every
+    /// `dt`) instead of the `f64` twin ([`step_response`]): for checking,
+    /// at about 7 ms a variant.
+    pub reference: bool,
 }
 
 /// A sweep: the base file, the grid, the tolerances.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Sweep {
     /// The base parameter set.
     pub base: RawParams,
@@ -234,42 +236,75 @@ impl Sweep {
     /// order), in variant order: grid points, and for each `samples`
     /// draws from one generator seeded with `seed` (Xoshiro256++).
     pub fn variants(&self) -> Result<Vec<Vec<f64>>, CliError> {
-        let n = self.variant_count()?;
+        Ok(self.variants_in(0, self.variant_count()?).map(|(_, v)| v).collect())
+    }
+
+    /// Variants `start..end` (`end` at most [`Self::variant_count`]) with
+    /// their index, as [`Self::variants`] numbers and draws them: the draws
+    /// of the variants before `start` are replayed (drawn and discarded),
+    /// so a shard's variants are the single run's.
+    pub fn variants_in(&self, start: usize, end: usize) -> Variants<'_> {
         let names = self.parameter_names();
-        let samples = self.samples.max(1);
-        let base_value = |name: &str| {
-            let all = self
-                .base
-                .core
-                .named()
-                .into_array()
-                .into_iter()
-                .chain(self.base.estimator.named().into_array())
-                .chain(self.base.machine.iter().flat_map(|m| m.named().into_array()));
-            all.into_iter().find(|n| n.path == name).map_or(f64::NAN, |n| n.value)
-        };
+        let base_value = |name: &str| self.base.get(name).unwrap_or(f64::NAN);
+        let base: Vec<f64> = names.iter().map(|name| base_value(name)).collect();
+        let slots = self
+            .vary
+            .iter()
+            .map(|t| names.iter().position(|n| *n == t.name).unwrap_or(0))
+            .collect();
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(self.seed);
-        let mut out = Vec::with_capacity(n);
-        for i in 0..n {
-            let mut point = i / samples;
-            let mut values: Vec<f64> = names.iter().map(|name| base_value(name)).collect();
-            // Grid index: the last axis varies fastest.
-            for (k, axis) in self.grid.iter().enumerate().rev() {
-                values[k] = axis.values[point % axis.values.len()];
-                point /= axis.values.len();
+        for _ in 0..start {
+            for _ in &self.vary {
+                let _: f64 = rng.random_range(-1.0..=1.0);
             }
-            for t in &self.vary {
-                let k = names.iter().position(|n| *n == t.name).unwrap_or(0);
-                let u: f64 = rng.random_range(-1.0..=1.0);
-                values[k] += if t.relative {
-                    values[k] * t.half_width * u
-                } else {
-                    t.half_width * u
-                };
-            }
-            out.push(values);
         }
-        Ok(out)
+        Variants {
+            sweep: self,
+            base,
+            slots,
+            rng,
+            next: start,
+            end,
+        }
+    }
+}
+
+/// An iterator over a sweep's variants ([`Sweep::variants_in`]):
+/// `(index, parameter values)`.
+pub struct Variants<'a> {
+    sweep: &'a Sweep,
+    base: Vec<f64>,
+    slots: Vec<usize>,
+    rng: Xoshiro256PlusPlus,
+    next: usize,
+    end: usize,
+}
+
+impl Iterator for Variants<'_> {
+    type Item = (usize, Vec<f64>);
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.next >= self.end {
+            return None;
+        }
+        let i = self.next;
+        self.next += 1;
+        let mut point = i / self.sweep.samples.max(1);
+        let mut values = self.base.clone();
+        // Grid index: the last axis varies fastest.
+        for (k, axis) in self.sweep.grid.iter().enumerate().rev() {
+            values[k] = axis.values[point % axis.values.len()];
+            point /= axis.values.len();
+        }
+        for (t, &k) in self.sweep.vary.iter().zip(&self.slots) {
+            let u: f64 = self.rng.random_range(-1.0..=1.0);
+            values[k] += if t.relative {
+                values[k] * t.half_width * u
+            } else {
+                t.half_width * u
+            };
+        }
+        Some((i, values))
     }
 }
 
@@ -287,8 +322,19 @@ pub fn metric_columns(metrics: &Metrics, with_machine: bool) -> Vec<String> {
     cols
 }
 
+/// Samples of the Eq. (32) check: every 0.1 C of the validated range.
+pub fn monotonicity_samples(raw: &RawParams) -> u32 {
+    let (lo, hi) = (raw.estimator.valid_min, raw.estimator.valid_max);
+    (((hi - lo) / 0.1).round() as u32).saturating_add(1)
+}
+
 /// One variant's metrics as CSV cells, or why it could not be evaluated.
 pub fn evaluate(raw: &RawParams, metrics: &Metrics) -> Result<Vec<String>, String> {
+    evaluate_with(raw, metrics, &cache::Shared::none())
+}
+
+/// [`evaluate`] with the work the sweep's variants share ([`cache`]).
+pub fn evaluate_with(raw: &RawParams, metrics: &Metrics, shared: &cache::Shared) -> Result<Vec<String>, String> {
     raw.validate().map_err(|e| e.to_string())?;
     let p = Params::<f64>::new(raw).map_err(|e| e.to_string())?;
     let mut cells = Vec::new();
@@ -297,14 +343,26 @@ pub fn evaluate(raw: &RawParams, metrics: &Metrics) -> Result<Vec<String>, Strin
         cells.push(format!("{}", e.x));
     }
     let (lo, hi) = (raw.estimator.valid_min, raw.estimator.valid_max);
-    let samples = (((hi - lo) / 0.1).round() as u32).saturating_add(1);
-    let m = monotonicity(&p, lo, hi, samples).map_err(|e| format!("Eq. (32) over {lo}-{hi} C: {e}"))?;
+    let samples = monotonicity_samples(raw);
+    let m = shared
+        .monotonicity(&p, lo, hi, samples)
+        .map_err(|e| format!("Eq. (32) over {lo}-{hi} C: {e}"))?;
     cells.push(m.monotonic.to_string());
     cells.push(format!("{}", m.worst_dx_dt));
     let (from, to) = metrics.step;
-    let ind = step_indicators(raw, &p, from, to, metrics.dt, metrics.t_end).map_err(|e| e.to_string())?;
-    cells.push(format!("{}", ind.dominant_re));
-    cells.push(format!("{}", ind.settling_time));
+    if metrics.reference {
+        let ind = step_indicators(raw, &p, from, to, metrics.dt, metrics.t_end).map_err(|e| e.to_string())?;
+        cells.push(format!("{}", ind.dominant_re));
+        cells.push(format!("{}", ind.settling_time));
+    } else {
+        // As `step_indicators`, the response from the twin.
+        let x_star = equilibrium(&p, to).map_err(|e| format!("--steps: {to} C: {e}"))?.x;
+        equilibrium(&p, from).map_err(|e| format!("--steps: {from} C: {e}"))?;
+        let lin = linearise(&p, to).map_err(|e| format!("linearisation at {to} C: {e}"))?;
+        let s = step_response::settling_time(&p, &lin, from, to, metrics.dt, metrics.t_end, x_star)?;
+        cells.push(format!("{}", lin.dominant.re));
+        cells.push(format!("{}", s.time));
+    }
     if p.machine.is_some() {
         let n = (hi - lo).floor() as usize;
         let mut sum = 0.0;
@@ -383,50 +441,12 @@ impl Progress {
 }
 
 /// Runs the sweep: one row per variant, `variant` (0-based), the parameter
-/// columns, the metrics; a variant that fails has an `error` cell.
+/// columns, the metrics and `error` (empty, or why the variant could not
+/// be evaluated), as CSV text ([`stream::write`] into memory).
 pub fn run(sweep: &Sweep) -> Result<String, CliError> {
-    let variants = sweep.variants()?;
-    let names = sweep.parameter_names();
-    let metrics = &sweep.metrics;
-    let with_machine = sweep.base.machine.is_some();
-    let mut header: Vec<String> = vec!["variant".into()];
-    header.extend(names.iter().map(|s| s.to_string()));
-    header.extend(metric_columns(metrics, with_machine));
-    let header_refs: Vec<&str> = header.iter().map(String::as_str).collect();
-    let progress = Progress::new(variants.len());
-    let results: Vec<Result<Vec<String>, String>> = variants
-        .par_iter()
-        .map(|values| {
-            let mut raw = sweep.base;
-            let mut r = Ok(());
-            for (name, &v) in names.iter().zip(values) {
-                match with_value(&raw, name, v) {
-                    Ok(next) => raw = next,
-                    Err(e) => r = Err(e),
-                }
-            }
-            let out = r.and_then(|()| evaluate(&raw, metrics));
-            progress.inc();
-            out
-        })
-        .collect();
-    progress.finish();
-    let mut table = Table::new(&header_refs);
-    for (i, (values, result)) in variants.iter().zip(results).enumerate() {
-        let mut lead: Vec<String> = vec![i.to_string()];
-        lead.extend(values.iter().map(|v| format!("{v}")));
-        match result {
-            Ok(cells) => {
-                lead.extend(cells);
-                table.row_cells(&lead);
-            }
-            Err(e) => {
-                let lead: Vec<f64> = std::iter::once(i as f64).chain(values.iter().copied()).collect();
-                table.row_error(&lead, &e);
-            }
-        }
-    }
-    Ok(table.as_str().to_string())
+    let mut out = Vec::new();
+    stream::write(sweep, None, crate::units::Units::Si, &mut out)?;
+    String::from_utf8(out).map_err(|e| CliError::Failed(format!("sweep output: {e}")))
 }
 
 /// Builds a sweep from the command's arguments.
@@ -454,6 +474,25 @@ pub fn build(
             return Err(CliError::Input(format!("--vary: {} is given twice", a.name)));
         }
     }
+    // An absolute tolerance far below the value is most likely a
+    // percentage written without its `%` (plunger.spring_rate=5 is +-5 N/m
+    // on 23,116 N/m).
+    for t in vary.iter().filter(|t| !t.relative) {
+        if let Ok(v) = base.get(t.name)
+            && t.half_width > 0.0
+            && t.half_width < 1e-3 * v.abs()
+        {
+            eprintln!(
+                "sweep: WARNING: --vary {}={}: +-{} is {} % of the file's {}; for a relative tolerance write {}%",
+                t.name,
+                crate::display::sig(t.half_width, 6),
+                crate::display::sig(t.half_width, 6),
+                crate::display::sig(100.0 * t.half_width / v.abs(), 2),
+                crate::display::sig(v, 6),
+                crate::display::sig(t.half_width, 6)
+            );
+        }
+    }
     for name in grid.iter().map(|a| a.name).chain(vary.iter().map(|t| t.name)) {
         if name.starts_with("machine.") && base.machine.is_none() {
             return Err(CliError::Input(format!(
@@ -470,7 +509,12 @@ pub fn build(
         (None, false) => 100,
         (None, true) => 1,
     };
+    let env = crate::envelope::Envelope::of(
+        &base,
+        &compensator::Params::<f64>::new(&base).map_err(|e| CliError::Input(e.to_string()))?,
+    );
     let temps = temps::parse(temps_spec)?;
+    env.check_all(&temps, "--temps")?;
     if temps.len() > 100 {
         return Err(CliError::Input("--temps: at most 100 temperatures in a sweep".into()));
     }
@@ -480,6 +524,7 @@ pub fn build(
             "--step: '{step_spec}' is not one from:to pair"
         )));
     };
+    env.check_all(&[step.0, step.1], "--step")?;
     tick_count(t_end, dt)?;
     let sweep = Sweep {
         base,
@@ -487,7 +532,13 @@ pub fn build(
         vary,
         samples,
         seed,
-        metrics: Metrics { temps, step, dt, t_end },
+        metrics: Metrics {
+            temps,
+            step,
+            dt,
+            t_end,
+            reference: false,
+        },
     };
     sweep.variant_count()?;
     Ok(sweep)

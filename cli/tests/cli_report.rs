@@ -64,7 +64,7 @@ fn report_writes_tables_figures_and_a_summary_from_any_directory() {
     let elsewhere = temp_dir("report-cwd");
     let (code, listing, err) = run_in(
         &elsewhere,
-        &["report", "--out", out_dir.to_str().unwrap(), "--png", "--units", "eng"],
+        &["report", "--dir", out_dir.to_str().unwrap(), "--png", "--units", "eng"],
         b"",
     );
     assert_eq!(code, 0, "{err}");
@@ -128,19 +128,19 @@ fn report_writes_tables_figures_and_a_summary_from_any_directory() {
 
     // Without --png, no PNG; in SI the columns are SI.
     let si_dir = dir.join("si");
-    let (code, _, err) = run(&["report", "--out", si_dir.to_str().unwrap()]);
+    let (code, _, err) = run(&["report", "--dir", si_dir.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
     assert!(!si_dir.join("eigenvalues.png").exists());
     let t1 = std::fs::read_to_string(si_dir.join("table1.csv")).unwrap();
     assert!(
-        t1.starts_with("t_c,dp_pa,paper_dp_ab_pa,model_dp_ab_pa,residual_pa\n"),
+        t1.starts_with("t_c,dp_pa,paper_dp_ab_pa,model_dp_ab_pa,residual_pa,error\n"),
         "{t1}"
     );
 
-    // An output folder that cannot be made: bad input naming --out.
-    let (code, _, err) = run(&["report", "--out", "/proc/no/such"]);
+    // An output folder that cannot be made: bad input naming --dir.
+    let (code, _, err) = run(&["report", "--dir", "/proc/no/such"]);
     assert_eq!(code, 2);
-    assert!(err.contains("--out"), "{err}");
+    assert!(err.contains("--dir"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
     let _ = std::fs::remove_dir_all(&elsewhere);
 }

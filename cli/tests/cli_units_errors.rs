@@ -2,7 +2,7 @@
 //! `error` column, the rest of the table kept, exit status 1 after it.
 
 mod common;
-use common::{column, csv, run, temp_dir};
+use common::{csv, run, temp_dir};
 
 const P: &str = "presets/paper.toml";
 
@@ -27,6 +27,13 @@ fn tabular_commands() -> Vec<Vec<&'static str>> {
         vec!["eigen", "--params", P, "--temps", "30,60"],
         vec!["indicators", "--params", P, "--steps", "40:50", "--t-end", "0.2"],
         vec!["compensation", "--params", P, "--temps", "30:80:10"],
+        vec![
+            "estimate",
+            "--params",
+            P,
+            "--sensor-data",
+            "data/logs/probe-warm-up.csv",
+        ],
         vec![
             "sweep",
             "--params",
@@ -103,7 +110,7 @@ fn eng_units_rename_and_convert_every_tables_columns() {
 }
 
 #[test]
-fn eng_units_are_refused_where_the_output_is_a_parameter_file_or_text() {
+fn units_are_not_offered_where_the_output_is_a_parameter_file_or_text() {
     for args in [
         &["size", "--params", P, "--for", "machine"][..],
         &["calibrate"][..],
@@ -112,8 +119,13 @@ fn eng_units_are_refused_where_the_output_is_a_parameter_file_or_text() {
         let (code, out, err) = run(&[args, &["--units", "eng"]].concat());
         assert_eq!(code, 2, "{args:?}");
         assert!(out.is_empty());
-        assert!(err.contains("--units"), "{err}");
-        let (code, _, err) = run(&[args, &["--units", "si"]].concat());
+        // Refused by name, with the commands that do take it.
+        assert!(err.contains("unexpected argument '--units'"), "{err}");
+        assert!(err.contains("tip: --units is taken by equilibrium"), "{err}");
+        assert!(err.lines().count() <= 2, "{err}");
+        let (_, help, _) = run(&[args[0], "--help"]);
+        assert!(!help.contains("--units"), "{args:?} offers --units: {help}");
+        let (code, _, err) = run(args);
         assert_eq!(code, 0, "{args:?}: {err}");
     }
 }
@@ -144,8 +156,7 @@ fn eng_units_reach_the_figures() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Commands whose rows are temperatures, with a list reaching 200 C,
-/// beyond the viscosity law of the paper's oil (below 2 cSt).
+/// Commands whose rows are temperatures.
 fn per_temperature() -> Vec<Vec<&'static str>> {
     vec![
         vec!["equilibrium", "--params", P],
@@ -157,33 +168,37 @@ fn per_temperature() -> Vec<Vec<&'static str>> {
 }
 
 #[test]
-fn a_temperature_beyond_the_model_keeps_the_table_with_an_error_column() {
+fn a_temperature_outside_the_oil_model_is_refused_and_rows_outside_the_validated_range_are_flagged() {
     for args in per_temperature() {
+        // 200 C: beyond the paper oil's viscosity law (below 2 cSt from 105.9 C).
         let (code, out, err) = run(&[&args[..], &["--temps", "30,200,50"]].concat());
-        assert_eq!(code, 1, "{args:?}: {err}");
-        assert!(err.contains("1 of 3 rows"), "{args:?}: {err}");
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(out.is_empty(), "{args:?}");
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+        assert!(
+            err.contains("--temps: 200 C is above the oil model's range -20 to 105.9 C")
+                && err.contains("viscosity below 2 cSt")
+                && err.contains("validated 26 to 78 C"),
+            "{args:?}: {err}"
+        );
+        // Below estimator.oil_min (-20 C): refused too, naming the field.
+        let (code, _, err) = run(&[&args[..], &["--temps=-30"]].concat());
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(
+            err.contains("-30 C is below") && err.contains("estimator.oil_min"),
+            "{err}"
+        );
+        // Inside the oil model: computed, each row flagged by its zone;
+        // the header is the same whether rows fail or not.
+        let (code, out, err) = run(&[&args[..], &["--temps", "20,50,90"]].concat());
+        assert_eq!(code, 0, "{args:?}: {err}");
         let (header, rows) = csv(&out);
-        assert_eq!(header.last().map(String::as_str), Some("error"), "{args:?}");
-        assert_eq!(rows.len(), 3, "{args:?}");
-        assert!(rows[0].last().unwrap().is_empty() && rows[2].last().unwrap().is_empty());
-        let why = rows[1].last().unwrap();
-        assert!(why.contains("range"), "{args:?}: {why}");
-        assert_eq!(rows[1][0], "200");
-        assert!(rows[1][1..rows[1].len() - 1].iter().all(String::is_empty), "{args:?}");
-        // The rows that could be computed are those of a run without 200 C.
-        let (code, good, _) = run(&[&args[..], &["--temps", "30,50"]].concat());
-        assert_eq!(code, 0);
-        let (good_header, good_rows) = csv(&good);
-        assert!(!good_header.iter().any(|h| h == "error"), "{good}");
-        for (kept, alone) in [(&rows[0], &good_rows[0]), (&rows[2], &good_rows[1])] {
-            assert_eq!(&kept[..kept.len() - 1], &alone[..], "{args:?}");
-        }
-        // JSON: the failed row has its reason and nulls.
-        let (code, json, _) = run(&[&args[..], &["--temps", "30,200,50", "--format", "json"]].concat());
-        assert_eq!(code, 1);
-        let v: serde_json::Value = serde_json::from_str(&json).unwrap();
-        assert!(v[1]["error"].as_str().is_some_and(|s| s.contains("range")), "{json}");
-        assert!(v[0]["error"].is_null() && v[1][header[1].as_str()].is_null(), "{json}");
+        assert_eq!(&header[header.len() - 2..], ["envelope", "error"], "{args:?}");
+        let zones: Vec<&str> = rows.iter().map(|r| r[r.len() - 2].as_str()).collect();
+        assert_eq!(zones, ["oil_model", "validated", "oil_model"], "{args:?}");
+        assert!(rows.iter().all(|r| r.last().unwrap().is_empty()), "{args:?}");
+        let (_, good, _) = run(&[&args[..], &["--temps", "50"]].concat());
+        assert_eq!(csv(&good).0, header, "{args:?}");
     }
 }
 
@@ -191,39 +206,44 @@ fn a_temperature_beyond_the_model_keeps_the_table_with_an_error_column() {
 fn failed_rows_still_reach_the_output_file_and_bad_input_stays_status_2() {
     let dir = temp_dir("errors");
     let file = dir.join("out.csv");
-    let (code, out, err) = run(&[
-        "eigen",
+    // A variant outside its field's plausible range keeps its row.
+    let sweep = [
+        "sweep",
         "--params",
         P,
-        "--temps",
-        "200,40",
-        "-o",
-        file.to_str().unwrap(),
-    ]);
+        "--set",
+        "plunger.mass=0.01,-1",
+        "--t-end",
+        "0.05",
+    ];
+    let (code, out, err) = run(&[&sweep[..], &["-o", file.to_str().unwrap()]].concat());
     assert_eq!(code, 1, "{err}");
+    assert!(err.contains("1 of 2 rows"), "{err}");
     assert!(out.is_empty());
     let written = std::fs::read_to_string(&file).unwrap();
-    assert_eq!(column(&written, "t_c"), vec![200.0, 40.0]);
-    // Every row failing is still a table, status 1.
-    let (code, out, _) = run(&["equilibrium", "--params", P, "--temps", "200,300"]);
+    let (header, rows) = csv(&written);
+    assert_eq!(header.last().map(String::as_str), Some("error"));
+    assert!(rows[0].last().unwrap().is_empty(), "{written}");
+    assert!(rows[1].last().unwrap().contains("plunger.mass"), "{written}");
+    // JSON: the failed row has its reason and nulls.
+    let (code, json, _) = run(&[&sweep[..], &["--format", "json"]].concat());
     assert_eq!(code, 1);
-    assert_eq!(out.lines().count(), 3);
-    // A list that is not a list, or a file that is not valid: status 2, nothing printed.
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert!(
+        v[1]["error"].as_str().is_some_and(|s| s.contains("plunger.mass")),
+        "{json}"
+    );
+    assert!(v[0]["error"].is_null() && v[1]["x_30c_m"].is_null(), "{json}");
+    // A list that is not a list, a file that is not valid, a step beyond
+    // the oil model: status 2, nothing printed.
     for args in [
         &["equilibrium", "--params", P, "--temps", "30,x"][..],
         &["equilibrium", "--params", "/nonexistent.toml"][..],
+        &["indicators", "--params", P, "--steps", "40:50,40:200", "--t-end", "0.1"][..],
     ] {
         let (code, out, _) = run(args);
         assert_eq!(code, 2, "{args:?}");
         assert!(out.is_empty());
     }
-    // A step the model cannot reach: its row, status 1.
-    let (code, out, err) = run(&["indicators", "--params", P, "--steps", "40:50,40:200", "--t-end", "0.1"]);
-    assert_eq!(code, 1, "{err}");
-    let (_, rows) = csv(&out);
-    assert!(
-        rows[0].last().unwrap().is_empty() && !rows[1].last().unwrap().is_empty(),
-        "{out}"
-    );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -260,10 +260,14 @@ fn bad_transients_exit_2_naming_row_and_column() {
             "time_s,t_c,x_m\n0,40,0\n0.001,50,0\n0.002,50,-0.001\n",
             "row 3, column x_m",
         ),
-        // A temperature the oil model cannot take.
+        // A temperature the oil model cannot take, one no oil has (in K?).
         (
-            "time_s,t_c,x_m\n0,40,0\n0.001,400,0\n0.002,400,0\n",
-            "row 2, column t_c",
+            "time_s,t_c,x_m\n0,40,0\n0.001,200,0\n0.002,200,0\n",
+            "row 2, column t_c: 200 C is above the oil model's range",
+        ),
+        (
+            "time_s,t_c,x_m\n0,40,0\n0.001,320,0\n0.002,320,0\n",
+            "column t_c: 320 C is not a plausible oil temperature [-60, 300] C; written in another unit? (320 K = 46.85 C",
         ),
         // A text column is ignored; a wanted column twice is ambiguous.
         ("time_s,t_c,x_m,x_m\n0,40,0,0\n", "column x_m appears twice"),

@@ -10,7 +10,8 @@
 
 pub mod tables;
 
-use crate::error::{CliError, load_params};
+use crate::error::CliError;
+use crate::input::load_params;
 use crate::lsq::{max_abs, rms};
 use crate::statics::find_balance;
 use compensator::Params;

@@ -1,0 +1,107 @@
+//! `estimate`: the firmware's estimator replayed over a recorded probe log.
+
+use crate::args::{Output, ParamsArg, PlotArg, TableArgs};
+use crate::error::CliError;
+use crate::estimate::{self, Options};
+use std::path::PathBuf;
+
+const HELP: &str = "\
+Runs the firmware's estimator (the same code, f32, the same tick
+1/estimator.tick_hz) over a recorded probe log: it starts at rest at the
+first reading, each row is delivered on the tick its time falls in, and
+the oil-temperature observer is designed for the log's reading interval
+(the median of its intervals). A board's or QEMU's telemetry CSV
+(cargo xtask flash --csv / run --csv) replays as it is, through its
+t_probe_c column.
+
+Log (CSV; ',' ';' or tab separated, '#' lines are comments, other columns
+ignored): time_s [s], increasing, no gap longer than the estimator's fault
+timeout (0.5 s at the default tick), and exactly one of
+  t_c        probe temperature [C] (t_probe_c: the same, as telemetry names it)
+  rtd_ohm    RTD resistance [ohm], through the file's Callendar-Van Dusen coefficients
+  code       the MAX31865's 15-bit code, R = code * estimator.rtd_reference / 2^15
+A reading the firmware flags (outside estimator.oil_min..oil_max, a code
+of 0 or 32767) is flagged SENSOR_FAULT the same way.
+
+Output: CSV, one row per telemetry period (estimator.telemetry_hz), or
+per input row with --every-sample; SI units, every digit of the f32
+estimate:
+  time_s [s] (the tick's start), t_probe_c [C] (the last accepted reading),
+  t_oil_c [C] (estimated oil temperature), t_oil_sd_c [C],
+  x_m [m], x_sd_m [m], p_a_pa [Pa], p_a_sd_pa [Pa], p_b_pa [Pa], p_b_sd_pa [Pa],
+  q_total_m3s [m^3/s], q_total_sd_m3s [m^3/s],
+  compensation_error_m3s [m^3/s], compensation_error_sd_m3s [m^3/s]
+  (NaN without a [machine] section), reseats [-], flags (names joined by |)
+The *_sd_* columns are standard uncertainties (k = 1): +-1.96 of them is
+the 95 % band (docs/firmware.md). stderr: the readings, their interval and
+the ticks run.
+
+Example:
+  compensator estimate --params presets/paper.toml \\
+    --sensor-data data/logs/probe-warm-up.csv --plot estimate.svg";
+
+/// Replay a recorded probe log through the firmware's estimator: state estimates with their uncertainties.
+#[derive(clap::Args, Debug, Clone)]
+#[command(after_long_help = HELP)]
+pub struct Args {
+    #[command(flatten)]
+    params: ParamsArg,
+    /// Probe log: time_s and one of t_c, t_probe_c, rtd_ohm, code (CSV); - reads standard input.
+    #[arg(long, value_name = "LOG.csv")]
+    sensor_data: PathBuf,
+    /// One row per row of the log instead of one per telemetry period.
+    #[arg(long)]
+    every_sample: bool,
+    #[command(flatten)]
+    plot: PlotArg,
+    #[command(flatten)]
+    table: TableArgs,
+}
+
+impl Args {
+    /// Runs the command.
+    ///
+    /// # Errors
+    ///
+    /// Bad input (the file, the log: naming row, line and column) as
+    /// [`estimate::read_log`] and [`estimate::run`].
+    pub fn run(self) -> Result<Output, CliError> {
+        let log_path = &self.sensor_data;
+        if log_path.as_os_str() == "-" && self.params.params.as_os_str() == "-" {
+            return Err(CliError::Input(
+                "--sensor-data: standard input is --params' already; give one of them as a file".into(),
+            ));
+        }
+        let raw = self.params.raw()?;
+        let text = crate::input::bounded_text(
+            log_path,
+            "--sensor-data",
+            crate::input::MAX_LOG_BYTES,
+            &format!(": {}", estimate::SPLIT),
+        )?;
+        let shown = if log_path.as_os_str() == "-" {
+            "standard input".to_string()
+        } else {
+            log_path.display().to_string()
+        };
+        let prefix = |e: String| CliError::Input(format!("--sensor-data: {shown}: {e}"));
+        let log = estimate::read_log(&text).map_err(prefix)?;
+        let replay = estimate::run(
+            &raw,
+            &log,
+            Options {
+                every_sample: self.every_sample,
+            },
+        )
+        .map_err(|e| match e {
+            CliError::Input(m) if !m.starts_with("--params") => prefix(m),
+            e => e,
+        })?;
+        eprintln!("{}", replay.note);
+        let units = self.table.units.units;
+        self.plot.draw(&replay.table, |csv| {
+            crate::plot::estimate(csv, raw.core.stroke, &format!("Estimate over {shown}"), units)
+        })?;
+        Ok(Output::table(replay.table, &self.table))
+    }
+}
