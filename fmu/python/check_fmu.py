@@ -12,15 +12,25 @@
    the same trajectory; reset returns to the start;
 4. an invalid parameter is refused at once with a logged message naming
    the field, and the instance ends cleanly; an invalid parameter passed to
-   `fmpy.simulate_fmu` fails the simulation with an exception, not a crash.
+   `fmpy.simulate_fmu` fails the simulation with an exception, not a crash;
+5. for each `--grid H CSV`: the step with communication steps of H (not
+   whole ticks: sub-tick, between two counts) gives the CLI's run on the
+   same grid (`--dt H/ceil(H/tick)`, a row every H) within 1e-6;
+6. a variable sequence of communication steps follows the reference
+   solver (`--reference-csv`, sampled finely) within 0.5 % of the step (the
+   f32 twin's goal); a negative step is refused;
+7. the archive carries a binary for each of `--platforms`.
 
 Usage: check_fmu.py FMU --step-csv F --ramp-csv F --from C --to C --ramp C_PER_S
+       [--grid H CSV]... [--reference-csv F] [--platforms LIST]
 Ends with `fmu check: N passed, M failed`; exit status 1 if any failed.
 """
 
 import argparse
+import bisect
 import csv
 import sys
+import zipfile
 
 import fmpy
 from fmpy.validation import validate_fmu
@@ -127,6 +137,9 @@ def main():
     ap.add_argument("--from", dest="t_from", type=float, required=True)
     ap.add_argument("--to", dest="t_to", type=float, required=True)
     ap.add_argument("--ramp", type=float, required=True)
+    ap.add_argument("--grid", nargs=2, action="append", default=[], metavar=("H", "CSV"))
+    ap.add_argument("--reference-csv")
+    ap.add_argument("--platforms")
     args = ap.parse_args()
 
     problems = validate_fmu(args.fmu)
@@ -183,15 +196,27 @@ def main():
         again.append(b.get("x", "p_a", "p_b"))
     check(f"a serialized state ({len(serialized)} bytes) replays the ramp exactly", again == got_b[n // 2:])
 
-    # A step that is not whole ticks: refused (Discard), logged, nothing done.
+    # A negative step: refused (Discard), logged, nothing done.
     before = b.get("x")
     try:
-        b.step(n * tick, 0.5 * tick)
+        b.step(n * tick, -0.5 * tick)
         refused = False
     except Exception:
         refused = True
-    check("a step of half a tick is refused with a logged message",
-          refused and b.get("x") == before and any("whole multiple" in m for m in logged))
+    check("a negative step is refused with a logged message",
+          refused and b.get("x") == before and any("positive and finite" in m for m in logged))
+
+    # A value reference read as another type: the message names the
+    # version's type (FMI 2.0 Integer, FMI 3.0 Int32).
+    logged.clear()
+    try:
+        (b.s.getInt32 if b.v3 else b.s.getInteger)([b.vr["x"]])
+        refused = False
+    except Exception:
+        refused = True
+    want = "not an Int32" if b.v3 else "not an Integer"
+    check(f"a Float read as an integer is refused in the version's words ('{want}')",
+          refused and any(want in m for m in logged), " | ".join(logged))
 
     b.s.reset()
     b.initialize(args.t_from)
@@ -221,6 +246,57 @@ def main():
 
     res = fmpy.simulate_fmu(args.fmu, stop_time=0.05, start_values={"T_oil": args.t_to}, validate=False)
     check("fmpy.simulate_fmu runs the packaged parameters", len(res) > 1 and bool(abs(res["x"][-1]) < 1.0))
+
+    for h, path in args.grid:
+        h = float(h)
+        rows = read_cli(path)
+        s = Slave(md, unzipdir, "grid", logged)
+        s.initialize(args.t_from)
+        got = []
+        for k in range(len(rows) - 1):
+            s.set("T_oil", args.t_to)
+            s.step(k * h, h)
+            got.append(s.get("x", "p_a", "p_b"))
+        time = s.get("time")[0] if s.v3 else None
+        s.free()
+        dx, dpr = deviation(rows, got, stroke, dp)
+        exact = dx == 0.0 and dpr == 0.0
+        check(f"communication steps of {h * 1e3:.9g} ms ({len(got)} steps) against the CLI on the same grid",
+              dx <= TOLERANCE and dpr <= TOLERANCE and (time is None or time == len(got) * h or
+                                                        abs(time - len(got) * h) <= 1e-12),
+              f"max |dx| {dx:.2e} of the stroke, max |dp| {dpr:.2e} of dp{' (exactly equal)' if exact else ''}")
+
+    if args.reference_csv:
+        with open(args.reference_csv, newline="") as f:
+            ref = [(float(r["time_s"]), float(r["x_m"])) for r in csv.DictReader(f)]
+        times = [r[0] for r in ref]
+        sequence = [1e-3, 1e-4, 2.5e-3, 1e-3 / 3.0, 7e-4, 5e-5, 1.7e-3, 1e-2]
+        s = Slave(md, unzipdir, "variable", logged)
+        s.initialize(args.t_from)
+        t, k, worst = 0.0, 0, 0.0
+        step = abs(ref[-1][1] - ref[0][1])
+        while t + sequence[k % len(sequence)] <= min(0.3, times[-1]):
+            h = sequence[k % len(sequence)]
+            s.set("T_oil", args.t_to)
+            s.step(t, h)
+            t += h
+            k += 1
+            i = min(max(bisect.bisect_left(times, t), 1), len(times) - 1)
+            (t0, x0), (t1, x1) = ref[i - 1], ref[i]
+            x_ref = x0 + (x1 - x0) * (t - t0) / (t1 - t0)
+            worst = max(worst, abs(s.get("x")[0] - x_ref) / step * 100.0)
+        s.free()
+        check(f"a variable step sequence ({k} steps of {', '.join(f'{h * 1e3:.4g}' for h in sequence)} ms) "
+              f"against the reference solver", worst <= 0.5, f"max |dx| {worst:.4f} % of the step")
+
+    if args.platforms:
+        names = zipfile.ZipFile(args.fmu).namelist()
+        v3 = md.fmiVersion.startswith("3")
+        folders = {"x86_64-linux": ("linux64", "so"), "x86_64-windows": ("win64", "dll"),
+                   "aarch64-linux": ("aarch64-linux", "so")}
+        want = [f"binaries/{p if v3 else folders[p][0]}/compensator.{folders[p][1]}" for p in args.platforms.split(",")]
+        missing = [w for w in want if w not in names]
+        check(f"the archive carries the binaries of {args.platforms}", not missing, ", ".join(missing))
 
     failed = checks.count(False)
     print(f"fmu check: {len(checks) - failed} passed, {failed} failed")

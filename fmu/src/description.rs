@@ -4,33 +4,24 @@
 //! twin's tick). Also the Markdown table of the variables in
 //! `docs/fmu.md` (a test keeps the two the same).
 
-use crate::instance::{Setup, t_oil_start};
+use crate::instance::{Instance, Setup};
 use crate::variables::{
-    FLAGS_OUTPUT, OUTPUTS, Unit, VR_FIRST_FIELD, VR_FIRST_OUTPUT, VR_MACHINE_PRESENT, VR_T_OIL, VR_TIME, field_min,
-    fields, fmi_unit, used_units,
+    FLAGS_OUTPUT, INPUTS, OUTPUTS, Unit, VR_FIRST_FIELD, VR_FIRST_OUTPUT, VR_MACHINE_PRESENT, VR_T_OIL, VR_TIME,
+    field_min, fields, fmi_unit, used_units,
 };
 use compensator::RawParams;
 use compensator::dynamics::TwinConfig;
 use core::fmt::Write;
 
 /// The FMI version of a model description (and of the functions an
-/// importer calls: the binary exports both sets).
+/// importer calls: the binary exports both sets). The binaries' folders
+/// are [`crate::platforms::Platform::dir`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FmiVersion {
-    /// FMI 2.0 co-simulation (`binaries/linux64/`).
+    /// FMI 2.0 co-simulation (`binaries/linux64/`, `win64/`, `aarch64-linux/`).
     V2,
-    /// FMI 3.0 co-simulation (`binaries/x86_64-linux/`).
+    /// FMI 3.0 co-simulation (`binaries/x86_64-linux/`, `x86_64-windows/`, `aarch64-linux/`).
     V3,
-}
-
-impl FmiVersion {
-    /// The platform folder of a Linux x86-64 binary under `binaries/`.
-    pub fn linux_x86_64_dir(self) -> &'static str {
-        match self {
-            FmiVersion::V2 => "linux64",
-            FmiVersion::V3 => "x86_64-linux",
-        }
-    }
 }
 
 /// The model identifier: the name of the binary (`compensator.so`).
@@ -66,10 +57,13 @@ fn fnv1a(bytes: &[u8], seed: u64) -> u64 {
 /// `(value reference, name, unit)` of every variable (FMI 3.0's `time`
 /// included).
 fn variable_list() -> Vec<(u32, String, Option<&'static str>)> {
-    let mut v = vec![
-        (VR_TIME, "time".to_string(), Some("s")),
-        (VR_T_OIL, "T_oil".into(), Some("degC")),
-    ];
+    let mut v = vec![(VR_TIME, "time".to_string(), Some("s"))];
+    v.extend(
+        INPUTS
+            .iter()
+            .enumerate()
+            .map(|(i, v)| (VR_T_OIL + i as u32, v.name.to_string(), v.unit)),
+    );
     v.extend(
         OUTPUTS
             .iter()
@@ -134,7 +128,7 @@ fn base_unit(u: &Unit) -> String {
 fn summary(config: &TwinConfig) -> String {
     format!(
         "Passive throttle-based temperature flow compensator: the firmware's f32 twin ({}, {} substep{} per {} s tick, \
-         as chosen for the packaged parameter file), driven by the oil temperature",
+         as chosen for the packaged parameter file), driven by the oil temperature and the port pressures",
         config.scheme.name(),
         config.substeps,
         if config.substeps == 1 { "" } else { "s" },
@@ -150,35 +144,34 @@ pub fn model_description(version: FmiVersion, raw: &RawParams, config: &TwinConf
     let mut x = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     let generation = format!("compensator-fmu {} (cargo xtask fmu)", env!("CARGO_PKG_VERSION"));
     let token = token();
-    match version {
-        FmiVersion::V2 => {
-            let _ = writeln!(
-                x,
-                "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{MODEL_IDENTIFIER}\" guid=\"{token}\" \
-                 description=\"{}\" generationTool=\"{generation}\" variableNamingConvention=\"structured\">",
-                attr(&summary(config))
-            );
-            let _ = writeln!(
-                x,
-                "  <CoSimulation modelIdentifier=\"{MODEL_IDENTIFIER}\" canHandleVariableCommunicationStepSize=\"true\" \
-                 canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"true\" canNotUseMemoryManagementFunctions=\"true\"/>"
-            );
-        }
-        FmiVersion::V3 => {
-            let _ = writeln!(
-                x,
-                "<fmiModelDescription fmiVersion=\"3.0\" modelName=\"{MODEL_IDENTIFIER}\" instantiationToken=\"{token}\" \
-                 description=\"{}\" generationTool=\"{generation}\" variableNamingConvention=\"structured\">",
-                attr(&summary(config))
-            );
-            let _ = writeln!(
-                x,
-                "  <CoSimulation modelIdentifier=\"{MODEL_IDENTIFIER}\" canHandleVariableCommunicationStepSize=\"true\" \
-                 canGetAndSetFMUState=\"true\" canSerializeFMUState=\"true\" fixedInternalStepSize=\"{tick}\" \
-                 hasEventMode=\"false\"/>"
-            );
-        }
-    }
+    // What the versions' headers differ in: the version, the name of the
+    // fingerprint, the state capabilities' spelling, FMI 3.0's fixed
+    // internal step and event mode, FMI 2.0's memory callbacks.
+    let (fmi, token_name, state, extra) = match version {
+        FmiVersion::V2 => (
+            "2.0",
+            "guid",
+            "FMUstate",
+            " canNotUseMemoryManagementFunctions=\"true\"".to_string(),
+        ),
+        FmiVersion::V3 => (
+            "3.0",
+            "instantiationToken",
+            "FMUState",
+            format!(" fixedInternalStepSize=\"{tick}\" hasEventMode=\"false\""),
+        ),
+    };
+    let _ = writeln!(
+        x,
+        "<fmiModelDescription fmiVersion=\"{fmi}\" modelName=\"{MODEL_IDENTIFIER}\" {token_name}=\"{token}\" \
+         description=\"{}\" generationTool=\"{generation}\" variableNamingConvention=\"structured\">",
+        attr(&summary(config))
+    );
+    let _ = writeln!(
+        x,
+        "  <CoSimulation modelIdentifier=\"{MODEL_IDENTIFIER}\" canHandleVariableCommunicationStepSize=\"true\" \
+         canGetAndSet{state}=\"true\" canSerialize{state}=\"true\"{extra}/>"
+    );
     x.push_str("  <UnitDefinitions>\n");
     for u in used_units() {
         let _ = writeln!(x, "    <Unit name=\"{}\">{}</Unit>", attr(u.name), base_unit(&u));
@@ -213,20 +206,24 @@ pub fn model_description(version: FmiVersion, raw: &RawParams, config: &TwinConf
             String::new(),
         );
     }
-    let t_doc = attr(
-        "Oil temperature. Outside estimator.oil_min..oil_max it is not used (the twin keeps the last one, flag SENSOR_FAULT); \
-         its value at the end of initialisation is where the twin starts at rest.",
-    );
-    let t_start = number(t_oil_start(raw));
-    var(
-        &mut x,
-        format!(
-            "    <Float64 name=\"T_oil\" valueReference=\"{VR_T_OIL}\" causality=\"input\" variability=\"continuous\" unit=\"degC\" start=\"{t_start}\" description=\"{t_doc}\"/>\n"
-        ),
-        format!(
-            "    <ScalarVariable name=\"T_oil\" valueReference=\"{VR_T_OIL}\" causality=\"input\" variability=\"continuous\" description=\"{t_doc}\">\n      <Real unit=\"degC\" start=\"{t_start}\"/>\n    </ScalarVariable>\n"
-        ),
-    );
+    let inputs = Instance::new(raw).inputs();
+    for (k, (input, start)) in INPUTS
+        .iter()
+        .zip([inputs.t_oil, inputs.p_supply, inputs.p_outlet])
+        .enumerate()
+    {
+        let (name, vr, doc, start) = (input.name, VR_T_OIL + k as u32, attr(input.doc), number(start));
+        let unit = input.unit.unwrap_or_default();
+        var(
+            &mut x,
+            format!(
+                "    <Float64 name=\"{name}\" valueReference=\"{vr}\" causality=\"input\" variability=\"continuous\" unit=\"{unit}\" start=\"{start}\" description=\"{doc}\"/>\n"
+            ),
+            format!(
+                "    <ScalarVariable name=\"{name}\" valueReference=\"{vr}\" causality=\"input\" variability=\"continuous\" description=\"{doc}\">\n      <Real unit=\"{unit}\" start=\"{start}\"/>\n    </ScalarVariable>\n"
+            ),
+        );
+    }
     for (i, o) in OUTPUTS.iter().enumerate() {
         let vr = VR_FIRST_OUTPUT + i as u32;
         let doc = attr(o.doc);
@@ -331,10 +328,16 @@ pub fn variables_markdown() -> String {
         s,
         "| `time` | independent (FMI 3.0 only) | Float64 | s | {VR_TIME} | | Simulation time |"
     );
-    let _ = writeln!(
-        s,
-        "| `T_oil` | input | Float64 | degC | {VR_T_OIL} | | Oil temperature (start: middle of the validated range) |"
-    );
+    for (k, i) in INPUTS.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "| `{}` | input | Float64 | {} | {} | | {} |",
+            i.name,
+            i.unit.unwrap_or_default(),
+            VR_T_OIL + k as u32,
+            i.doc.replace('|', "\\|")
+        );
+    }
     for (i, o) in OUTPUTS.iter().enumerate() {
         let ty = if i == FLAGS_OUTPUT {
             "Int32 (FMI 2.0: Integer)"

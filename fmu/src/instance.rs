@@ -16,18 +16,19 @@
 //! linearisation, machine losses: `compensator::estimator` module docs).
 
 use crate::variables::{
-    FIELD_COUNT, FLAGS_OUTPUT, OUTPUTS, VR_FIRST_OUTPUT, VR_MACHINE_PRESENT, VR_T_OIL, VR_TIME, field_of, fields,
+    FIELD_COUNT, FLAGS_OUTPUT, INPUTS, OUTPUTS, VR_FIRST_OUTPUT, VR_MACHINE_PRESENT, VR_P_OUTLET, VR_P_SUPPLY, VR_TIME,
+    field_of, fields, input_of,
 };
 use compensator::dynamics::config::choose;
 use compensator::dynamics::fsi::{Contact, Fsi};
 use compensator::dynamics::linear::characteristic_polynomial;
 use compensator::dynamics::schemes::OdeSystem;
-use compensator::dynamics::{Twin, TwinConfig, TwinMemory};
-use compensator::equilibrium::{a_parameter, equilibrium_for};
+use compensator::dynamics::{DynamicState, Twin, TwinConfig, TwinMemory};
+use compensator::equilibrium::{a_parameter, equilibrium, equilibrium_for};
 use compensator::estimator::{EstimatorConfig, Flags, quartic_hurwitz};
 use compensator::throttle::FlowLaws;
 use compensator::{ModelError, Params, RawParams, asymptotic, compensation};
-use compensator_params::MACHINE_FIELDS;
+use compensator_params::{MACHINE_FIELDS, RawTolerances};
 
 /// Where an instance is in the FMI state machine.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -60,6 +61,21 @@ impl Phase {
     }
 }
 
+/// The types of the FMU's variables, as each FMI version names them
+/// (FMI 2.0 `Real`, `Integer`; FMI 3.0 `Float64`, `Int32`; both
+/// `Boolean`, `String`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Type {
+    /// A 64-bit float.
+    Float,
+    /// A 32-bit integer.
+    Integer,
+    /// A Boolean.
+    Boolean,
+    /// A string (the FMU has none).
+    String,
+}
+
 /// Why a call failed: the message the logger gets (naming the field or
 /// the quantity), and whether the instance can go on (`Discard`) or not.
 #[derive(Clone, Debug, PartialEq)]
@@ -67,27 +83,54 @@ pub enum Failure {
     /// The call was refused and changed nothing; the instance goes on
     /// (FMI `Discard` for a step, `Error` for a set or get).
     Refused(String),
+    /// A value reference read or written as a type it is not (or set
+    /// though it is not settable): refused as [`Failure::Refused`].
+    NotOfType {
+        /// The value reference.
+        vr: u32,
+        /// The type the call reads or writes.
+        ty: Type,
+        /// The call writes.
+        settable: bool,
+    },
     /// The instance cannot go on without a reset or an earlier state.
     Broken(String),
 }
 
 impl Failure {
-    /// The message.
-    pub fn message(&self) -> &str {
+    /// The message, the types named by `type_name` (the FMI version's).
+    pub fn message(&self, type_name: impl Fn(Type) -> &'static str) -> String {
         match self {
-            Failure::Refused(m) | Failure::Broken(m) => m,
+            Failure::Refused(m) | Failure::Broken(m) => m.clone(),
+            Failure::NotOfType { ty: Type::String, .. } => "this FMU has no String variable".into(),
+            Failure::NotOfType { vr, ty, settable } => {
+                let name = type_name(*ty);
+                let article = if !settable && name.starts_with(['A', 'E', 'I', 'O', 'U']) {
+                    "an"
+                } else {
+                    "a"
+                };
+                format!(
+                    "value reference {vr}: not {article}{} {name}",
+                    if *settable { " settable" } else { "" }
+                )
+            }
         }
     }
 }
 
 /// The values settable before initialisation: every parameter-file field
-/// (in [`fields`] order) and whether the `[machine]` section is present.
+/// (in [`fields`] order) and whether the `[machine]` section is present;
+/// with the packaged file's `[tolerances]`, which are no variables (the
+/// uncertainty table the estimator settings are built with needs them).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Setup {
     /// Field values, in [`fields`] order.
     pub values: [f64; FIELD_COUNT],
     /// The `[machine]` section is used (`machine.present`).
     pub machine_present: bool,
+    /// The packaged file's standard uncertainties and correlations.
+    pub tolerances: RawTolerances,
 }
 
 /// Start values of the `[machine]` fields for a file without that section
@@ -107,10 +150,12 @@ impl Setup {
             .map(|n| n.value)
             .chain(machine.unwrap_or(NO_MACHINE))
             .chain(raw.estimator.named().into_array().iter().map(|n| n.value))
+            .chain(raw.probe.named().into_array().iter().map(|n| n.value))
             .collect();
         Setup {
             values: values.try_into().expect("one value per field"),
             machine_present: raw.machine.is_some(),
+            tolerances: raw.tolerances,
         }
     }
 
@@ -130,18 +175,38 @@ impl Setup {
             }
             Some(self.values[i])
         })
+        .map(|raw| RawParams {
+            tolerances: self.tolerances,
+            ..raw
+        })
         .map_err(|e| e.to_string())
     }
 }
 
-/// Results that depend on the temperature only (what the estimator's jobs
-/// keep).
+/// The port pressures `(p_supply, p_outlet)` [Pa] of a parameter set: the
+/// inputs' start values (`operating.outlet_pressure + pressure_drop`,
+/// `operating.outlet_pressure`).
+pub fn pressures_start(raw: &RawParams) -> (f64, f64) {
+    let c = &raw.core;
+    (c.outlet_pressure + c.pressure_drop, c.outlet_pressure)
+}
+
+/// Results that depend on the temperature and the port pressures only
+/// (what the estimator's jobs keep).
 #[derive(Clone, Copy, Debug)]
 struct Statics {
     flows: FlowLaws<f32>,
     stable: bool,
     /// The machine's losses [m^3/s] (NaN without a machine).
     losses: f32,
+}
+
+/// What the twin's coefficients were last set from: the oil temperature
+/// [C] and the port pressures `(p_supply, p_outlet)` [Pa].
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Applied {
+    t: f32,
+    pressures: (f32, f32),
 }
 
 /// An initialised instance: the twin and what it needs.
@@ -151,20 +216,21 @@ struct Sim {
     params: Params<f32>,
     estimator: EstimatorConfig,
     twin: Twin<f32, f32>,
+    /// The configured tick [s] (the chooser's; a communication step that
+    /// is not whole ticks runs shorter ones, `Twin::set_tick`).
+    tick: f64,
     monotonic: bool,
-    slot_window_factor: f32,
     machine_mu_ref: f32,
     /// Temperature the twin was built at [C].
     t_init: f32,
-    /// Temperature of the twin's coefficients [C].
-    applied: f32,
+    /// Temperature and pressures of the twin's coefficients.
+    applied: Applied,
     statics: Statics,
-    /// The last temperature-only results could not be computed at
-    /// `applied` (the previous ones stand, flagged `DEGRADED`, until they
-    /// can).
+    /// The last results could not be computed at `applied` (the previous
+    /// ones stand, flagged `DEGRADED`, until they can).
     stale: bool,
-    ticks: u64,
-    start_time: f64,
+    /// The instance's time [s]: the end of the last communication step.
+    time: f64,
     flags: Flags,
     outputs: [f64; 10],
 }
@@ -173,16 +239,30 @@ fn model_error(what: &str, e: ModelError) -> String {
     format!("{what}: {e}")
 }
 
+/// The inputs of one communication step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inputs {
+    /// Oil temperature [C].
+    pub t_oil: f64,
+    /// Supply pressure [Pa].
+    pub p_supply: f64,
+    /// Outlet pressure [Pa].
+    pub p_outlet: f64,
+}
+
 impl Sim {
+    /// The twin at rest at `inputs` (the equilibrium of the oil
+    /// temperature at the port pressures). `chosen`: a configuration
+    /// already chosen for these parameters.
     fn new(
         setup: &Setup,
-        t_oil: f64,
+        inputs: Inputs,
         start_time: f64,
         chosen: Option<(&RawParams, TwinConfig)>,
     ) -> Result<Sim, String> {
         let raw = setup.to_raw()?;
         let params = Params::<f32>::new(&raw).map_err(|e| e.to_string())?;
-        let estimator = EstimatorConfig::new(&raw.estimator).map_err(|e| e.to_string())?;
+        let estimator = EstimatorConfig::new(&raw).map_err(|e| e.to_string())?;
         let config = match chosen {
             Some((r, c)) if *r == raw => c,
             _ => {
@@ -202,6 +282,7 @@ impl Sim {
                     .config
             }
         };
+        let t_oil = inputs.t_oil;
         let t = t_oil as f32;
         if !(t.is_finite() && estimator.oil.contains(t)) {
             return Err(format!(
@@ -209,7 +290,34 @@ impl Sim {
                 estimator.oil.min, estimator.oil.max
             ));
         }
-        let twin = Twin::new(&params, config, t).map_err(|e| model_error(&format!("T_oil = {t_oil} degC"), e))?;
+        let pressures = (inputs.p_supply as f32, inputs.p_outlet as f32);
+        if !(pressures.0.is_finite() && pressures.1.is_finite() && pressures.0 > pressures.1) {
+            return Err(format!(
+                "p_supply = {} Pa, p_outlet = {} Pa: at the end of initialisation the supply must exceed the outlet \
+                 (the twin starts at rest in the equilibrium there)",
+                inputs.p_supply, inputs.p_outlet
+            ));
+        }
+        let mut twin = Twin::new(&params, config, t).map_err(|e| model_error(&format!("T_oil = {t_oil} degC"), e))?;
+        let designed = (params.pressure_drop + params.outlet_pressure, params.outlet_pressure);
+        if pressures != designed {
+            let at = pressures_of(&params, pressures);
+            let eq = equilibrium(&at, t).map_err(|e| model_error("the equilibrium at p_supply, p_outlet", e))?;
+            twin.set_pressures(pressures.0, pressures.1)
+                .map_err(|e| model_error("p_supply, p_outlet", e))?;
+            twin.set_state(&DynamicState {
+                x: eq.x,
+                v: 0.0,
+                p_a: eq.p_a,
+                p_b: eq.p_b,
+            });
+            // At rest: no transient to grade.
+            let memory = twin.memory();
+            twin.restore(&TwinMemory {
+                abrupt: false,
+                ..memory
+            });
+        }
         let monotonic = asymptotic::monotonicity(&params, estimator.valid.min, estimator.valid.max, 201)
             .map(|m| m.monotonic)
             .unwrap_or(false);
@@ -223,17 +331,17 @@ impl Sim {
             }
             None => f32::NAN,
         };
-        let slot_window_factor = params.slot.window_factor(params.pressure_drop);
+        let applied = Applied { t, pressures };
         let mut sim = Sim {
             raw,
             params,
             estimator,
             twin,
+            tick: config.tick,
             monotonic,
-            slot_window_factor,
             machine_mu_ref,
             t_init: t,
-            applied: t,
+            applied,
             statics: Statics {
                 flows: FlowLaws {
                     capillary_conductance: 0.0,
@@ -244,39 +352,44 @@ impl Sim {
                 losses: f32::NAN,
             },
             stale: false,
-            ticks: 0,
-            start_time,
+            time: start_time,
             flags: Flags::empty(),
             outputs: [f64::NAN; 10],
         };
         sim.statics = sim
-            .statics_at(t)
+            .statics_at(applied)
             .map_err(|e| model_error(&format!("T_oil = {t_oil} degC"), e))?;
         let flags = sim.base_flags();
         sim.publish(flags);
         Ok(sim)
     }
 
-    /// The estimator's temperature-only jobs at `t` [C] (Fluid, Equilibrium,
-    /// Stability, Losses: `compensator::estimator`), with the twin's
-    /// current coefficients.
-    fn statics_at(&self, t: f32) -> Result<Statics, ModelError> {
-        let p = &self.params;
-        let point = p.oil.point(t)?;
+    /// The estimator's jobs at `at` (Fluid, Equilibrium, Stability,
+    /// Losses: `compensator::estimator`), with the twin's current
+    /// coefficients; the flow laws at the port pressures. Stability needs
+    /// an equilibrium, which a drop that is not positive has not: it keeps
+    /// its last verdict then.
+    fn statics_at(&self, at: Applied) -> Result<Statics, ModelError> {
+        let p = &pressures_of(&self.params, at.pressures);
+        let point = p.oil.point(at.t)?;
         let flows = FlowLaws::new(
             &p.capillary,
             &p.orifice,
-            self.slot_window_factor,
+            p.slot.window_factor(p.pressure_drop),
             point.state.density,
             point.state.dynamic_viscosity,
         );
-        let eq = equilibrium_for(p, point.state, a_parameter(p, &point.state))?;
-        let y_equilibrium: [f32; 4] = self.twin.model().equilibrium_state(&eq);
-        let sys = Fsi {
-            coefficients: self.twin.coefficients(),
-            contact: Contact::Free,
+        let stable = if p.pressure_drop > 0.0 {
+            let eq = equilibrium_for(p, point.state, a_parameter(p, &point.state))?;
+            let y_equilibrium: [f32; 4] = self.twin.model().equilibrium_state(&eq);
+            let sys = Fsi {
+                coefficients: self.twin.coefficients(),
+                contact: Contact::Free,
+            };
+            quartic_hurwitz(&characteristic_polynomial(&sys.jacobian(&y_equilibrium)))
+        } else {
+            self.statics.stable
         };
-        let stable = quartic_hurwitz(&characteristic_polynomial(&sys.jacobian(&y_equilibrium)));
         let losses = match &p.machine {
             Some(m) => compensation::losses_for(m, self.machine_mu_ref, point.state.dynamic_viscosity)?,
             None => f32::NAN,
@@ -284,13 +397,17 @@ impl Sim {
         Ok(Statics { flows, stable, losses })
     }
 
-    /// Flags that follow from the design and the applied temperature.
+    /// Flags that follow from the design, the applied temperature and the
+    /// applied drop (outside `operating.pressure_drop`'s plausible range:
+    /// out of the model's range, as a temperature outside the validated one).
     fn base_flags(&self) -> Flags {
         let mut flags = Flags::empty();
         if !self.monotonic {
             flags.insert(Flags::NOT_UNIQUE);
         }
-        if !self.estimator.valid.contains(self.applied) {
+        let drop = (self.applied.pressures.0 - self.applied.pressures.1) as f64;
+        let drop_in_range = (DROP_FIELD.min..=DROP_FIELD.max).contains(&drop);
+        if !(self.estimator.valid.contains(self.applied.t) && drop_in_range) {
             flags.insert(Flags::OUT_OF_RANGE);
         }
         if !self.statics.stable {
@@ -308,8 +425,9 @@ impl Sim {
         let p = &self.params;
         let st = &self.statics;
         let s = self.twin.state();
-        let q_a = st.flows.capillary_flow(s.p_a - p.outlet_pressure);
-        let q_b = st.flows.orifice_flow(s.p_b - p.outlet_pressure);
+        let outlet = self.applied.pressures.1;
+        let q_a = st.flows.capillary_flow(s.p_a - outlet);
+        let q_b = st.flows.orifice_flow(s.p_b - outlet);
         let q_throt = st.flows.window_flow(s.x);
         let q_total = q_a + q_b + q_throt;
         let error = match &p.machine {
@@ -331,34 +449,16 @@ impl Sim {
         ];
     }
 
-    fn tick(&self) -> f64 {
-        self.twin.config().tick
-    }
-
-    fn time(&self) -> f64 {
-        self.start_time + self.ticks as f64 * self.tick()
-    }
-
-    /// `n` ticks with the oil at `t_oil` [C].
-    fn step(&mut self, t_oil: f64, n: u64) -> Result<(), String> {
+    /// Sets the twin's coefficients for `inputs` where they are usable
+    /// (as `compensator step`: before the ticks; held over the
+    /// communication step); the flags of what was not.
+    fn apply(&mut self, inputs: Inputs) -> Flags {
         let mut flags = Flags::empty();
-        let t = t_oil as f32;
+        let mut next = self.applied;
+        let t = inputs.t_oil as f32;
         if t.is_finite() && self.estimator.oil.contains(t) {
-            // As `compensator step`: the temperature set before each tick
-            // (held over this communication step, so once).
             match self.twin.set_temperature(t) {
-                Ok(()) => {
-                    if t != self.applied || self.stale {
-                        match self.statics_at(t) {
-                            Ok(s) => {
-                                self.statics = s;
-                                self.stale = false;
-                            }
-                            Err(_) => self.stale = true,
-                        }
-                        self.applied = t;
-                    }
-                }
+                Ok(()) => next.t = t,
                 Err(_) => flags.insert(Flags::DEGRADED),
             }
         } else {
@@ -366,15 +466,45 @@ impl Sim {
             // as the estimator flags an unusable sample.
             flags.insert(Flags::SENSOR_FAULT);
         }
+        let pressures = (inputs.p_supply as f32, inputs.p_outlet as f32);
+        if pressures.0.is_finite() && pressures.1.is_finite() {
+            if pressures != self.applied.pressures {
+                match self.twin.set_pressures(pressures.0, pressures.1) {
+                    Ok(()) => next.pressures = pressures,
+                    Err(_) => flags.insert(Flags::DEGRADED),
+                }
+            }
+        } else {
+            flags.insert(Flags::SENSOR_FAULT);
+        }
+        if next != self.applied || self.stale {
+            match self.statics_at(next) {
+                Ok(s) => {
+                    self.statics = s;
+                    self.stale = false;
+                }
+                Err(_) => self.stale = true,
+            }
+            self.applied = next;
+        }
+        flags
+    }
+
+    /// `n` ticks of `tick` [s] with the inputs held.
+    fn step(&mut self, inputs: Inputs, n: u64, tick: f64) -> Result<(), String> {
+        let mut flags = self.apply(inputs);
+        if self.twin.config().tick != tick {
+            self.twin
+                .set_tick(tick)
+                .map_err(|e| model_error(&format!("a tick of {tick} s"), e))?;
+        }
         for _ in 0..n {
             if self.twin.tick().is_err() {
                 // As the estimator: a failed tick (never seen with valid
                 // parameters) restarts the twin at rest in the equilibrium.
-                self.twin = Twin::new(&self.params, self.twin.config(), self.applied)
-                    .map_err(|e| model_error(&format!("restarting the twin at {} degC", self.applied), e))?;
+                self.restart()?;
                 flags.insert(Flags::DEGRADED);
             }
-            self.ticks += 1;
         }
         if self.stale {
             flags.insert(Flags::DEGRADED);
@@ -384,7 +514,46 @@ impl Sim {
         self.publish(all);
         Ok(())
     }
+
+    /// A new twin at rest in the equilibrium of the applied temperature and
+    /// the design's drop, given the applied pressures and the current tick.
+    fn restart(&mut self) -> Result<(), String> {
+        let what = || format!("restarting the twin at {} degC", self.applied.t);
+        let tick = self.twin.config().tick;
+        let mut twin = Twin::new(
+            &self.params,
+            TwinConfig {
+                tick: self.tick,
+                ..self.twin.config()
+            },
+            self.applied.t,
+        )
+        .map_err(|e| model_error(&what(), e))?;
+        let (ps, po) = self.applied.pressures;
+        twin.set_pressures(ps, po).map_err(|e| model_error(&what(), e))?;
+        twin.set_tick(tick).map_err(|e| model_error(&what(), e))?;
+        self.twin = twin;
+        Ok(())
+    }
 }
+
+/// The parameters with the port pressures `(p_supply, p_outlet)` [Pa] as
+/// the design's operating point (for the closed forms at the current drop).
+fn pressures_of(params: &Params<f32>, (supply, outlet): (f32, f32)) -> Params<f32> {
+    Params {
+        pressure_drop: supply - outlet,
+        outlet_pressure: outlet,
+        ..*params
+    }
+}
+
+/// The schema's `operating.pressure_drop` (its plausible range bounds the
+/// drops the flags call in range).
+static DROP_FIELD: std::sync::LazyLock<&'static compensator_params::Field> = std::sync::LazyLock::new(|| {
+    fields()
+        .find(|f| f.path == "operating.pressure_drop")
+        .expect("the schema has operating.pressure_drop")
+});
 
 /// One FMU instance.
 #[derive(Clone, Debug)]
@@ -394,12 +563,18 @@ pub struct Instance {
     setup: Setup,
     t_oil_start: f64,
     t_oil: f64,
+    /// The pressure inputs as set (`None`: never set since instantiation or
+    /// reset, so at their start values: the operating point of the current
+    /// parameters).
+    p_supply: Option<f64>,
+    p_outlet: Option<f64>,
     start_time: f64,
     phase: Phase,
     sim: Option<Sim>,
 }
 
-/// Tolerance on a communication step's length, as a fraction of the tick.
+/// Tolerance on a communication step's length, as a fraction of the tick:
+/// a step within it of a whole number of ticks is that many ticks.
 const STEP_TOLERANCE: f64 = 1e-6;
 
 /// Most ticks one communication step may take (10,000 s at 1 kHz, a few
@@ -407,9 +582,28 @@ const STEP_TOLERANCE: f64 = 1e-6;
 /// run for hours.
 pub const MAX_TICKS_PER_STEP: f64 = 1e7;
 
+/// How the twin takes a communication step of `h` [s] with configured
+/// tick `tick` [s]: `(n, tick')`, `n` ticks of `tick'`. A whole number of
+/// ticks (within [`STEP_TOLERANCE`] of a tick) is that many configured
+/// ticks; any other step is `ceil(h / tick)` equal ticks of `h / n`, each
+/// shorter than the configured one (the same substeps, so at least as
+/// accurate): the step ends exactly at `t + h`. `None` for a step that is
+/// not positive and finite.
+pub fn ticks_for(h: f64, tick: f64) -> Option<(f64, f64)> {
+    if !(h.is_finite() && h > 0.0) {
+        return None;
+    }
+    let whole = (h / tick).round();
+    if whole >= 1.0 && (h - whole * tick).abs() <= STEP_TOLERANCE * tick {
+        return Some((whole, tick));
+    }
+    let n = (h / tick).ceil().max(1.0);
+    Some((n, h / n))
+}
+
 impl Instance {
     /// An instance with the values of `raw` (the packaged parameter file),
-    /// the input at its start value.
+    /// the inputs at their start values.
     pub fn new(raw: &RawParams) -> Instance {
         let setup = Setup::from_raw(raw);
         let t = t_oil_start(raw);
@@ -418,6 +612,8 @@ impl Instance {
             setup,
             t_oil_start: t,
             t_oil: t,
+            p_supply: None,
+            p_outlet: None,
             start_time: 0.0,
             phase: Phase::Instantiated,
             sim: None,
@@ -439,6 +635,23 @@ impl Instance {
         self.sim.as_ref().map(|s| s.twin.config())
     }
 
+    /// The inputs as they stand: `p_supply`, `p_outlet` at their start
+    /// values (the current parameters' operating point) until set.
+    pub fn inputs(&self) -> Inputs {
+        let value = |path: &str| {
+            fields()
+                .position(|f| f.path == path)
+                .map_or(f64::NAN, |i| self.setup.values[i])
+        };
+        let outlet = value("operating.outlet_pressure");
+        let p_outlet = self.p_outlet.unwrap_or(outlet);
+        Inputs {
+            t_oil: self.t_oil,
+            p_supply: self.p_supply.unwrap_or(outlet + value("operating.pressure_drop")),
+            p_outlet,
+        }
+    }
+
     fn settable(&self, name: &str) -> Result<(), Failure> {
         match self.phase {
             Phase::Instantiated | Phase::Initialization => Ok(()),
@@ -448,30 +661,39 @@ impl Instance {
         }
     }
 
-    /// Sets a Float64 variable: the input `T_oil` (any time before
-    /// termination) or a parameter (before exit-initialization, checked
-    /// against the field's own rule at once; the rules between fields are
-    /// checked when initialisation ends).
+    /// Sets a Float64 variable: an input (any time before termination) or
+    /// a parameter (before exit-initialization, checked against the
+    /// field's own rule at once; the rules between fields are checked when
+    /// initialisation ends).
     ///
     /// # Errors
     ///
     /// An unknown or read-only value reference, a parameter set too late,
     /// or a value the field refuses (the message names the field).
     pub fn set_real(&mut self, vr: u32, value: f64) -> Result<(), Failure> {
-        if vr == VR_T_OIL {
+        if let Some(k) = input_of(vr) {
             if self.phase == Phase::Terminated {
-                return Err(Failure::Refused("T_oil: the instance is terminated".into()));
+                return Err(Failure::Refused(format!(
+                    "{}: the instance is terminated",
+                    INPUTS[k].name
+                )));
             }
-            self.t_oil = value;
+            match vr {
+                VR_P_SUPPLY => self.p_supply = Some(value),
+                VR_P_OUTLET => self.p_outlet = Some(value),
+                _ => self.t_oil = value,
+            }
             if self.phase == Phase::Initialization {
                 self.sim = None;
             }
             return Ok(());
         }
         let Some((i, field)) = field_of(vr) else {
-            return Err(Failure::Refused(format!(
-                "value reference {vr}: not a settable Float64"
-            )));
+            return Err(Failure::NotOfType {
+                vr,
+                ty: Type::Float,
+                settable: true,
+            });
         };
         self.settable(field.path)?;
         let v = field.check(value).map_err(|e| Failure::Refused(e.to_string()))?;
@@ -487,9 +709,11 @@ impl Instance {
     /// Another value reference, or a set after initialisation.
     pub fn set_boolean(&mut self, vr: u32, value: bool) -> Result<(), Failure> {
         if vr != VR_MACHINE_PRESENT {
-            return Err(Failure::Refused(format!(
-                "value reference {vr}: not a settable Boolean"
-            )));
+            return Err(Failure::NotOfType {
+                vr,
+                ty: Type::Boolean,
+                settable: true,
+            });
         }
         self.settable("machine.present")?;
         self.setup.machine_present = value;
@@ -500,13 +724,14 @@ impl Instance {
     /// Builds the twin from the current values when it is not built.
     fn ensure_sim(&mut self) -> Result<&mut Sim, Failure> {
         if self.sim.is_none() {
-            self.sim = Some(Sim::new(&self.setup, self.t_oil, self.start_time, None).map_err(Failure::Refused)?);
+            let inputs = self.inputs();
+            self.sim = Some(Sim::new(&self.setup, inputs, self.start_time, None).map_err(Failure::Refused)?);
         }
         Ok(self.sim.as_mut().expect("built above"))
     }
 
-    /// Reads a Float64: time, the input, an output (from initialization
-    /// mode on: the twin at rest at `T_oil` until the first step) or a
+    /// Reads a Float64: time, an input, an output (from initialization
+    /// mode on: the twin at rest at the inputs until the first step) or a
     /// parameter.
     ///
     /// # Errors
@@ -514,8 +739,13 @@ impl Instance {
     /// An unknown value reference, an output read before initialization
     /// mode, or (in initialization mode) values that do not initialise.
     pub fn get_real(&mut self, vr: u32) -> Result<f64, Failure> {
-        if vr == VR_T_OIL {
-            return Ok(self.t_oil);
+        if input_of(vr).is_some() {
+            let i = self.inputs();
+            return Ok(match vr {
+                VR_P_SUPPLY => i.p_supply,
+                VR_P_OUTLET => i.p_outlet,
+                _ => i.t_oil,
+            });
         }
         if let Some((i, _)) = field_of(vr) {
             return Ok(self.setup.values[i]);
@@ -523,9 +753,13 @@ impl Instance {
         let out = vr.wrapping_sub(VR_FIRST_OUTPUT) as usize;
         if vr == VR_TIME || (out < OUTPUTS.len() && out != FLAGS_OUTPUT) {
             let sim = self.initialised_sim(vr)?;
-            return Ok(if vr == VR_TIME { sim.time() } else { sim.outputs[out] });
+            return Ok(if vr == VR_TIME { sim.time } else { sim.outputs[out] });
         }
-        Err(Failure::Refused(format!("value reference {vr}: not a Float64")))
+        Err(Failure::NotOfType {
+            vr,
+            ty: Type::Float,
+            settable: false,
+        })
     }
 
     fn initialised_sim(&mut self, vr: u32) -> Result<&mut Sim, Failure> {
@@ -548,7 +782,11 @@ impl Instance {
     /// Another value reference, or as [`Instance::get_real`].
     pub fn get_integer(&mut self, vr: u32) -> Result<i32, Failure> {
         if vr != VR_FIRST_OUTPUT + FLAGS_OUTPUT as u32 {
-            return Err(Failure::Refused(format!("value reference {vr}: not an integer")));
+            return Err(Failure::NotOfType {
+                vr,
+                ty: Type::Integer,
+                settable: false,
+            });
         }
         Ok(self.initialised_sim(vr)?.flags.0 as i32)
     }
@@ -560,7 +798,11 @@ impl Instance {
     /// Another value reference.
     pub fn get_boolean(&self, vr: u32) -> Result<bool, Failure> {
         if vr != VR_MACHINE_PRESENT {
-            return Err(Failure::Refused(format!("value reference {vr}: not a Boolean")));
+            return Err(Failure::NotOfType {
+                vr,
+                ty: Type::Boolean,
+                settable: false,
+            });
         }
         Ok(self.setup.machine_present)
     }
@@ -586,12 +828,13 @@ impl Instance {
     }
 
     /// Leaves initialization mode: validates the parameters, chooses the
-    /// twin's configuration and puts the twin at rest at `T_oil`.
+    /// twin's configuration and puts the twin at rest at the inputs.
     ///
     /// # Errors
     ///
     /// A parameter the validation refuses (the message names the field), a
-    /// `T_oil` outside the oil model's range, or not in initialization mode.
+    /// `T_oil` outside the oil model's range, a supply pressure not above
+    /// the outlet's, or not in initialization mode.
     pub fn exit_initialization(&mut self) -> Result<(), Failure> {
         if self.phase != Phase::Initialization {
             return Err(Failure::Refused(
@@ -603,49 +846,53 @@ impl Instance {
         Ok(())
     }
 
-    /// Advances from `time` [s] by `h` [s]: `h / tick` ticks of the twin
-    /// with the oil at `T_oil` throughout.
+    /// Advances from `time` [s] by `h` [s] with the inputs held: whole
+    /// ticks of the twin, or, for a step that is not whole ticks (shorter
+    /// than one, or between two counts), equal shorter ticks that end
+    /// exactly at `time + h` ([`ticks_for`]).
     ///
     /// # Errors
     ///
-    /// `Refused` (nothing done: FMI `Discard`) for a step that is not a
-    /// whole, positive number of ticks (at most [`MAX_TICKS_PER_STEP`]) or
-    /// does not start at the instance's time; `Broken` for a twin that cannot be restarted.
+    /// `Refused` (nothing done: FMI `Discard`) for a step that is not
+    /// positive and finite, takes more than [`MAX_TICKS_PER_STEP`] ticks or
+    /// does not start at the instance's time; `Broken` for a twin that
+    /// cannot be restarted.
     pub fn do_step(&mut self, time: f64, h: f64) -> Result<(), Failure> {
         if self.phase != Phase::Step {
             return Err(Failure::Broken(
                 "do step: only in step mode (after exit initialization)".into(),
             ));
         }
-        let t_oil = self.t_oil;
+        let inputs = self.inputs();
         let sim = self
             .sim
             .as_mut()
             .ok_or_else(|| Failure::Broken("do step: not initialised".into()))?;
-        let tick = sim.tick();
-        let n = (h / tick).round();
-        if !(h.is_finite() && n >= 1.0 && (h - n * tick).abs() <= STEP_TOLERANCE * tick) {
+        let Some((n, tick)) = ticks_for(h, sim.tick) else {
             return Err(Failure::Refused(format!(
-                "communication step {h} s is not a whole multiple of the twin's tick {tick} s (estimator.tick_hz)"
+                "communication step {h} s: must be positive and finite"
             )));
-        }
+        };
         if n > MAX_TICKS_PER_STEP {
             return Err(Failure::Refused(format!(
-                "communication step {h:e} s is more than {MAX_TICKS_PER_STEP} ticks of {tick} s: take shorter steps"
+                "communication step {h:e} s is more than {MAX_TICKS_PER_STEP} ticks of {} s: take shorter steps",
+                sim.tick
             )));
         }
-        let now = sim.time();
-        if !((time - now).abs() <= 0.25 * tick) {
+        let now = sim.time;
+        if !((time - now).abs() <= STEP_TOLERANCE * sim.tick + 1e-12 * now.abs()) {
             return Err(Failure::Refused(format!(
                 "communication point {time} s is not the instance's time {now} s"
             )));
         }
-        sim.step(t_oil, n as u64).map_err(Failure::Broken)
+        sim.step(inputs, n as u64, tick).map_err(Failure::Broken)?;
+        sim.time = time + h;
+        Ok(())
     }
 
-    /// The twin's tick [s] once initialised.
+    /// The twin's configured tick [s] once initialised.
     pub fn tick(&self) -> Option<f64> {
-        self.sim.as_ref().map(Sim::tick)
+        self.sim.as_ref().map(|s| s.tick)
     }
 
     /// Terminates.
@@ -654,16 +901,18 @@ impl Instance {
     }
 
     /// Back to the freshly instantiated state (the packaged parameters,
-    /// the input's start value).
+    /// the inputs' start values).
     pub fn reset(&mut self) {
         self.setup = self.start;
         self.t_oil = self.t_oil_start;
+        self.p_supply = None;
+        self.p_outlet = None;
         self.start_time = 0.0;
         self.sim = None;
         self.phase = Phase::Instantiated;
     }
 
-    /// The instance's state as bytes: phase, parameters, input and (once
+    /// The instance's state as bytes: phase, parameters, inputs and (once
     /// initialised) the twin's memory and outputs. [`Instance::deserialize`]
     /// restores it exactly.
     pub fn serialize(&self) -> Vec<u8> {
@@ -676,14 +925,21 @@ impl Instance {
             b.extend_from_slice(&v.to_le_bytes());
         }
         b.extend_from_slice(&self.t_oil.to_le_bytes());
+        for p in [self.p_supply, self.p_outlet] {
+            b.push(p.is_some() as u8);
+            b.extend_from_slice(&p.unwrap_or(0.0).to_le_bytes());
+        }
         b.extend_from_slice(&self.start_time.to_le_bytes());
         match &self.sim {
             None => b.push(0),
             Some(s) => {
                 b.push(1);
                 b.extend_from_slice(&s.t_init.to_le_bytes());
-                b.extend_from_slice(&s.applied.to_le_bytes());
-                b.extend_from_slice(&s.ticks.to_le_bytes());
+                b.extend_from_slice(&s.applied.t.to_le_bytes());
+                b.extend_from_slice(&s.applied.pressures.0.to_le_bytes());
+                b.extend_from_slice(&s.applied.pressures.1.to_le_bytes());
+                b.extend_from_slice(&s.time.to_le_bytes());
+                b.extend_from_slice(&s.twin.config().tick.to_le_bytes());
                 let m = s.twin.memory();
                 for v in m.state {
                     b.extend_from_slice(&v.to_le_bytes());
@@ -721,15 +977,27 @@ impl Instance {
         let setup = Setup {
             values,
             machine_present,
+            // Not a variable: the packaged file's, as at instantiation.
+            tolerances: self.start.tolerances,
         };
         let t_oil = r.f64().ok_or_else(bad)?;
+        let mut set = [None; 2];
+        for p in &mut set {
+            let given = r.u8().ok_or_else(bad)? != 0;
+            let v = r.f64().ok_or_else(bad)?;
+            *p = given.then_some(v);
+        }
         let start_time = r.f64().ok_or_else(bad)?;
         let sim = match r.u8().ok_or_else(bad)? {
             0 => None,
             1 => {
                 let t_init = r.f32().ok_or_else(bad)?;
-                let applied = r.f32().ok_or_else(bad)?;
-                let ticks = r.u64().ok_or_else(bad)?;
+                let applied = Applied {
+                    t: r.f32().ok_or_else(bad)?,
+                    pressures: (r.f32().ok_or_else(bad)?, r.f32().ok_or_else(bad)?),
+                };
+                let time = r.f64().ok_or_else(bad)?;
+                let tick = r.f64().ok_or_else(bad)?;
                 let mut state = [0.0f32; 4];
                 for v in &mut state {
                     *v = r.f32().ok_or_else(bad)?;
@@ -741,26 +1009,37 @@ impl Instance {
                 for v in &mut outputs {
                     *v = r.f64().ok_or_else(bad)?;
                 }
-                // The twin rebuilt along the same path (built at t_init,
-                // then given the last temperature), then its memory.
+                // The twin rebuilt along the same path (built at t_init at
+                // the design's pressures, then given the last temperature
+                // and pressures and the last tick), then its memory.
                 let chosen = self.sim.as_ref().map(|s| (&s.raw, s.twin.config()));
-                let mut sim = Sim::new(&setup, t_init as f64, start_time, chosen).map_err(Failure::Refused)?;
-                if applied != t_init {
-                    sim.twin
-                        .set_temperature(applied)
-                        .map_err(|e| Failure::Refused(model_error("FMU state: temperature", e)))?;
-                    match sim.statics_at(applied) {
-                        Ok(st) => sim.statics = st,
-                        Err(_) => sim.stale = true,
-                    }
-                    sim.applied = applied;
+                let raw = setup.to_raw().map_err(Failure::Refused)?;
+                let (ps, po) = pressures_start(&raw);
+                let designed = Inputs {
+                    t_oil: t_init as f64,
+                    p_supply: ps,
+                    p_outlet: po,
+                };
+                let mut sim = Sim::new(&setup, designed, start_time, chosen).map_err(Failure::Refused)?;
+                let restored = sim.apply(Inputs {
+                    t_oil: applied.t as f64,
+                    p_supply: applied.pressures.0 as f64,
+                    p_outlet: applied.pressures.1 as f64,
+                });
+                if sim.applied != applied || !restored.is_empty() {
+                    return Err(Failure::Refused(
+                        "FMU state: its temperature or pressures no longer apply".into(),
+                    ));
                 }
+                sim.twin
+                    .set_tick(tick)
+                    .map_err(|e| Failure::Refused(model_error("FMU state: tick", e)))?;
                 sim.twin.restore(&TwinMemory {
                     state,
                     xi_carry,
                     abrupt,
                 });
-                sim.ticks = ticks;
+                sim.time = time;
                 sim.flags = flags;
                 sim.outputs = outputs;
                 Some(sim)
@@ -773,6 +1052,7 @@ impl Instance {
         self.phase = phase;
         self.setup = setup;
         self.t_oil = t_oil;
+        [self.p_supply, self.p_outlet] = set;
         self.start_time = start_time;
         self.sim = sim;
         Ok(())
@@ -787,7 +1067,7 @@ pub fn t_oil_start(raw: &RawParams) -> f64 {
 
 const MAGIC: &[u8; 4] = b"CFMU";
 /// Version of the state's byte layout.
-const FORMAT: u32 = 1;
+const FORMAT: u32 = 2;
 
 struct Reader<'a> {
     bytes: &'a [u8],
@@ -809,9 +1089,6 @@ impl Reader<'_> {
     fn u32(&mut self) -> Option<u32> {
         Some(u32::from_le_bytes(self.take(4)?.try_into().ok()?))
     }
-    fn u64(&mut self) -> Option<u64> {
-        Some(u64::from_le_bytes(self.take(8)?.try_into().ok()?))
-    }
     fn f32(&mut self) -> Option<f32> {
         Some(f32::from_le_bytes(self.take(4)?.try_into().ok()?))
     }
@@ -823,6 +1100,7 @@ impl Reader<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::variables::VR_T_OIL;
 
     fn preset(name: &str) -> RawParams {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -14,10 +14,14 @@
 //!   twin, the state's serialisation), no statics: instances never share
 //!   state;
 //! * [`description`]: `modelDescription.xml` for either version;
-//! * `fmi2`, `fmi3`: the C interfaces, thin wrappers that log every
-//!   refusal through the importer's logger and never unwind into it (each
-//!   entry point runs under `catch_unwind` as a last guard; nothing in the
-//!   instance panics by design).
+//! * `shell`: the FMI shell both versions share (checked entry points,
+//!   refusals logged through the importer's logger, FMU states) over a
+//!   small per-version trait (names, logger, type names); `fmi2`, `fmi3`:
+//!   the exported C functions, one call into the shell each, differing
+//!   only where the standards do. No entry point unwinds into the importer
+//!   (each runs under `catch_unwind` as a last guard; nothing in the
+//!   instance panics by design);
+//! * [`platforms`]: the platforms an archive can carry a binary for.
 //!
 //! The C interface is written here by hand against the standard's headers
 //! (`fmi2Functions.h`, `fmi3Functions.h`): `fmi-export` exports FMI 3.0
@@ -30,10 +34,12 @@ pub mod description;
 pub mod fmi2;
 pub mod fmi3;
 pub mod instance;
+pub mod platforms;
+mod shell;
 pub mod variables;
 
 use compensator::RawParams;
-use instance::{Failure, Instance};
+use instance::Failure;
 use std::path::{Path, PathBuf};
 
 /// The parameter file inside an FMU's `resources/` folder.
@@ -49,9 +55,17 @@ pub(crate) enum Status {
 }
 
 /// A path from a resource location: a `file:` URI (FMI 2.0:
-/// `file:///tmp/x/resources`, `file:/tmp/x/resources`; percent-escapes
-/// decoded) or a plain path (FMI 3.0's `resourcePath`).
+/// `file:///tmp/x/resources`, `file:/tmp/x/resources`, on Windows
+/// `file:///C:/x/resources`; percent-escapes decoded) or a plain path
+/// (FMI 3.0's `resourcePath`).
 pub fn path_from_location(location: &str) -> Option<PathBuf> {
+    location_path(location, cfg!(windows))
+}
+
+/// [`path_from_location`] for a Windows host (`windows`: a URI's
+/// `/C:/...` is the drive path `C:/...`) or another.
+fn location_path(location: &str, windows: bool) -> Option<PathBuf> {
+    let uri = location.starts_with("file:");
     let rest = match location.strip_prefix("file://") {
         Some(r) => r.strip_prefix("localhost").unwrap_or(r),
         None => location.strip_prefix("file:").unwrap_or(location),
@@ -72,7 +86,15 @@ pub fn path_from_location(location: &str) -> Option<PathBuf> {
             i += 1;
         }
     }
-    Some(PathBuf::from(String::from_utf8(bytes).ok()?))
+    let path = String::from_utf8(bytes).ok()?;
+    let drive = |p: &str| {
+        let b = p.as_bytes();
+        b.len() >= 3 && b[0] == b'/' && b[1].is_ascii_alphabetic() && b[2] == b':'
+    };
+    if windows && uri && drive(&path) {
+        return Some(PathBuf::from(&path[1..]));
+    }
+    Some(PathBuf::from(path))
 }
 
 /// The packaged parameter file of the FMU whose resources are in `dir`.
@@ -112,35 +134,6 @@ pub(crate) fn guarded<T>(f: impl FnOnce() -> Result<T, Failure>) -> Result<T, Fa
     }
 }
 
-/// What both C interfaces keep per instance besides the [`Instance`].
-pub(crate) struct Shell<L> {
-    pub(crate) instance: Instance,
-    pub(crate) name: std::ffi::CString,
-    pub(crate) logger: L,
-    pub(crate) logging_on: bool,
-    /// An earlier call broke the instance: only reset, a state or free.
-    pub(crate) broken: bool,
-    /// Start time from `fmi2SetupExperiment` [s] (FMI 3.0 passes it to
-    /// enter-initialization directly).
-    pub(crate) start_time: f64,
-}
-
-impl<L> Shell<L> {
-    /// What a log with debug logging on says after initialisation.
-    pub(crate) fn initialised_note(&self) -> Option<String> {
-        if !self.logging_on {
-            return None;
-        }
-        let c = self.instance.twin_config()?;
-        Some(format!(
-            "initialised: the twin runs {}, {} substep(s) per {} s tick (the core's chooser for these parameters)",
-            c.scheme.name(),
-            c.substeps,
-            c.tick
-        ))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -156,5 +149,12 @@ mod tests {
         assert_eq!(path_from_location("/tmp/x/"), Some("/tmp/x/".into()));
         assert_eq!(path_from_location(""), None);
         assert_eq!(path_from_location("file:///tmp/%zz"), None);
+        assert_eq!(
+            location_path("file:///C:/Users/a%20b/resources", true),
+            Some("C:/Users/a b/resources".into())
+        );
+        assert_eq!(location_path("file:///C:/x", false), Some("/C:/x".into()));
+        assert_eq!(location_path("file:///tmp/x", true), Some("/tmp/x".into()));
+        assert_eq!(location_path("Z:\\tmp\\x", true), Some("Z:\\tmp\\x".into()));
     }
 }

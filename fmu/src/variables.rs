@@ -4,13 +4,49 @@
 //! `MACHINE_FIELDS`, `ESTIMATOR_FIELDS`): names, units, descriptions and
 //! plausible ranges are never restated here.
 
-use compensator_params::{CORE_FIELDS, ESTIMATOR_FIELDS, Field, Kind, MACHINE_FIELDS};
+use compensator_params::{CORE_FIELDS, ESTIMATOR_FIELDS, Field, Kind, MACHINE_FIELDS, PROBE_FIELDS};
 
 /// Value reference of the independent variable `time` [s] (declared in
 /// FMI 3.0 only, where it is required).
 pub const VR_TIME: u32 = 0;
 /// Value reference of the input `T_oil` [degC].
 pub const VR_T_OIL: u32 = 1;
+/// Value reference of the input `p_supply` [Pa].
+pub const VR_P_SUPPLY: u32 = 2;
+/// Value reference of the input `p_outlet` [Pa].
+pub const VR_P_OUTLET: u32 = 3;
+
+/// The inputs (continuous Float64s, held over a communication step), in
+/// value-reference order from [`VR_T_OIL`].
+pub const INPUTS: [Variable; 3] = [
+    Variable {
+        name: "T_oil",
+        unit: Some("degC"),
+        doc: "Oil temperature. Outside estimator.oil_min..oil_max it is not used (the twin keeps the last one, flag \
+              SENSOR_FAULT); its value at the end of initialisation is where the twin starts at rest. Start: the \
+              middle of the validated range.",
+    },
+    Variable {
+        name: "p_supply",
+        unit: Some("Pa"),
+        doc: "Supply (inlet) pressure p_p. Not finite: not used (the twin keeps the last pressures, flag SENSOR_FAULT); \
+              at the end of initialisation it must exceed p_outlet. Start: operating.outlet_pressure + \
+              operating.pressure_drop.",
+    },
+    Variable {
+        name: "p_outlet",
+        unit: Some("Pa"),
+        doc: "Outlet pressure p_c (the circuit downstream). Not finite: not used (the twin keeps the last pressures, \
+              flag SENSOR_FAULT). Start: operating.outlet_pressure.",
+    },
+];
+
+/// The input of value reference `vr`, with its index in [`INPUTS`].
+pub fn input_of(vr: u32) -> Option<usize> {
+    let i = vr.checked_sub(VR_T_OIL)? as usize;
+    (i < INPUTS.len()).then_some(i)
+}
+
 /// Value reference of the first output (`x`); the outputs follow in
 /// [`OUTPUTS`] order.
 pub const VR_FIRST_OUTPUT: u32 = 10;
@@ -20,9 +56,9 @@ pub const VR_MACHINE_PRESENT: u32 = 100;
 /// [`fields`] order (core, machine, estimator: file order).
 pub const VR_FIRST_FIELD: u32 = 1000;
 
-/// An output of the twin.
+/// An input or an output of the twin.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Output {
+pub struct Variable {
     /// Variable name.
     pub name: &'static str,
     /// FMI unit name (`None`: an integer, no unit).
@@ -33,53 +69,53 @@ pub struct Output {
 
 /// The outputs, in value-reference order from [`VR_FIRST_OUTPUT`]; the last
 /// (`flags`) is an integer, the others are Float64.
-pub const OUTPUTS: [Output; 10] = [
-    Output {
+pub const OUTPUTS: [Variable; 10] = [
+    Variable {
         name: "x",
         unit: Some("m"),
         doc: "Plunger displacement (0: window closed).",
     },
-    Output {
+    Variable {
         name: "v",
         unit: Some("m/s"),
         doc: "Plunger velocity.",
     },
-    Output {
+    Variable {
         name: "p_a",
         unit: Some("Pa"),
         doc: "Chamber (a) pressure.",
     },
-    Output {
+    Variable {
         name: "p_b",
         unit: Some("Pa"),
         doc: "Chamber (b) pressure.",
     },
-    Output {
+    Variable {
         name: "Q_a",
         unit: Some("m3/s"),
         doc: "Flow leaving chamber (a) through its capillary.",
     },
-    Output {
+    Variable {
         name: "Q_b",
         unit: Some("m3/s"),
         doc: "Flow leaving chamber (b) through its orifice.",
     },
-    Output {
+    Variable {
         name: "Q_throt",
         unit: Some("m3/s"),
         doc: "Flow through the window opened by the plunger.",
     },
-    Output {
+    Variable {
         name: "Q0",
         unit: Some("m3/s"),
         doc: "Total flow Q0 = Q_a + Q_b + Q_throt.",
     },
-    Output {
+    Variable {
         name: "compensation_error",
         unit: Some("m3/s"),
         doc: "Q0 - (Q_work + dQ_lost(T)) of the driven machine; NaN when machine.present is false.",
     },
-    Output {
+    Variable {
         name: "flags",
         unit: None,
         doc: "Estimator flags, a bit set: 1 AT_STOP, 2 OUT_OF_RANGE, 4 NOT_UNIQUE, 8 UNSTABLE, 16 SENSOR_FAULT, 64 DEGRADED (docs/fmu.md).",
@@ -89,16 +125,19 @@ pub const OUTPUTS: [Output; 10] = [
 /// Index of `flags` in [`OUTPUTS`].
 pub const FLAGS_OUTPUT: usize = 9;
 
-/// The parameter file's fields in file order: core, machine, estimator.
+/// The parameter file's fields in file order: core, machine, estimator,
+/// probe (its `[tolerances]` are not variables: they travel with the
+/// packaged file, [`crate::instance::Setup`]).
 pub fn fields() -> impl Iterator<Item = &'static Field> {
     CORE_FIELDS
         .iter()
         .chain(MACHINE_FIELDS.iter())
         .chain(ESTIMATOR_FIELDS.iter())
+        .chain(PROBE_FIELDS.iter())
 }
 
 /// Number of parameter-file fields.
-pub const FIELD_COUNT: usize = CORE_FIELDS.len() + MACHINE_FIELDS.len() + ESTIMATOR_FIELDS.len();
+pub const FIELD_COUNT: usize = CORE_FIELDS.len() + MACHINE_FIELDS.len() + ESTIMATOR_FIELDS.len() + PROBE_FIELDS.len();
 
 /// The field of value reference `vr`, with its index in [`fields`] order.
 pub fn field_of(vr: u32) -> Option<(usize, &'static Field)> {
@@ -136,7 +175,7 @@ const fn unit(name: &'static str, exponents: [i8; 8]) -> Unit {
 }
 
 /// Every unit the FMU declares: the schema's units and the outputs'.
-pub const UNITS: [Unit; 16] = [
+pub const UNITS: [Unit; 17] = [
     unit("m", [0, 1, 0, 0, 0, 0, 0, 0]),
     unit("m/s", [0, 1, -1, 0, 0, 0, 0, 0]),
     unit("Pa", [1, -1, -2, 0, 0, 0, 0, 0]),
@@ -151,6 +190,7 @@ pub const UNITS: [Unit; 16] = [
     unit("N/m", [1, 0, -2, 0, 0, 0, 0, 0]),
     unit("s", [0, 0, 1, 0, 0, 0, 0, 0]),
     unit("Hz", [0, 0, -1, 0, 0, 0, 0, 0]),
+    unit("K/s", [0, 0, -1, 0, 1, 0, 0, 0]),
     unit("Ohm", [1, 2, -3, -2, 0, 0, 0, 0]),
     Unit {
         name: "degC",
@@ -179,6 +219,7 @@ pub fn fmi_unit(schema_unit: &str) -> Option<&'static str> {
         "Pa" => "Pa",
         "s" => "s",
         "Hz" => "Hz",
+        "C/s" => "K/s",
         "ohm" => "Ohm",
         "C" => "degC",
         _ => return None,
@@ -216,7 +257,8 @@ mod tests {
     #[test]
     fn value_references_are_unique_and_resolve() {
         assert_eq!(fields().count(), FIELD_COUNT);
-        let mut vrs: Vec<u32> = vec![VR_TIME, VR_T_OIL, VR_MACHINE_PRESENT];
+        let mut vrs: Vec<u32> = vec![VR_TIME, VR_MACHINE_PRESENT];
+        vrs.extend((0..INPUTS.len() as u32).map(|i| VR_T_OIL + i));
         vrs.extend((0..OUTPUTS.len() as u32).map(|i| VR_FIRST_OUTPUT + i));
         vrs.extend((0..FIELD_COUNT as u32).map(|i| VR_FIRST_FIELD + i));
         let n = vrs.len();
@@ -229,6 +271,12 @@ mod tests {
         }
         assert_eq!(field_of(VR_FIRST_FIELD + FIELD_COUNT as u32), None);
         assert_eq!(field_of(VR_T_OIL), None);
+        for (k, vr) in [VR_T_OIL, VR_P_SUPPLY, VR_P_OUTLET].into_iter().enumerate() {
+            assert_eq!(input_of(vr), Some(k));
+            assert!(vr < VR_FIRST_OUTPUT);
+        }
+        assert_eq!(input_of(VR_P_OUTLET + 1), None);
+        assert_eq!(input_of(VR_TIME), None);
         assert_eq!(OUTPUTS[FLAGS_OUTPUT].name, "flags");
     }
 

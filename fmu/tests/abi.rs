@@ -3,7 +3,9 @@
 //! driven directly (as `compensator step --precision f32` drives it),
 //! reset, state get/set and serialisation round trips.
 
-use compensator::dynamics::Twin;
+mod common;
+
+use compensator::dynamics::{Twin, TwinConfig};
 use compensator::{Params, RawParams};
 use compensator_fmu::description::token;
 use compensator_fmu::variables::{VR_FIRST_FIELD, VR_FIRST_OUTPUT, VR_T_OIL, VR_TIME, fields};
@@ -63,26 +65,8 @@ struct Fmu3 {
 impl Fmu3 {
     fn try_new(dir: &Path, token: &str) -> (Option<Fmu3>, Vec<String>) {
         let log = Box::new(Log(Mutex::new(Vec::new())));
-        let name = CString::new("inst").expect("name");
-        let token = CString::new(token).expect("token");
-        let path = CString::new(dir.to_str().expect("utf-8")).expect("path");
-        // SAFETY: valid strings and callback; the log outlives the instance.
-        let inst = unsafe {
-            fmi3::fmi3InstantiateCoSimulation(
-                name.as_ptr(),
-                token.as_ptr(),
-                path.as_ptr(),
-                false,
-                false,
-                false,
-                false,
-                std::ptr::null(),
-                0,
-                &*log as *const Log as *mut c_void,
-                Some(log3),
-                std::ptr::null(),
-            )
-        };
+        // The log outlives the instance.
+        let inst = common::instantiate(dir, token, &*log as *const Log as *mut c_void, Some(log3));
         let messages = log.0.lock().expect("log").clone();
         if inst.is_null() {
             (None, messages)
@@ -230,25 +214,120 @@ fn several_ticks_per_step_equal_one_tick_per_step() {
     assert!((a.get(VR_TIME) - 2.5).abs() < 1e-9);
 }
 
+/// The twin as `compensator step --precision f32 --dt TICK --substeps N`
+/// drives it (built with that tick from the start): at rest at `from`,
+/// each tick's temperature set before the tick; the states after each tick.
+fn direct_at(raw: &RawParams, tick: f64, from: f32, to: f32, n: usize) -> Vec<[f64; 4]> {
+    let p = Params::<f32>::new(raw).expect("valid");
+    let config = TwinConfig {
+        tick,
+        ..chosen_config(raw).expect("chosen")
+    };
+    let mut twin = Twin::<f32, f32>::new(&p, config, from).expect("twin");
+    (0..n)
+        .map(|_| {
+            twin.set_temperature(to).expect("temperature");
+            twin.tick().expect("tick");
+            let s = twin.state();
+            [s.x as f64, s.v as f64, s.p_a as f64, s.p_b as f64]
+        })
+        .collect()
+}
+
 #[test]
-fn a_step_that_is_not_whole_ticks_is_discarded_and_logged() {
-    let f = Fmu3::new(&paper_resources("partial"));
+fn steps_of_any_length_end_exactly_and_equal_the_twin_at_that_tick() {
+    // 0.1 ms (sub-tick), 2.5 ms (between 2 and 3 ticks: 3 ticks of 5/6 ms),
+    // 1/3 ms: each the twin built with the tick h / ceil(h / tick), what
+    // `compensator step --dt` runs, to the last bit.
+    let raw = paper();
+    let tick = 1.0 / raw.estimator.tick_hz;
+    for (h, ticks_per_step) in [(1e-4, 1), (2.5e-3, 3), (1.0 / 3.0 * 1e-3, 1)] {
+        let f = Fmu3::new(&paper_resources("any step"));
+        f.set(VR_T_OIL, 40.0);
+        assert_eq!(f.init(0.0), OK);
+        f.set(VR_T_OIL, 60.0);
+        let steps = (0.06 / h) as usize;
+        let want = direct_at(&raw, h / ticks_per_step as f64, 40.0, 60.0, steps * ticks_per_step);
+        let mut t = 0.0;
+        for k in 0..steps {
+            assert_eq!(f.step(t, h), OK, "{h} s, step {k}: {:?}", f.messages());
+            t += h;
+            assert_eq!(f.state(), want[(k + 1) * ticks_per_step - 1], "{h} s, step {k}");
+            assert_eq!(f.get(VR_TIME), t);
+        }
+        assert!(f.state()[0] > 1e-4, "the plunger moved");
+        assert_eq!(tick, 1e-3);
+    }
+}
+
+#[test]
+fn a_variable_step_sequence_matches_the_twin_step_by_step() {
+    // Whole ticks, sub-ticks and steps between counts mixed: each step the
+    // twin at that step's tick, carried over from the step before.
+    let raw = paper();
+    let p = Params::<f32>::new(&raw).expect("valid");
+    let config = chosen_config(&raw).expect("chosen");
+    let mut twin = Twin::<f32, f32>::new(&p, config, 35.0).expect("twin");
+    let f = Fmu3::new(&paper_resources("variable"));
+    f.set(VR_T_OIL, 35.0);
+    assert_eq!(f.init(0.0), OK);
+    let sequence = [
+        1e-3,
+        1e-4,
+        2.5e-3,
+        3e-3,
+        1.0 / 3.0 * 1e-3,
+        7e-4,
+        1.7e-3,
+        1e-3,
+        5e-5,
+        1e-2,
+    ];
+    let mut t = 0.0;
+    for (k, h) in sequence.iter().cycle().take(200).enumerate() {
+        let temp = 35.0 + 40.0 * ((k / 20) % 2) as f32;
+        f.set(VR_T_OIL, temp as f64);
+        assert_eq!(f.step(t, *h), OK);
+        t += h;
+        let n = (h / config.tick - 1e-6).ceil().max(1.0);
+        twin.set_temperature(temp).expect("temperature");
+        twin.set_tick(if n * config.tick == *h { config.tick } else { h / n })
+            .expect("tick");
+        for _ in 0..n as usize {
+            twin.tick().expect("tick");
+        }
+        let s = twin.state();
+        assert_eq!(
+            f.state(),
+            [s.x as f64, s.v as f64, s.p_a as f64, s.p_b as f64],
+            "step {k} of {h} s"
+        );
+        assert_eq!(f.get(VR_TIME), t);
+    }
+}
+
+#[test]
+fn a_step_the_instance_cannot_take_is_discarded_and_logged() {
+    let f = Fmu3::new(&paper_resources("refused step"));
     assert_eq!(f.init(0.0), OK);
     let before = f.state();
-    assert_eq!(f.step(0.0, 0.0015), DISCARD);
+    for h in [0.0, -0.001, f64::NAN, f64::INFINITY, 1e5] {
+        assert_eq!(f.step(0.0, h), DISCARD, "{h}");
+    }
     assert!(
-        f.messages().iter().any(|m| m.contains("not a whole multiple")),
+        f.messages().iter().any(|m| m.contains("must be positive and finite")),
         "{:?}",
         f.messages()
     );
+    assert!(f.messages().iter().any(|m| m.contains("take shorter steps")));
     assert_eq!(f.get(VR_TIME), 0.0);
     assert_eq!(f.state(), before);
-    assert_eq!(f.step(0.0, -0.001), DISCARD);
     assert_eq!(
         f.step(0.5, 0.001),
         DISCARD,
         "a communication point not the instance's time"
     );
+    assert_eq!(f.step(1e-4, 0.001), DISCARD, "a skipped sub-tick step");
     // It goes on.
     assert_eq!(f.step(0.0, 0.002), OK);
 }
@@ -498,7 +577,7 @@ fn fmi2_steps_refuses_and_rolls_back_as_fmi3() {
     unsafe {
         assert_eq!(fmi2::fmi2GetInteger(f.0, &vr, 1, &mut flags), OK);
         assert_eq!(flags, g.flags());
-        assert_eq!(fmi2::fmi2DoStep(f.0, 0.1, 0.0005, 1), DISCARD);
+        assert_eq!(fmi2::fmi2DoStep(f.0, 0.1, -0.0005, 1), DISCARD);
         let mut last = f64::NAN;
         assert_eq!(fmi2::fmi2GetRealStatus(f.0, 2, &mut last), OK);
         assert!((last - 0.1).abs() < 1e-12);

@@ -4,73 +4,24 @@
 //! ramp; each through the FMI 3.0 interface, one tick per step with the
 //! tick's midpoint temperature, compared with the CLI's output row by row.
 
-use compensator_fmu::description::token;
-use compensator_fmu::fmi3;
+mod common;
+
+use common::Inst;
 use compensator_fmu::variables::{VR_FIRST_OUTPUT, VR_T_OIL};
-use std::ffi::{CString, c_void};
 use std::path::{Path, PathBuf};
 
 const DESIGNS: usize = 16;
 
-struct Inst(*mut c_void);
-
-impl Drop for Inst {
-    fn drop(&mut self) {
-        // SAFETY: freed once.
-        unsafe { fmi3::fmi3FreeInstance(self.0) }
-    }
-}
-
-fn set(i: &Inst, vr: u32, v: f64) {
-    // SAFETY: a live instance, one value.
-    assert_eq!(unsafe { fmi3::fmi3SetFloat64(i.0, &vr, 1, &v, 1) }, 0);
-}
-
-fn get(i: &Inst, vr: u32) -> f64 {
-    let mut v = f64::NAN;
-    // SAFETY: as `set`.
-    assert_eq!(unsafe { fmi3::fmi3GetFloat64(i.0, &vr, 1, &mut v, 1) }, 0);
-    v
-}
-
 /// The FMU at rest at `from`, then `n` ticks with `temperature(k)` [C].
 fn fmu_run(dir: &Path, from: f64, n: usize, tick: f64, temperature: impl Fn(usize) -> f64) -> Vec<[f64; 4]> {
-    let token = CString::new(token()).expect("token");
-    let path = CString::new(dir.to_str().expect("utf-8")).expect("path");
-    // SAFETY: valid strings; no logger.
-    let i = Inst(unsafe {
-        fmi3::fmi3InstantiateCoSimulation(
-            c"d".as_ptr(),
-            token.as_ptr(),
-            path.as_ptr(),
-            false,
-            false,
-            false,
-            false,
-            std::ptr::null(),
-            0,
-            std::ptr::null_mut(),
-            None,
-            std::ptr::null(),
-        )
-    });
-    assert!(!i.0.is_null());
-    set(&i, VR_T_OIL, from);
-    // SAFETY: a live instance.
-    unsafe {
-        assert_eq!(fmi3::fmi3EnterInitializationMode(i.0, false, 0.0, 0.0, false, 0.0), 0);
-        assert_eq!(fmi3::fmi3ExitInitializationMode(i.0), 0);
-    }
+    let i = Inst::new(dir);
+    i.set(VR_T_OIL, from);
+    i.initialise();
     (0..n)
         .map(|k| {
-            set(&i, VR_T_OIL, temperature(k));
-            let (mut a, mut b, mut c, mut t) = (false, false, false, 0.0);
-            // SAFETY: as above.
-            assert_eq!(
-                unsafe { fmi3::fmi3DoStep(i.0, k as f64 * tick, tick, false, &mut a, &mut b, &mut c, &mut t) },
-                0
-            );
-            [0, 1, 2, 3].map(|o| get(&i, VR_FIRST_OUTPUT + o))
+            i.set(VR_T_OIL, temperature(k));
+            i.step(k as f64 * tick, tick);
+            [0, 1, 2, 3].map(|o| i.get(VR_FIRST_OUTPUT + o))
         })
         .collect()
 }
