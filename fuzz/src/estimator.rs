@@ -84,7 +84,7 @@ const FAULTS: [SensorFault; 6] = [
 pub fn settings(u: &mut Unstructured, base: &RawEstimator) -> RawEstimator {
     let mut e = *base;
     e.tick_hz = [1000.0, 500.0, 2000.0, 250.0, 4000.0][usize::from(byte(u) % 5)];
-    e.filter_time_constant *= (f64::from(byte(u) as i8) / 64.0).exp2();
+    e.max_oil_rate = [1.0, 0.2, 5.0, 20.0][usize::from(byte(u) % 4)];
     e.spike_threshold *= (f64::from(byte(u) as i8) / 32.0).exp2();
     e.spike_limit = f64::from((5 + u16::from(byte(u))) % 12);
     e.telemetry_hz = [2.0, 0.0, 10.0, 50.0][usize::from(byte(u) % 4)];
@@ -106,6 +106,10 @@ pub fn run(data: &[u8]) {
     let preset = usize::from(byte(&mut u) % 2);
     let mut raw: RawParams = presets()[preset];
     raw.estimator = settings(&mut u, &raw.estimator);
+    // The readings are held oil temperatures: a probe of 10 ms to 0.2 s,
+    // so that the observer reaches a held reading in bounded time.
+    raw.probe.time_constant = [0.01, 0.03, 0.1, 0.2][usize::from(byte(&mut u) % 4)];
+    raw.probe.well_time_constant = 0.0;
     let through_driver = byte(&mut u) % 2 == 1;
     let start = temperature(word(&mut u)) as f32;
     let mut steps = Vec::with_capacity(STEPS);
@@ -116,7 +120,7 @@ pub fn run(data: &[u8]) {
             gap: byte(&mut u),
         });
     }
-    let (Ok(p), Ok(cfg)) = (Params::<f32>::new(&raw), EstimatorConfig::new(&raw.estimator)) else {
+    let (Ok(p), Ok(cfg)) = (Params::<f32>::new(&raw), EstimatorConfig::new(&raw)) else {
         panic!("preset {preset} with {:?} is refused", raw.estimator);
     };
     let Ok(est) = Estimator::new(&p, cfg, start) else {
@@ -334,13 +338,14 @@ impl Run {
             .fold(f64::INFINITY, f64::min);
         let tau = 1.0 / slowest;
         let raw = &self.raw.estimator;
-        // The spike filter (and, through the driver, a detection cycle and
-        // its restart), the low-pass filter, the twin's slew over the oil's
-        // viscosity range (a Fluid job on at least every other tick), the
-        // twin's settling.
+        // The spike gate (and, through the driver, a detection cycle and
+        // its restart), the observer's settling (its fast mode decays with
+        // the probe's time constant, its hold mode over a hundred of them),
+        // the twin's slew over the oil's viscosity range (a Fluid job on at
+        // least every other tick), the twin's settling.
         let period = sensor_every as f64 * tick;
         let spikes = (raw.spike_limit + 12.0) * period;
-        let filter = 15.0 * raw.filter_time_constant;
+        let filter = 100.0 * self.raw.probe.time_constant + 1.0;
         let mu = |t: f64| self.p.oil.state(t as f32).map(|f| f64::from(f.dynamic_viscosity));
         let (Ok(cold), Ok(hot)) = (mu(raw.oil_min.max(-20.0)), mu(raw.oil_max.min(150.0))) else {
             return;
@@ -349,9 +354,8 @@ impl Run {
         let cap = spikes + filter + slew + 20.0 * tau + 0.05;
         let max_ticks = (cap / tick).ceil() as u32;
         let resting = ((3.0 * tau / tick).ceil() as u32).max(20);
-        // Finding F2 (docs/fuzzing.md), fixed: the low-pass is a
-        // compensated sum and reaches its input within an ulp; no
-        // allowance for a stall.
+        // Finding F2 (docs/fuzzing.md), fixed: the observer's sums are
+        // compensated and reach their input; no allowance for a stall.
         let mut within = 0u32;
         let mut last = None;
         for k in 0..max_ticks {

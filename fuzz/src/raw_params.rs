@@ -22,9 +22,11 @@
 //! * `RawParams::validate` refuses it exactly when `Params::<f64>::new`
 //!   does (but for `NotRepresentable`), and `Params::<f32>::new` refuses
 //!   whatever it refuses; `EstimatorConfig::new` accepts exactly the
-//!   `[estimator]` sections that validate;
+//!   sets that validate with their tolerances (`RawTolerances::validate`,
+//!   which the uncertainty table applies and `RawParams::validate` does
+//!   not);
 //! * an accepted set written as TOML (`file::to_toml`) parses back to
-//!   itself;
+//!   itself (refused, when its tolerances are);
 //! * at each temperature, in `f64` and `f32`: the closed form keeps its
 //!   promises ([`check::equilibrium`]); `f32` agrees with `f64` (where
 //!   every core field is a normal `f32`) as far as `f32`'s own oil
@@ -50,7 +52,8 @@ use compensator::asymptotic::{Expansion, Reading, monotonicity, sensitivity};
 use compensator::dynamics::Model;
 use compensator::dynamics::linear::{hurwitz_stable, jacobian_at_equilibrium, linearise};
 use compensator::equilibrium::{Equilibrium, Stop, equilibrium};
-use compensator::estimator::EstimatorConfig;
+use compensator::estimator::{ConfigError, EstimatorConfig};
+use compensator::uncertainty::UncertaintyError;
 use compensator::params::{CORE_FIELDS, ESTIMATOR_FIELDS, MACHINE_FIELDS, Named, Problem};
 use compensator::{Float, Params, RawParams};
 use compensator_params::file::{parse, to_toml};
@@ -124,18 +127,32 @@ pub fn check_set(raw: &RawParams, temps: &[f64]) {
     if let (Err(e), Ok(_)) = (&valid, &p32) {
         panic!("{raw:?}: validation refuses it ({e}), Params<f32> takes it");
     }
-    assert_eq!(
-        raw.estimator.validate().is_ok(),
-        EstimatorConfig::new(&raw.estimator).is_ok(),
-        "{raw:?}: EstimatorConfig::new and RawEstimator::validate disagree"
-    );
+    // The estimator refuses what validation refuses, and takes what it
+    // takes but for the tolerances, which are checked against the values
+    // where the uncertainty table is built (not on the target): a
+    // tolerance wider than its field's value is refused there, naming it.
+    match (&valid, EstimatorConfig::new(raw)) {
+        (Ok(()), Err(ConfigError::Uncertainty(UncertaintyError::Tolerance(path)))) => {
+            assert!(path.starts_with("tolerances."), "{raw:?}: {path}")
+        }
+        (Ok(()), Err(ConfigError::Uncertainty(UncertaintyError::Params(e)))) if e.field.starts_with("tolerances.") => {}
+        (v, c) => assert_eq!(
+            v.is_ok(),
+            c.is_ok(),
+            "{raw:?}: EstimatorConfig::new and RawParams::validate disagree: {c:?}"
+        ),
+    }
     if valid.is_err() {
         return;
     }
+    // The file refuses what the tolerances' own rules refuse (naming the
+    // tolerance), and reads back the rest exactly.
     let written = to_toml(raw);
-    match parse(&written) {
-        Ok(back) => assert!(back == *raw, "{raw:?} written as {written:?} reads back as {back:?}"),
-        Err(e) => panic!("{raw:?} written as {written:?} is refused: {e}"),
+    match (parse(&written), raw.tolerances.validate(&raw.core, raw.machine.as_ref())) {
+        (Ok(back), Ok(())) => assert!(back == *raw, "{raw:?} written as {written:?} reads back as {back:?}"),
+        (Err(e), Err(t)) => assert!(e.to_string().contains(t.field), "{raw:?}: the file says {e}, the rule {t}"),
+        (Ok(_), Err(t)) => panic!("{raw:?} written as {written:?} is taken, its tolerance refused: {t}"),
+        (Err(e), Ok(())) => panic!("{raw:?} written as {written:?} is refused: {e}"),
     }
     let (Ok(p64), p32) = (p64, p32.ok()) else {
         return;

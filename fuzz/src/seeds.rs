@@ -33,7 +33,7 @@ fn params_files() -> Vec<(&'static str, String)> {
         (
             "paper-estimator",
             format!(
-                "{paper}\n[estimator]\ntick_hz = 500\nfilter_time_constant = 0.1\nspike_limit = 3\n\
+                "{paper}\n[estimator]\ntick_hz = 500\nmax_oil_rate = 0.5\nspike_limit = 3\n\
                  valid_min = 20\nvalid_max = 95\ntelemetry_hz = 0\nrtd_wires = 4\nmains_hz = 60\n"
             ),
         ),

@@ -54,7 +54,7 @@ fn run(name: &str) -> bool {
         }
         "estimator-f32" => {
             let (raw, p) = params::<f32>();
-            let cfg = EstimatorConfig::new(&raw.estimator).unwrap();
+            let cfg = EstimatorConfig::new(&raw).unwrap();
             let mut est = Estimator::new(&p, cfg, 30.0).unwrap();
             for k in 0..COUNT {
                 black_box(est.tick(if k % 20 == 0 { Ok(Some(40.0)) } else { Ok(None) }));

@@ -7,13 +7,18 @@
 
 pub mod accuracy;
 pub mod bench;
+pub mod board;
+pub mod coverage;
 pub mod fixed_audit;
+pub mod identify_study;
 pub mod matrix;
 pub mod probe;
 pub mod random;
 pub mod settling;
 pub mod soak;
 pub mod survey;
+pub mod sweep_twin;
+pub mod tracking;
 pub use compensator_reference::statics as reference;
 
 use std::path::PathBuf;

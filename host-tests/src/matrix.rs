@@ -16,7 +16,11 @@
 //! and that the document is current.
 
 use compensator::equilibrium::equilibrium;
-use compensator::params::{CORE_FIELDS, Compact, ESTIMATOR_FIELDS, Field, Kind, MACHINE_FIELDS, Problem, RawParams};
+use compensator::estimator::{ConfigError, Estimator, EstimatorConfig};
+use compensator::params::{
+    CORE_FIELDS, Compact, ESTIMATOR_FIELDS, Field, Kind, MACHINE_FIELDS, PROBE_FIELDS, Problem, RawParams,
+};
+use compensator::uncertainty::UncertaintyError;
 use compensator::{Float, Params};
 use compensator_cli::params_file::{self, LoadError, fmt_float};
 use std::fmt::Write as _;
@@ -27,6 +31,46 @@ pub fn fields() -> impl Iterator<Item = &'static Field> {
         .iter()
         .chain(MACHINE_FIELDS.iter())
         .chain(ESTIMATOR_FIELDS.iter())
+        .chain(PROBE_FIELDS.iter())
+}
+
+/// The standard uncertainty of every field that can have one, as a field
+/// of its own: section `tolerances.<section>`, path
+/// `tolerances.<section>.<key>`, plausible up to a third of the preset's
+/// value ([`compensator::params::RawTolerances::validate`]).
+pub fn tolerance_fields() -> Vec<&'static Field> {
+    let base = params_file::parse(&base_text()).expect("the preset");
+    CORE_FIELDS
+        .iter()
+        .chain(MACHINE_FIELDS.iter())
+        .map(|f| {
+            let value = base
+                .core
+                .named()
+                .into_array()
+                .iter()
+                .chain(
+                    base.machine
+                        .iter()
+                        .flat_map(|m| m.named().into_array())
+                        .collect::<Vec<_>>()
+                        .iter(),
+                )
+                .find(|n| n.path == f.path)
+                .map_or(0.0, |n| n.value);
+            let field: &'static Field = Box::leak(Box::new(Field {
+                section: Box::leak(format!("tolerances.{}", f.section).into_boxed_str()),
+                path: f.tolerance_path,
+                min: 0.0,
+                max: value.abs() / 3.0,
+                kind: Kind::Real,
+                default: Some(0.0),
+                doc: "Standard uncertainty (GUM, one standard deviation).",
+                ..*f
+            }));
+            field
+        })
+        .collect()
 }
 
 /// One kind of input tried on every field.
@@ -104,8 +148,12 @@ impl Case {
 
     /// The TOML value written for `field` (`None`: the key left out).
     pub fn value(self, field: &Field) -> Option<String> {
-        let below = if field.min == 0.0 {
+        let below = if field.min == 0.0 && field.max > 0.0 {
             -1e-6 * field.max
+        } else if field.min == 0.0 {
+            // A range of zero alone (the tolerance of a field whose value
+            // is 0): a millionth below it.
+            -1e-6
         } else {
             field.min - 1e-6 * field.min.abs()
         };
@@ -122,6 +170,7 @@ impl Case {
             Case::Below => fmt_float(below),
             Case::AtMin => fmt_float(field.min),
             Case::AtMax => fmt_float(field.max),
+            Case::Above if field.max == 0.0 => fmt_float(1e-6),
             Case::Above => fmt_float(field.max + 1e-6 * field.max.abs()),
         })
     }
@@ -133,8 +182,9 @@ pub fn base_text() -> String {
     std::fs::read_to_string(crate::repo_root().join("presets/paper.toml")).expect("presets/paper.toml")
 }
 
-/// `text` with `field` set to `value` (its line replaced, or appended in
-/// an `[estimator]` section), or left out when `value` is `None`.
+/// `text` with `field` set to `value` (its line replaced, added under its
+/// section's header, or appended in a section of its own), or left out
+/// when `value` is `None`.
 pub fn edited(text: &str, field: &Field, value: Option<&str>) -> String {
     let mut out = String::new();
     let mut current = String::new();
@@ -154,11 +204,28 @@ pub fn edited(text: &str, field: &Field, value: Option<&str>) -> String {
         }
         out.push_str(line);
         out.push('\n');
+        if trimmed == format!("[{}]", field.section) && !text_has_key(text, field) {
+            if let Some(v) = value {
+                let _ = writeln!(out, "{} = {v}", field.key);
+            }
+            hit = true;
+        }
     }
     if !hit && let Some(v) = value {
         let _ = write!(out, "\n[{}]\n{} = {v}\n", field.section, field.key);
     }
     out
+}
+
+/// Whether `text` sets `field` in its section.
+fn text_has_key(text: &str, field: &Field) -> bool {
+    let mut current = "";
+    text.lines().map(str::trim).any(|l| {
+        if l.starts_with('[') {
+            current = l.trim_matches(|c| c == '[' || c == ']');
+        }
+        current == field.section && !l.starts_with('#') && l.split('=').next().map(str::trim) == Some(field.key)
+    })
 }
 
 /// What became of one case.
@@ -234,6 +301,16 @@ pub fn run(base: &str, field: &Field, case: Case) -> Outcome {
             message: e.to_string(),
         });
     }
+    // A tolerance whose device the model refuses either way: refused by
+    // the estimator's construction, naming it (what the CLI, the FMU and
+    // the firmware's build script report).
+    if let Err(ConfigError::Uncertainty(e @ UncertaintyError::Tolerance(path))) = EstimatorConfig::new(&raw) {
+        return Outcome::Refused(Refusal {
+            field: Some(path),
+            rule: "model",
+            message: e.to_string(),
+        });
+    }
     let t = 0.5 * (raw.estimator.valid_min + raw.estimator.valid_max);
     let failure = evaluate::<f64>(&raw, t)
         .err()
@@ -246,15 +323,33 @@ pub fn run(base: &str, field: &Field, case: Case) -> Outcome {
 }
 
 /// The model on an accepted set: conversion, then the equilibrium at `t`,
-/// every result finite.
+/// every result finite; and the estimator (its observer designed, its
+/// uncertainty table built) through a second of readings at `t`, its
+/// estimate and uncertainty finite.
 fn evaluate<T: Float>(raw: &RawParams, t: f64) -> Result<(), String> {
     let p = Params::<T>::new(raw).map_err(|e| format!("{}: {e}", T::NAME))?;
     let e = equilibrium(&p, T::from_f64(t)).map_err(|e| format!("{} at {t} C: {e}", T::NAME))?;
     let all = [e.a, e.p_a, e.p_b, e.dp_ab, e.x, e.q_branch, e.q_throt, e.q_total];
-    if all.iter().all(|v| v.is_finite()) {
+    if !all.iter().all(|v| v.is_finite()) {
+        return Err(format!("{} at {t} C: not finite: {e:?}", T::NAME));
+    }
+    let config = EstimatorConfig::new(raw).map_err(|e| format!("estimator: {e}"))?;
+    let p32 = Params::<f32>::new(raw).map_err(|e| format!("f32: {e}"))?;
+    let mut est = Estimator::new(&p32, config, t as f32).map_err(|e| format!("estimator at {t} C: {e}"))?;
+    let every = config.ticks_per(0.02);
+    let ticks = config.ticks_per(1.0).min(5_000);
+    let mut last = None;
+    for k in 0..ticks {
+        let reading = if k % every == 0 { Ok(Some(t as f32)) } else { Ok(None) };
+        last = Some(est.tick(reading));
+    }
+    let e = last.ok_or("no tick")?;
+    let u = e.uncertainty;
+    let bands = [u.t_oil, u.x, u.p_a, u.p_b, u.q_total];
+    if e.is_finite() && bands.iter().all(|v| v.is_finite() && *v >= 0.0) {
         Ok(())
     } else {
-        Err(format!("{} at {t} C: not finite: {e:?}", T::NAME))
+        Err(format!("estimator at {t} C: not finite: {e:?}"))
     }
 }
 
@@ -300,8 +395,18 @@ impl Cell {
 
 /// Every field against every case.
 pub fn matrix() -> Vec<Cell> {
+    cells(fields().collect())
+}
+
+/// Every tolerance against every case.
+pub fn tolerance_matrix() -> Vec<Cell> {
+    cells(tolerance_fields())
+}
+
+fn cells(fields: Vec<&'static Field>) -> Vec<Cell> {
     let base = base_text();
-    fields()
+    fields
+        .into_iter()
         .flat_map(|field| {
             let base = &base;
             Case::ALL.iter().map(move |&case| Cell {
@@ -409,8 +514,12 @@ pub fn summary(cells: &[Cell]) -> String {
 }
 
 /// The generated blocks of `docs/parameters.md`: `(marker, content)`.
-pub fn generated_blocks() -> [(&'static str, String); 2] {
-    [("fields", field_table()), ("matrix", matrix_table(&matrix()))]
+pub fn generated_blocks() -> [(&'static str, String); 3] {
+    [
+        ("fields", field_table()),
+        ("matrix", matrix_table(&matrix())),
+        ("tolerances", matrix_table(&tolerance_matrix())),
+    ]
 }
 
 /// `doc` with the content between `<!-- BEGIN GENERATED: name -->` and

@@ -31,8 +31,12 @@ pub enum Op {
     Divisor,
     /// `-a`.
     Neg,
-    /// `a.sqrt()`.
+    /// `a.sqrt()`, and the root of `Real::sqrt_sum_products` and
+    /// `Real::sqrt_recip_sum_products`.
     Sqrt,
+    /// The reciprocal `Real::sqrt_recip_sum_products` returns beside the
+    /// root (no division where the core multiplies 32 x 32 -> 64).
+    Reciprocal,
     /// `a.abs()`.
     Abs,
     /// `max`, `min`, `clamp_to`.
@@ -268,6 +272,19 @@ impl<T: Real> Real for Probe<T> {
     fn sqrt(self) -> Self {
         let r = self.0.sqrt();
         Self::out(Op::Sqrt, r, self.0 > T::ZERO && r == T::ZERO)
+    }
+    #[track_caller]
+    fn sqrt_sum_products(a: Self, b: Self, c: Self, d: Self) -> Self {
+        let r = T::sqrt_sum_products(a.0, b.0, c.0, d.0);
+        Self::out(Op::Sqrt, r, false)
+    }
+    #[track_caller]
+    fn sqrt_recip_sum_products(a: Self, b: Self, c: Self, d: Self) -> (Self, Self) {
+        let loc = Location::caller();
+        let (r, inv) = T::sqrt_recip_sum_products(a.0, b.0, c.0, d.0);
+        record(loc, Op::Sqrt, r.to_f64(), false);
+        record(loc, Op::Reciprocal, inv.to_f64(), false);
+        (Probe(r), Probe(inv))
     }
     #[track_caller]
     fn abs(self) -> Self {

@@ -71,6 +71,8 @@ pub fn physical_params(rng: &mut Rng) -> RawParams {
         core,
         machine: None,
         estimator: RawEstimator::DEFAULT,
+        probe: compensator::params::RawProbe::DEFAULT,
+        tolerances: compensator::params::RawTolerances::NONE,
     };
     raw.validate().expect("the generator makes valid sets");
     raw

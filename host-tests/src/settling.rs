@@ -60,7 +60,7 @@ pub fn estimator_reseats(raw: &RawParams, from: f64, to: f64) -> Option<u32> {
     if !(rate > 2.0) {
         return None;
     }
-    let cfg = EstimatorConfig::new(&raw.estimator).ok()?;
+    let cfg = EstimatorConfig::new(&raw).ok()?;
     let mut est = Estimator::new(&p32, cfg, from as f32).ok()?;
     let hold = (400.0 / rate).max(3.0);
     let tick = f64::from(cfg.tick());

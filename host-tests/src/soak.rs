@@ -1,10 +1,9 @@
-//! The soak with faults (issue 10 §3) on the host; `docs/soak.md` has the
-//! figures.
+//! The soak with faults on the host; `docs/soak.md` has the figures.
 //!
 //! * [`run`]: the estimator through a seeded temperature walk with
 //!   injected sensor faults, every tick checked. The walk, the faults and
-//!   the checks are the QEMU soak image's own (`src/bin/soak/harness.rs`,
-//!   included here): the same seed gives the same walk on both. On top,
+//!   the checks are the QEMU soak image's own (`compensator_testbench::soak`):
+//!   the same seed gives the same walk on both. On top,
 //!   every settled hold is also compared with the independent reference
 //!   ([`crate::reference`]), not only with the core's closed form.
 //! * [`drift`]: a `Twin<f32, f32>` and a `Twin<f64, f64>` driven through the
@@ -16,14 +15,14 @@
 //! `cargo run --release -p host-tests --example soak -- --ticks 10000000`
 //! is the long run.
 
-#[path = "../../src/bin/soak/harness.rs"]
-mod harness;
-
-pub use harness::{CHECKS, Fault, HOLD_TOLERANCE, Kind, Limits, SETTLE, Segment, Soak, Stats, Walk, XorShift64};
+pub use compensator_testbench::soak::{
+    CHECKS, Fault, HOLD_TOLERANCE, Kind, Limits, SETTLE, Segment, Soak, Stats, Walk, XorShift64,
+};
 
 use compensator::dynamics::config::choose;
 use compensator::dynamics::{Twin, TwinConfig};
 use compensator::estimator::EstimatorConfig;
+use compensator::estimator::{ObserverDesign, observer_settings};
 use compensator::sensor::max31865::Settings;
 use compensator::{Params, RawParams};
 use std::fmt::Write as _;
@@ -198,11 +197,17 @@ impl Run {
 }
 
 /// The estimator soak of `raw` for `ticks` ticks from `seed`, with the
-/// twin configuration the firmware would be built with.
+/// twin configuration the firmware would be built with. The walk's
+/// readings are the oil's temperature: the observer is designed for a
+/// probe without lag
+/// ([`ObserverSettings::without_lag`](compensator::estimator::ObserverSettings::without_lag)), as in the QEMU
+/// soak image.
 pub fn run(raw: &RawParams, ticks: u32, seed: u64) -> Result<Run, String> {
     let p = Params::<f32>::new(raw).map_err(|e| e.to_string())?;
     let p64 = Params::<f64>::new(raw).map_err(|e| e.to_string())?;
-    let mut config = EstimatorConfig::new(&raw.estimator).map_err(|e| e.to_string())?;
+    let mut config = EstimatorConfig::new(raw).map_err(|e| e.to_string())?;
+    let direct = observer_settings(raw, config.sample_period()).without_lag();
+    config.observer = ObserverDesign::new(&direct).map_err(|e| e.to_string())?;
     config.twin = TwinConfig {
         tick: config.twin.tick,
         ..twin_config(raw)?
@@ -337,16 +342,20 @@ impl Drift {
 
 /// A `Twin<f32, f32>` and a `Twin<f64, f64>` of `raw`, with the firmware's
 /// configuration, through `ticks` ticks of the walk of `seed` (its oil
-/// temperature only, through the estimator's first-order filter: what the
-/// estimator hands its twin, without the spike filter's jumps): both twins
-/// get the same `f32` temperature every tick.
+/// temperature only, through a first-order lag of [`DRIFT_LAG`]: a smooth
+/// temperature as the estimator hands its twin, without the walk's
+/// jumps): both twins get the same `f32` temperature every tick.
+/// Time constant of the lag the drift run's temperatures pass [s].
+pub const DRIFT_LAG: f64 = 0.2;
+
 pub fn drift(raw: &RawParams, ticks: u32, seed: u64) -> Result<Drift, String> {
     if ticks < 10 {
         return Err(format!("{ticks} ticks: a drift run needs tenths to compare"));
     }
     let p32 = Params::<f32>::new(raw).map_err(|e| e.to_string())?;
     let p64 = Params::<f64>::new(raw).map_err(|e| e.to_string())?;
-    let estimator = EstimatorConfig::new(&raw.estimator).map_err(|e| e.to_string())?;
+    let estimator = EstimatorConfig::new(raw).map_err(|e| e.to_string())?;
+    let gain = (1.0 - (-estimator.twin.tick / DRIFT_LAG).exp()) as f32;
     let config = TwinConfig {
         tick: estimator.twin.tick,
         ..twin_config(raw)?
@@ -378,7 +387,7 @@ pub fn drift(raw: &RawParams, ticks: u32, seed: u64) -> Result<Drift, String> {
     let settle = limits.ticks(SETTLE);
     for k in 0..ticks {
         let seg = *walk.at(k);
-        t += estimator.filter_gain * (seg.temperature(k) - t);
+        t += gain * (seg.temperature(k) - t);
         let set = a.set_temperature(t).is_ok() && b.set_temperature(f64::from(t)).is_ok();
         if !(set && a.tick().is_ok() && b.tick().is_ok()) {
             d.failed_ticks += 1;

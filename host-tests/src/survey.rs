@@ -107,6 +107,8 @@ pub fn designs(count: usize, seed: u64) -> Vec<RawParams> {
                 core: scattered(&base.core, &mut rng),
                 machine: None,
                 estimator: base.estimator,
+                probe: base.probe,
+                tolerances: compensator::params::RawTolerances::NONE,
             };
             let p = Params::<f64>::new(&raw).expect("scattered sets are valid");
             while p.oil.state(raw.estimator.oil_min).is_err() && raw.estimator.oil_min < raw.estimator.valid_min {

@@ -6,7 +6,9 @@
 //! `docs/parameters.md`'s; `cargo run -p host-tests --example
 //! bad_input_matrix -- --write` rewrites it.
 
-use host_tests::matrix::{Case, Outcome, fields, generated_blocks, matrix, summary, with_blocks};
+use host_tests::matrix::{
+    Case, Cell, Outcome, fields, generated_blocks, matrix, summary, tolerance_fields, tolerance_matrix, with_blocks,
+};
 use host_tests::random::{Rng, physical_params, unsized_params};
 use host_tests::repo_root;
 
@@ -14,13 +16,27 @@ use host_tests::repo_root;
 fn every_bad_value_of_every_field_is_refused_by_its_name_and_every_accepted_one_computes() {
     let cells = matrix();
     assert_eq!(cells.len(), fields().count() * Case::ALL.len());
+    check(&cells);
+}
+
+/// The same for the standard uncertainty of every field that can have one
+/// (`tolerances.section.key`), its plausible range up to a third of the
+/// preset's value.
+#[test]
+fn every_bad_tolerance_is_refused_by_its_name_and_every_accepted_one_computes() {
+    let cells = tolerance_matrix();
+    assert_eq!(cells.len(), tolerance_fields().len() * Case::ALL.len());
+    check(&cells);
+}
+
+fn check(cells: &[Cell]) {
     let wrong: Vec<String> = cells
         .iter()
         .filter(|c| !c.is_right())
         .map(|c| format!("{} {:?}: {:?}", c.field.path, c.case, c.outcome))
         .collect();
-    assert!(wrong.is_empty(), "{}\n{}", summary(&cells), wrong.join("\n"));
-    for c in &cells {
+    assert!(wrong.is_empty(), "{}\n{}", summary(cells), wrong.join("\n"));
+    for c in cells {
         match (&c.outcome, c.case) {
             // Every error is one short line.
             (Outcome::Refused(r), _) => {

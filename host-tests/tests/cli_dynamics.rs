@@ -4,13 +4,26 @@
 
 use host_tests::{isclose, repo_root, run_cli};
 
+/// The numeric columns of a command's CSV (the `envelope` and `error`
+/// columns, words, are left out; so is a time series' `t_c`, the
+/// profile's temperature, checked in
+/// `step_writes_the_temperature_each_tick_ran_at`, so that the positions
+/// below are `time_s, x_m, v_m_s, p_a_pa, p_b_pa`).
 fn rows(out: &str) -> (Vec<String>, Vec<Vec<f64>>) {
     let mut lines = out.lines();
-    let header = lines.next().unwrap().split(',').map(String::from).collect();
+    let all: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    let series = all.first().is_some_and(|h| h == "time_s");
+    let keep: Vec<usize> = (0..all.len())
+        .filter(|&i| all[i] != "envelope" && all[i] != "error" && !(series && all[i] == "t_c"))
+        .collect();
+    let header = keep.iter().map(|&i| all[i].clone()).collect();
     (
         header,
         lines
-            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .map(|l| {
+                let cells: Vec<&str> = l.split(',').collect();
+                keep.iter().map(|&i| cells[i].parse().unwrap()).collect()
+            })
             .collect(),
     )
 }
@@ -64,12 +77,48 @@ fn step_starts_at_the_equilibrium_and_writes_one_row_per_tick() {
 }
 
 #[test]
+fn step_writes_the_temperature_each_tick_ran_at() {
+    // A ramp 40 -> 41 C at 10 C/s, 1 ms ticks: tick k runs at its midpoint.
+    let (code, out, err) = run_cli(&[
+        "step",
+        "--params",
+        "presets/paper.toml",
+        "--from",
+        "40",
+        "--to",
+        "41",
+        "--ramp",
+        "10",
+        "--t-end",
+        "0.2",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let mut lines = out.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(
+        header,
+        ["time_s", "t_c", "x_m", "v_m_s", "p_a_pa", "p_b_pa", "envelope"]
+    );
+    for line in lines {
+        let cells: Vec<&str> = line.split(',').collect();
+        let (t, t_c): (f64, f64) = (cells[0].parse().unwrap(), cells[1].parse().unwrap());
+        let want = if t == 0.0 {
+            40.0
+        } else {
+            (40.0 + 10.0 * (t - 0.0005)).min(41.0)
+        };
+        assert!((t_c - want).abs() <= 1e-9, "{t}: {t_c} vs {want}");
+        assert_eq!(cells[6], "validated");
+    }
+}
+
+#[test]
 fn eigen_and_indicators_write_their_columns() {
     let (code, out, err) = run_cli(&["eigen", "--params", "presets/paper.toml", "--temps", "30,80"]);
     assert_eq!(code, 0, "{err}");
     let (header, r) = rows(&out);
-    assert_eq!(header.len(), 11);
-    assert_eq!(header[9..], ["zeta_dominant", "omega_n_dominant"]);
+    assert_eq!(header.len(), 12);
+    assert_eq!(header[9..], ["zeta_dominant", "omega_n_dominant", "zeta_plunger"]);
     assert!(r.iter().all(|row| row[1] < 0.0), "dominant real parts negative");
     let (code, out, err) = run_cli(&["indicators", "--params", "presets/paper.toml", "--steps", "30:40,70:80"]);
     assert_eq!(code, 0, "{err}");

@@ -231,14 +231,15 @@ fn every_fixed_point_quantity_keeps_its_range_and_resolution() {
     }
     assert!(sites > 100, "only {sites} sites recorded");
     // Every divisor of the stage solution resolved to better than 1e-3,
-    // but the step length `h gamma` of `k = tau / hg`: a release or an
-    // impact located in a step's first microseconds makes it a few LSB,
-    // whose rounding moves the located time by less than a nanosecond
-    // (the step is taken consistently with the rounded length).
+    // but the step length `h gamma` (of the step's `1 / hg`, and of `tau /
+    // hg` where that is not resolved): a release or an impact located in
+    // a step's first microseconds makes it a few LSB, whose rounding moves
+    // the located time by less than a nanosecond (the step is taken
+    // consistently with the rounded length).
     for (site, r) in total.fixed.iter() {
         if site.op == Op::Divisor && site.file.ends_with("dynamics/dirk.rs") {
             let line = source_line(site);
-            if line.contains("tau / hg") {
+            if line.contains("ONE / hg") || line.contains("tau / self.hg") {
                 continue;
             }
             assert!(
@@ -295,7 +296,7 @@ fn the_flow_unit_of_thin_hot_oils_changes_no_state() {
             ..c
         };
         let h = config.step(model.scales.time);
-        let dirk = Dirk::<f64>::new(&SDIRK3, h);
+        let dirk = Dirk::<f64>::new(&SDIRK3, h, &c);
         for y in [[0.3, 0.02, 0.4, 0.7], [0.0, 0.0, 0.9, 0.05], [0.95, -0.3, 0.1, 0.99]] {
             let (a, b) = (
                 Fsi {
@@ -353,7 +354,12 @@ fn a_plunger_creeping_over_short_steps_arrives() {
     // each product h b_j w_j of the displacement update is below half an
     // LSB. Rounded one by one they stopped Q12.20 4.2e-4 of the stroke
     // short, for good; summed exactly (`Real::dot_add_compensated`) it
-    // arrives with the f64 twin.
+    // arrives with the f64 twin, but for what Q12.20 resolves of the
+    // pressures of its slow chambers (`tau / h gamma = 30`): a substep
+    // moves them by 1/30 of their way to equilibrium, and a move below
+    // half an LSB rounds away, so they rest up to ~10 LSB (1e-5 of dp)
+    // from it; at phi / a_x = 14.3 that holds the plunger up to 3e-5 of
+    // the stroke off (`docs/dynamics.md`, "Fixed point").
     let raw = host_tests::survey::designs(1000, SEED)[259];
     let config = chosen(&raw).unwrap().config;
     assert_eq!(config.substeps, 32, "the design this test was written for");
@@ -362,5 +368,5 @@ fn a_plunger_creeping_over_short_steps_arrives() {
     let b = simulate(&raw, Precision::Fixed, config, &prof, 3000).unwrap();
     let (x, y) = (a.state[3000].x, b.state[3000].x);
     let off = (x - y).abs() / raw.core.stroke;
-    assert!(off <= 2e-5, "Q12.20 ends {off:.2e} of the stroke from f64");
+    assert!(off <= 4e-5, "Q12.20 ends {off:.2e} of the stroke from f64");
 }

@@ -101,7 +101,7 @@ fn twins_and_estimators_survive_any_sequence_of_inputs() {
     for _ in 0..30 {
         let raw: RawParams = physical_params(&mut rng);
         let p = Params::<f32>::new(&raw).unwrap();
-        let cfg = EstimatorConfig::new(&raw.estimator).unwrap();
+        let cfg = EstimatorConfig::new(&raw).unwrap();
         assert!(Estimator::new(&p, cfg, f32::NAN).is_err());
         let mut est = Estimator::new(&p, cfg, 40.0).unwrap();
         let mut twin = Twin::<f32, f32>::new(&p, TwinConfig::SHIPPED, 40.0).unwrap();

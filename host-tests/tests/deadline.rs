@@ -1,0 +1,115 @@
+//! Ticks that start late (`Estimator::tick_after`): the missed deadlines
+//! are counted and flagged, and the twin catches up in simulated time, so
+//! that after the same real time a late controller's twin is the punctual
+//! one's; in `f32` and in Q12.20.
+
+use compensator::Params;
+use compensator::Real;
+use compensator::dynamics::DynamicState;
+use compensator::estimator::{Estimator, EstimatorConfig, Flags, MAX_CATCH_UP};
+use compensator::scalar::Fixed;
+use host_tests::repo_root;
+
+fn setup<T: Real>(t: f32) -> (Params<f32>, Estimator<T>) {
+    let raw = compensator_cli::load(&repo_root().join("presets/paper.toml")).unwrap();
+    let p = Params::<f32>::new(&raw).unwrap();
+    let cfg = EstimatorConfig::new(&raw).unwrap();
+    (p, Estimator::<T>::with_scalar(&p, cfg, t).unwrap())
+}
+
+/// The twin off its equilibrium (the plunger half-way, the chamber
+/// pressures swapped), at a steady temperature: it relaxes by its own
+/// dynamics, which the late estimator must follow in real time.
+fn displaced<T: Real>(p: &Params<f32>, est: &mut Estimator<T>) {
+    let s = est.twin().state();
+    est.twin_mut().set_state(&DynamicState {
+        x: 0.5 * p.plunger.stroke,
+        v: 0.0,
+        p_a: s.p_b,
+        p_b: s.p_a,
+    });
+}
+
+fn late_twin_follows_real_time<T: Real>() {
+    let t = 55.0;
+    let (p, mut punctual) = setup::<T>(t);
+    let (_, mut late) = setup::<T>(t);
+    displaced(&p, &mut punctual);
+    displaced(&p, &mut late);
+    // 90 ms of real time (inside the consistency check's settling window,
+    // so that neither estimator re-seats its relaxing twin): the late
+    // controller ticks every 3 periods, then every 7.
+    let sample = |tick: u32| if tick.is_multiple_of(20) { Ok(Some(t)) } else { Ok(None) };
+    let (mut real, mut misses) = (0u32, 0u32);
+    let mut last = None;
+    for elapsed in std::iter::repeat_n(3u32, 15).chain(std::iter::repeat_n(7, 6)) {
+        for _ in 0..elapsed {
+            real += 1;
+            punctual.tick(sample(real));
+        }
+        let e = late.tick_after(sample(real), elapsed);
+        misses += elapsed - 1;
+        assert!(e.flags.contains(Flags::DEADLINE_MISSED), "{:?}", e.flags);
+        assert_eq!((e.tick, e.deadline_misses), (real, misses));
+        last = Some(e);
+    }
+    assert_eq!(real, 87);
+    assert_eq!((late.deadline_misses(), late.lost_ticks()), (misses, 0));
+    // The plunger moved (the twin relaxed), and the late twin is where the
+    // punctual one is: the same ticks of the same twin, bunched.
+    let (a, b) = (punctual.twin().raw_state(), late.twin().raw_state());
+    assert!(
+        (a[0].to_f64() - 0.5).abs() > 0.01,
+        "the displaced twin did not move: {a:?}"
+    );
+    for i in 0..4 {
+        assert!(
+            (a[i].to_f64() - b[i].to_f64()).abs() <= 1e-5,
+            "{}: late {b:?} vs punctual {a:?}",
+            T::NAME
+        );
+    }
+    // A tick on time again clears the flag, keeps the count.
+    let e = late.tick_after(sample(real + 1), 1);
+    assert!(!e.flags.contains(Flags::DEADLINE_MISSED));
+    assert_eq!(e.deadline_misses, last.unwrap().deadline_misses);
+}
+
+#[test]
+fn a_late_twin_follows_real_time_in_f32() {
+    late_twin_follows_real_time::<f32>();
+}
+
+#[test]
+fn a_late_twin_follows_real_time_in_q12_20() {
+    late_twin_follows_real_time::<Fixed>();
+}
+
+#[test]
+fn a_tick_later_than_the_catch_up_loses_the_rest_counted() {
+    let (_, mut est) = setup::<f32>(40.0);
+    let gap = MAX_CATCH_UP + 1 + 5;
+    let e = est.tick_after(Ok(None), gap);
+    assert_eq!(e.deadline_misses, gap - 1);
+    assert_eq!(est.lost_ticks(), 5);
+    assert_eq!(e.tick, gap);
+    assert!(e.flags.contains(Flags::DEADLINE_MISSED));
+    // No elapsed time at all is taken as one tick.
+    let e = est.tick_after(Ok(None), 0);
+    assert_eq!((e.tick, e.deadline_misses), (gap + 1, gap - 1));
+}
+
+#[test]
+fn a_record_due_inside_the_gap_goes_out_with_the_late_tick() {
+    let (_, mut est) = setup::<f32>(40.0);
+    let every = est.config().telemetry_every;
+    assert!(every > 10, "the preset publishes every {every} ticks");
+    for _ in 0..every - 2 {
+        est.tick(Ok(None));
+        assert!(!est.telemetry_due());
+    }
+    // Ticks every - 1 .. every + 1 elapse at once: the record due at
+    // `every` is published now.
+    est.tick_after(Ok(None), 3);
+    assert!(est.telemetry_due());
+}
