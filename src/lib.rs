@@ -5,7 +5,7 @@
 //! for the fault handler's test), and the hardware glue they share.
 //!
 //! * [`clock`]: real time from the tick counter (defmt timestamps).
-//! * [`replay_faults`]: the sensor faults the QEMU twin's replay injects.
+//! * [`deadline`]: the tick periods elapsed between ticks (late ticks).
 //! * `qemu` (QEMU images): semihosting exit, the shared panic and
 //!   HardFault handling, the defmt logger over semihosting.
 //!
@@ -16,7 +16,7 @@
 #![forbid(unsafe_op_in_unsafe_fn)]
 
 pub mod clock;
-pub mod replay_faults;
+pub mod deadline;
 
 #[cfg(all(feature = "qemu", target_os = "none"))]
 pub mod qemu;
@@ -32,7 +32,7 @@ use compensator::estimator::EstimatorConfig;
 ///
 /// Errors: an unknown scheme name or a substep count outside
 /// `1..=MAX_SUBSTEPS` (a build script out of step with the model).
-pub fn use_built_twin(config: &mut EstimatorConfig, scheme: &str, substeps: u8) -> Result<(), &'static str> {
+pub fn use_built_twin<U>(config: &mut EstimatorConfig<U>, scheme: &str, substeps: u8) -> Result<(), &'static str> {
     let scheme = Scheme::from_name(scheme).ok_or("unknown twin scheme")?;
     let twin = TwinConfig {
         scheme,

@@ -15,11 +15,34 @@ use cortex_m_rt::ExceptionFrame;
 use cortex_m_semihosting::debug;
 
 /// Configurable Fault Status Register (UsageFault, BusFault, MemManage).
+#[cfg_attr(not(target_has_atomic = "32"), allow(dead_code))]
 const CFSR: *const u32 = 0xE000_ED28 as *const u32;
 /// HardFault Status Register (FORCED: an escalated fault).
+#[cfg_attr(not(target_has_atomic = "32"), allow(dead_code))]
 const HFSR: *const u32 = 0xE000_ED2C as *const u32;
 /// BusFault Address Register (valid when CFSR.BFARVALID, bit 15).
+#[cfg_attr(not(target_has_atomic = "32"), allow(dead_code))]
 const BFAR: *const u32 = 0xE000_ED38 as *const u32;
+
+/// The emulated core, as the images name it (ARMv6-M is the profile
+/// without 32-bit atomics: stable Rust exposes no Arm target features).
+#[cfg(target_abi = "eabihf")]
+pub const CORE: &str = "Cortex-M4F";
+/// The emulated core, as the images name it.
+#[cfg(all(not(target_abi = "eabihf"), target_has_atomic = "32"))]
+pub const CORE: &str = "Cortex-M3";
+/// The emulated core, as the images name it.
+#[cfg(not(target_has_atomic = "32"))]
+pub const CORE: &str = "Cortex-M0";
+
+/// The twin's scalar on this core: `f32` with an FPU, Q12.20 without.
+#[cfg(target_abi = "eabihf")]
+pub type TwinScalar = f32;
+/// The twin's scalar on this core: `f32` with an FPU, Q12.20 without.
+#[cfg(not(target_abi = "eabihf"))]
+pub type TwinScalar = compensator::scalar::Fixed;
+/// The twin integrates in fixed point on this core.
+pub const FIXED_TWIN: bool = <TwinScalar as compensator::Real>::SATURATES;
 
 /// Ends the emulation with exit code 0 (`ok`) or 1.
 pub fn exit(ok: bool) -> ! {
@@ -39,15 +62,18 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
 }
 
 /// The estimator's settings from the parameter file's `[estimator]`
-/// section with the twin configuration the build chose (`TWIN_SCHEME`,
-/// `TWIN_SUBSTEPS`); a refused section or configuration is logged (the
-/// field, or what is wrong) and ends the run with exit code 1.
+/// section, the observer and uncertainty table the build designed
+/// (`OBSERVER`, `UNCERTAINTY`) and the twin configuration it chose
+/// (`TWIN_SCHEME`, `TWIN_SUBSTEPS`); a refused section or configuration is
+/// logged (the field, or what is wrong) and ends the run with exit code 1.
 pub fn built_estimator_config(
     raw: &compensator::params::RawEstimator,
+    observer: compensator::estimator::ObserverDesign,
+    uncertainty: &'static compensator::uncertainty::UncertaintyTable,
     scheme: &str,
     substeps: u8,
-) -> compensator::estimator::EstimatorConfig {
-    let mut config = match compensator::estimator::EstimatorConfig::new(raw) {
+) -> compensator::estimator::EstimatorConfig<&'static compensator::uncertainty::UncertaintyTable> {
+    let mut config = match compensator::estimator::EstimatorConfig::from_parts(raw, observer, uncertainty) {
         Ok(c) => c,
         Err(e) => {
             defmt::error!("estimator settings rejected: {=str}", e.field);
@@ -65,8 +91,12 @@ pub fn built_estimator_config(
 /// registers) and ends the emulation with exit code 1.
 pub fn hard_fault(frame: &ExceptionFrame) -> ! {
     // SAFETY: the System Control Block's fault registers, always mapped on
-    // ARMv7-M, read-only here.
+    // ARMv7-M, read-only here. ARMv6-M has none of them (its HardFault is
+    // the only fault): reported as zero.
+    #[cfg(target_has_atomic = "32")]
     let (cfsr, hfsr, bfar) = unsafe { (CFSR.read_volatile(), HFSR.read_volatile(), BFAR.read_volatile()) };
+    #[cfg(not(target_has_atomic = "32"))]
+    let (cfsr, hfsr, bfar) = (0u32, 0u32, 0u32);
     defmt::error!(
         "HardFault: pc {=u32:#010x}, lr {=u32:#010x}, xpsr {=u32:#010x}, CFSR {=u32:#010x}, HFSR {=u32:#010x}, BFAR {=u32:#010x}",
         frame.pc(),

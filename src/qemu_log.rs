@@ -13,7 +13,8 @@ use core::cell::UnsafeCell;
 use core::sync::atomic::{AtomicBool, Ordering};
 use cortex_m_semihosting::hio::HostStream;
 
-/// Buffer for one frame (the longest telemetry frame is ~80 bytes).
+/// Buffer for one frame (a telemetry frame is ~70 bytes: the record's 48,
+/// the time, the format strings' indices).
 const BUFFER: usize = 256;
 
 #[defmt::global_logger]
@@ -86,11 +87,14 @@ unsafe impl defmt::Logger for Logger {
     fn acquire() {
         // SAFETY: paired with the `release` below.
         let restore = unsafe { critical_section::acquire() };
-        if TAKEN.swap(true, Ordering::Relaxed) {
+        // A load and a store, not `swap`: the Cortex-M0 has no atomic
+        // read-modify-write, and inside the critical section none is needed.
+        if TAKEN.load(Ordering::Relaxed) {
             // Re-entered (a fault or panic while logging): the frame in
             // progress is lost; end the run rather than interleave frames.
             crate::qemu::exit(false);
         }
+        TAKEN.store(true, Ordering::Relaxed);
         // SAFETY: we hold the critical section and `TAKEN`.
         unsafe {
             *RESTORE.0.get() = restore;

@@ -10,11 +10,15 @@
 //! Every result line starts with `[measure]` and carries raw SysTick counts;
 //! `cargo xtask bench` converts them with the calibration line.
 //!
-//! * Cortex-M4F (`thumbv7em-none-eabihf`, netduinoplus2): the twin's tick in
-//!   `f32` and Q12.20 for every scheme and substep count, the estimator's
-//!   pieces, and the whole estimator tick (mean and worst, with telemetry).
-//! * Cortex-M3 (`thumbv7m-none-eabi`, netduino2): the twin's tick in
-//!   Q12.20 (and in soft-float `f32`, for comparison).
+//! On every core (Cortex-M4F `thumbv7em-none-eabihf` on netduinoplus2,
+//! Cortex-M3 `thumbv7m-none-eabi` on netduino2, Cortex-M0 `thumbv6m-none-eabi`
+//! on microbit): the fixed-point kernels checked against plain integer
+//! arithmetic, then the cost of each operation of a Q12.20 tick; the
+//! twin's tick in `f32` (the FPU's on the Cortex-M4F, software elsewhere)
+//! and Q12.20 for every scheme and substep count; the estimator's pieces;
+//! the whole estimator tick (mean and worst, with and without telemetry)
+//! with its twin in `f32` and in Q12.20. On the Cortex-M4F also the twin
+//! through ramps across the opening (releases and impacts).
 #![no_std]
 #![no_main]
 
@@ -139,14 +143,13 @@ fn twin_event_cost(params: &Params<f32>) -> Result<(), &'static str> {
     Ok(())
 }
 
-#[cfg(target_abi = "eabihf")]
 fn pieces(params: &Params<f32>) -> Result<(), &'static str> {
     use compensator::asymptotic::sensitivity_at;
     use compensator::dynamics::fsi::{Contact, DynamicState, Fsi, Model};
     use compensator::dynamics::linear::hurwitz_stable;
     use compensator::dynamics::schemes::OdeSystem;
     use compensator::equilibrium::{a_parameter, equilibrium_for};
-    use compensator::estimator::{Estimator, EstimatorConfig};
+    use compensator::estimator::{Estimator, EstimatorConfig, telemetry};
     use core::hint::black_box;
 
     let t = black_box(55.5f32);
@@ -190,12 +193,38 @@ fn pieces(params: &Params<f32>) -> Result<(), &'static str> {
     }
 
     // Telemetry packing alone: one estimate, encoded by defmt.
-    let mut config = EstimatorConfig::new(&RAW_PARAMS.estimator).map_err(|_| "estimator settings")?;
+    let mut config =
+        EstimatorConfig::from_parts(&RAW_PARAMS.estimator, OBSERVER, &UNCERTAINTY).map_err(|_| "estimator settings")?;
     compensator_firmware::use_built_twin(&mut config, TWIN_SCHEME, TWIN_SUBSTEPS)?;
     let mut est = Estimator::new(params, config, 40.0).map_err(|_| "estimator cannot start")?;
     let e = est.tick(Ok(Some(40.0)));
     let (_, c) = counts(|| info!("estimate {}", black_box(e)));
     info!("[measure] piece name=telemetry total={=u32}", c);
+    // Its parts: the record packed (`telemetry::encode`), and per field
+    // kind the cost of one field (sixteen values of that kind encoded and
+    // stored, `calls=16`: the report divides).
+    let (_, c) = counts(|| black_box(telemetry::encode(black_box(&e))));
+    info!("[measure] piece name=telemetry-pack total={=u32}", c);
+    let values: [f32; 16] = black_box(core::array::from_fn(|i| 1.5e-6 * i as f32 - 3e-6));
+    let (_, c) = counts(|| black_box(black_box(values).map(|v| v.to_bits().to_le_bytes())));
+    info!("[measure] piece name=telemetry-field-f32 calls=16 total={=u32}", c);
+    let per = black_box(1.0 / 1e-7f32);
+    let (_, c) = counts(|| black_box(black_box(values).map(|v| telemetry::u16_code(v, per).to_le_bytes())));
+    info!("[measure] piece name=telemetry-field-u16 calls=16 total={=u32}", c);
+    let (_, c) = counts(|| black_box(black_box(values).map(|v| telemetry::i16_code(v, per).to_le_bytes())));
+    info!("[measure] piece name=telemetry-field-i16 calls=16 total={=u32}", c);
+    let counts16: [u32; 16] = black_box(core::array::from_fn(|i| i as u32));
+    let (_, c) = counts(|| black_box(black_box(counts16).map(u32::to_le_bytes)));
+    info!("[measure] piece name=telemetry-field-u32 calls=16 total={=u32}", c);
+    // What a byte of the record adds to sending it (the logger's copy):
+    // a 64-byte string against an empty one.
+    let bytes = black_box([0x5Au8; 64]);
+    let (_, empty) = counts(|| info!("bytes {=[u8]}", black_box(&bytes[..0])));
+    let (_, full) = counts(|| info!("bytes {=[u8]}", black_box(&bytes[..])));
+    info!(
+        "[measure] piece name=telemetry-byte calls=64 total={=u32}",
+        full.saturating_sub(empty)
+    );
 
     // The tick that re-seats the twin (consistency check): an estimator
     // steady at 55 C for its settling window, its twin forced off the
@@ -230,18 +259,28 @@ fn pieces(params: &Params<f32>) -> Result<(), &'static str> {
     }
     info!("[measure] piece name=estimator-reseat-tick total={=u32}", worst);
 
-    // The whole estimator tick, as the firmware runs it: a sample every
-    // 20 ticks; a 30 -> 40 C step (taken as real by the spike filter, then
-    // followed by the twin at its slew), and ramps at 4 C/s from 26 C to
-    // 46 C and back (the plunger leaves the closed stop and creeps back
-    // onto it: the releases and impacts); with telemetry packed at its
-    // cadence (every 100 ticks here), then without telemetry.
+    Ok(())
+}
+
+/// The whole estimator tick with its twin in `T`, as the firmware runs it:
+/// a sample every 20 ticks; a 30 -> 40 C step (taken as real by the spike
+/// filter, then followed by the twin at its slew), and ramps at 4 C/s from
+/// 26 C to 46 C and back (the plunger leaves the closed stop and creeps
+/// back onto it: the releases and impacts); with telemetry packed at its
+/// cadence (every 100 ticks here), then without telemetry.
+fn estimator_cost<T: Real>(params: &Params<f32>, scalar: &str) -> Result<(), &'static str> {
+    use compensator::estimator::{Estimator, EstimatorConfig};
+    use core::hint::black_box;
+    let mut config =
+        EstimatorConfig::from_parts(&RAW_PARAMS.estimator, OBSERVER, &UNCERTAINTY).map_err(|_| "estimator settings")?;
+    compensator_firmware::use_built_twin(&mut config, TWIN_SCHEME, TWIN_SUBSTEPS)?;
     for (workload, n) in [("step", 1000u32), ("ramps", 10_000u32)] {
         for telemetry in [true, false] {
             let mut config = config;
             config.telemetry_every = if telemetry { 100 } else { 0 };
             let start = if workload == "step" { 30.0 } else { 26.0 };
-            let mut est = Estimator::new(params, config, start).map_err(|_| "estimator cannot start")?;
+            let mut est =
+                Estimator::<T, _>::with_scalar(params, config, start).map_err(|_| "estimator cannot start")?;
             let (mut total, mut worst, mut worst_tick) = (0u32, 0u32, 0u32);
             for k in 0..n {
                 let temperature = if workload == "step" {
@@ -264,10 +303,11 @@ fn pieces(params: &Params<f32>) -> Result<(), &'static str> {
                 }
             }
             info!(
-                "[measure] estimator workload={=str} scheme={=str} substeps={=u8} telemetry={=bool} ticks={=u32} total={=u32} worst={=u32} worst_tick={=u32}",
+                "[measure] estimator workload={=str} scheme={=str} substeps={=u8} scalar={=str} telemetry={=bool} ticks={=u32} total={=u32} worst={=u32} worst_tick={=u32}",
                 workload,
                 config.twin.scheme.name(),
                 config.twin.substeps,
+                scalar,
                 telemetry,
                 n,
                 total,
@@ -277,6 +317,119 @@ fn pieces(params: &Params<f32>) -> Result<(), &'static str> {
         }
     }
     Ok(())
+}
+
+/// The operations [`fixed_pieces`] measures, each out of line so that one
+/// call is one operation (an identity function's call is subtracted).
+mod ops {
+    use compensator::Real;
+    use compensator::scalar::Fixed;
+    fn bits(v: Fixed) -> i64 {
+        v.0.to_bits() as i64
+    }
+    fn f(v: Fixed) -> f32 {
+        v.to_f32()
+    }
+    #[inline(never)]
+    pub fn identity(a: Fixed, _b: Fixed) -> i64 {
+        bits(a)
+    }
+    #[inline(never)]
+    pub fn mul(a: Fixed, b: Fixed) -> i64 {
+        bits(a * b)
+    }
+    #[inline(never)]
+    pub fn div(a: Fixed, b: Fixed) -> i64 {
+        bits(a / b)
+    }
+    #[inline(never)]
+    pub fn sqrt(a: Fixed, _b: Fixed) -> i64 {
+        bits(a.sqrt())
+    }
+    #[inline(never)]
+    pub fn sqrt_recip(a: Fixed, b: Fixed) -> i64 {
+        let (r, i) = Fixed::sqrt_recip_sum_products(a, a, b, b);
+        bits(r) ^ bits(i)
+    }
+    #[inline(never)]
+    pub fn add(a: Fixed, b: Fixed) -> i64 {
+        bits(a + b)
+    }
+    #[inline(never)]
+    pub fn i64_mul(a: Fixed, b: Fixed) -> i64 {
+        bits(a) * bits(b)
+    }
+    #[inline(never)]
+    pub fn i64_div(a: Fixed, b: Fixed) -> i64 {
+        (bits(a) << 20) / (bits(b) | 1)
+    }
+    /// The operands converted once, outside the measured operation (the
+    /// conversions are subtracted with the identity's call).
+    #[inline(never)]
+    pub fn f32_mul(a: Fixed, b: Fixed) -> i64 {
+        (f(a) * f(b)).to_bits() as i64
+    }
+    #[inline(never)]
+    pub fn f32_div(a: Fixed, b: Fixed) -> i64 {
+        (f(a) / f(b)).to_bits() as i64
+    }
+    #[inline(never)]
+    pub fn f32_sqrt(a: Fixed, _b: Fixed) -> i64 {
+        Real::sqrt(f(a)).to_bits() as i64
+    }
+    #[inline(never)]
+    pub fn f32_convert(a: Fixed, b: Fixed) -> i64 {
+        (f(a).to_bits() ^ f(b).to_bits()) as i64
+    }
+}
+
+/// What the arithmetic of a Q12.20 tick costs on this core, one operation
+/// each, the mean over 16 operand pairs spanning the tick's ranges
+/// (`docs/dynamics.md`): the kernels, and what they replace (a 32 x 32 ->
+/// 64 product, a 64-bit quotient) or compete with (`f32`, in software
+/// without an FPU).
+fn fixed_pieces() {
+    use core::hint::black_box;
+    const N: usize = 16;
+    let mut a = [Fixed::ZERO; N];
+    let mut b = [Fixed::ZERO; N];
+    for k in 0..N {
+        a[k] = Fixed::from_f64(0.013 + 7.9 * k as f64 / N as f64);
+        b[k] = Fixed::from_f64(0.41 + 0.37 * k as f64);
+    }
+    let (a, b) = (black_box(a), black_box(b));
+    let each = |f: fn(Fixed, Fixed) -> i64| {
+        let f = black_box(f);
+        counts(|| {
+            for k in 0..N {
+                black_box(f(a[k], b[k]));
+            }
+        })
+        .1
+    };
+    let base = each(ops::identity);
+    // The f32 rows' two conversions from Q12.20 are subtracted too.
+    let convert = each(ops::f32_convert).saturating_sub(base);
+    let pieces: [(&str, fn(Fixed, Fixed) -> i64); 10] = [
+        ("mul", ops::mul),
+        ("div", ops::div),
+        ("sqrt", ops::sqrt),
+        ("sqrt-recip", ops::sqrt_recip),
+        ("add", ops::add),
+        ("i64-mul", ops::i64_mul),
+        ("i64-div", ops::i64_div),
+        ("f32-mul", ops::f32_mul),
+        ("f32-div", ops::f32_div),
+        ("f32-sqrt", ops::f32_sqrt),
+    ];
+    for (name, f) in pieces {
+        let overhead = if name.starts_with("f32") { base + convert } else { base };
+        let c = each(f).saturating_sub(overhead);
+        info!(
+            "[measure] fixed name={=str} calls={=u32} total={=u32}",
+            name, N as u32, c
+        );
+    }
 }
 
 #[entry]
@@ -293,6 +446,15 @@ fn main() -> ! {
     let (_, c) = counts(|| spin(core::hint::black_box(n)));
     info!("[measure] calibration instructions={=u32} total={=u32}", 2 * n, c);
 
+    // The fixed-point kernels of this core against plain integer
+    // arithmetic, before anything is measured with them.
+    if let Err(m) = compensator::scalar::check_kernels(2000) {
+        error!(
+            "fixed-point kernel {=str} wrong: operands {=i64} {=i64}, got {=i64}",
+            m.kernel, m.operands.0, m.operands.1, m.got
+        );
+        exit(false)
+    }
     let Ok(params) = Params::<f32>::new(&RAW_PARAMS) else {
         error!("parameters rejected");
         exit(false)
@@ -320,20 +482,19 @@ fn main() -> ! {
         (Scheme::Rk4, 32),
         (Scheme::Rk4, 64),
     ];
+    // `f32` is the FPU's on the Cortex-M4F, software elsewhere.
+    let f32_name = if cfg!(target_abi = "eabihf") { "f32" } else { "f32-soft" };
     let run = || -> Result<(), &'static str> {
+        fixed_pieces();
         for (scheme, substeps) in configs {
-            #[cfg(target_abi = "eabihf")]
-            twin_cost::<f32>(&params, scheme, substeps, "f32")?;
+            twin_cost::<f32>(&params, scheme, substeps, f32_name)?;
             twin_cost::<Fixed>(&params, scheme, substeps, "q12.20")?;
-            #[cfg(not(target_abi = "eabihf"))]
-            if scheme == Scheme::Ros3 && substeps == 2 {
-                twin_cost::<f32>(&params, scheme, substeps, "f32-soft")?;
-            }
         }
         #[cfg(target_abi = "eabihf")]
         twin_event_cost(&params)?;
-        #[cfg(target_abi = "eabihf")]
         pieces(&params)?;
+        estimator_cost::<f32>(&params, f32_name)?;
+        estimator_cost::<Fixed>(&params, "q12.20")?;
         Ok(())
     };
     match run() {

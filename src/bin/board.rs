@@ -14,6 +14,12 @@
 //! | CS   | PA4 (GPIO, active low) |
 //! | VIN, GND | 3V3, GND |
 //!
+//! Deadlines: a tick that starts after the next one was due is counted,
+//! flagged `DEADLINE_MISSED` and caught up (`Estimator::tick_after`). The
+//! independent watchdog (frozen under the debugger) resets a loop that
+//! stops completing ticks; the first telemetry record after such a reset
+//! carries `WATCHDOG_RESET`.
+//!
 //! Clocks: 8 MHz HSE -> 168 MHz SYSCLK; SysTick interrupts at the tick rate
 //! of the parameter file (1 kHz by default); TIM5 provides the chip-select
 //! delays. The converter runs in automatic conversion mode (a reading every
@@ -36,10 +42,11 @@
 #![no_main]
 
 use compensator::Params;
-use compensator::estimator::{Estimator, EstimatorConfig};
+use compensator::estimator::{Estimator, EstimatorConfig, Flags, MAX_CATCH_UP};
 use compensator::sensor::TemperatureSource;
 use compensator::sensor::max31865::{Max31865, Settings};
 use compensator_firmware::clock::TickClock;
+use compensator_firmware::deadline::TickPace;
 use core::sync::atomic::{AtomicU32, Ordering};
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{ExceptionFrame, entry, exception};
@@ -53,11 +60,25 @@ use stm32f4xx_hal::pac;
 use stm32f4xx_hal::prelude::*;
 use stm32f4xx_hal::rcc::Config;
 use stm32f4xx_hal::spi::Spi;
+use stm32f4xx_hal::watchdog::IndependentWatchdog;
 
 include!(concat!(env!("OUT_DIR"), "/params.rs"));
 
 /// The core clock [Hz] (8 MHz HSE through the PLL).
 const SYSCLK_HZ: u32 = 168_000_000;
+
+/// The independent watchdog's timeout in tick periods, at least
+/// [`WATCHDOG_MIN_MS`]: fed once per tick that completes, it resets a loop
+/// that hangs (a stuck bus, a tick that never returns). The IWDG counts
+/// the LSI oscillator, 32 kHz nominal but 17 to 47 kHz over the STM32F405's
+/// range (datasheet DS8626, table 38): the timeout is at least 32 / 47 of
+/// the nominal one, so the loop may go up to 0.68 x `WATCHDOG_TICKS`
+/// periods without a completed tick (34 ms at 1 kHz, where the worst tick
+/// takes 20 us): far beyond the worst tick and the catch-up of a late one
+/// (`MAX_CATCH_UP` twin ticks more), nothing a healthy loop reaches.
+const WATCHDOG_TICKS: u32 = 50;
+/// The watchdog's shortest nominal timeout [ms] (fast ticks).
+const WATCHDOG_MIN_MS: u32 = 50;
 
 /// Ticks elapsed (incremented by the SysTick interrupt).
 static TICKS: AtomicU32 = AtomicU32::new(0);
@@ -113,6 +134,14 @@ fn main() -> ! {
     let (Some(dp), Some(mut cp)) = (pac::Peripherals::take(), cortex_m::Peripherals::take()) else {
         defmt::panic!("peripherals already taken");
     };
+    // The reset cause (RCC_CSR), then cleared (RMVF) so that the next
+    // reset reads its own: an independent-watchdog reset is reported at
+    // start and on the first telemetry record.
+    let watchdog_reset = dp.RCC.csr().read().wdgrstf().bit_is_set();
+    dp.RCC.csr().modify(|_, w| w.rmvf().set_bit());
+    if watchdog_reset {
+        warn!("restarted by the independent watchdog (RCC_CSR IWDGRSTF): the previous run hung");
+    }
     // Debug builds: keep the debug port clocked while the core sleeps in
     // `wfi` (DBGMCU_CR DBG_SLEEP/STOP/STANDBY) and a bus master clocked
     // (DMA1), so that RTT and reflashing work between ticks. Release
@@ -128,7 +157,7 @@ fn main() -> ! {
         Ok(p) => p,
         Err(e) => defmt::panic!("parameters rejected: {=str}", e.field),
     };
-    let mut config = match EstimatorConfig::new(&RAW_PARAMS.estimator) {
+    let mut config = match EstimatorConfig::from_parts(&RAW_PARAMS.estimator, OBSERVER, &UNCERTAINTY) {
         Ok(c) => c,
         Err(e) => defmt::panic!("estimator settings rejected: {=str}", e.field),
     };
@@ -204,18 +233,47 @@ fn main() -> ! {
     cp.SYST.enable_interrupt();
     cp.SYST.enable_counter();
 
+    // The watchdog: frozen while a debugger halts the core, started last
+    // (the start-up readings above may take a second), fed once per tick
+    // that completes.
+    let timeout_ms = WATCHDOG_MIN_MS.max(clock().map_or(0, |c| (c.micros(WATCHDOG_TICKS) / 1000) as u32));
+    let mut watchdog = IndependentWatchdog::new(dp.IWDG);
+    watchdog.stop_on_debug(&dp.DBGMCU, true);
+    watchdog.start(timeout_ms.millis());
+    info!(
+        "independent watchdog: {=u32} ms nominal, at least {=u32} ms (LSI at 47 kHz); catch-up of a late tick: up to {=u32} ticks",
+        timeout_ms,
+        timeout_ms * 32 / 47,
+        MAX_CATCH_UP
+    );
+
     let sensor_every = config.ticks_per(settings.mains.conversion_period());
-    let mut done = TICKS.load(Ordering::Relaxed);
+    let mut pace = TickPace::new(TICKS.load(Ordering::Relaxed));
+    let mut first_record = true;
     loop {
-        while TICKS.load(Ordering::Relaxed) == done {
+        while !pace.due(TICKS.load(Ordering::Relaxed)) {
             cortex_m::asm::wfi();
         }
         let now = TICKS.load(Ordering::Relaxed);
-        if now.wrapping_sub(done) > 1 {
-            warn!("{=u32} ticks overran", now.wrapping_sub(done) - 1);
+        // More than one period since the last tick: this one starts late
+        // (the estimator counts, flags and catches up).
+        let elapsed = pace.take(now);
+        let extra = if watchdog_reset && first_record {
+            Flags::WATCHDOG_RESET
+        } else {
+            Flags::empty()
+        };
+        if tick_path(
+            &mut sensor,
+            &mut estimator,
+            now,
+            elapsed,
+            now % sensor_every == 0,
+            extra,
+        ) {
+            first_record = false;
         }
-        done = now;
-        tick_path(&mut sensor, &mut estimator, now, now % sensor_every == 0);
+        watchdog.feed();
     }
 }
 
@@ -223,18 +281,26 @@ fn main() -> ! {
 /// telemetry record when due. Not inlined, so that `cargo xtask test` can
 /// check that nothing reachable from it panics (the HAL's SPI and the
 /// RTT logger included).
+/// `elapsed`: the tick periods since the last tick (more than one: this
+/// tick is late); `extra`: flags the firmware adds to the record published
+/// (the watchdog's reset on the first). Returns whether a record went out.
 #[inline(never)]
 fn tick_path<S: embedded_hal::spi::SpiDevice>(
     sensor: &mut Max31865<S>,
-    estimator: &mut Estimator,
+    estimator: &mut Estimator<f32, &'static compensator::uncertainty::UncertaintyTable>,
     now: u32,
+    elapsed: u32,
     read: bool,
-) {
+    extra: Flags,
+) -> bool {
     let sample = if read { sensor.read() } else { Ok(None) };
-    let estimate = estimator.tick(sample);
+    let mut estimate = estimator.tick_after(sample, elapsed);
     if estimator.telemetry_due() {
+        estimate.flags.insert(extra);
         // The same line as the QEMU twin's: `cargo xtask` decodes it.
         let ms = clock().map_or(0, |c| c.millis(now));
         info!("{=u32} ms {}", ms, estimate);
+        return true;
     }
+    false
 }

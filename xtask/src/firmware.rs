@@ -8,10 +8,13 @@ use std::time::Duration;
 
 /// Cortex-M4F (STM32F405, QEMU netduinoplus2).
 pub const M4: &str = "thumbv7em-none-eabihf";
-/// Cortex-M3 (QEMU netduino2): the fixed-point benchmark.
+/// Cortex-M3 (QEMU netduino2): no FPU, hardware divide and long multiply.
 pub const M3: &str = "thumbv7m-none-eabi";
+/// Cortex-M0/M0+ (QEMU microbit, nRF51): no FPU, no divide, no long
+/// multiply.
+pub const M0: &str = "thumbv6m-none-eabi";
 /// Every target the project builds for.
-pub const TARGETS: [&str; 2] = [M4, M3];
+pub const TARGETS: [&str; 3] = [M4, M3, M0];
 
 /// One firmware image.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -37,10 +40,30 @@ impl Image {
         target: M4,
         features: "qemu",
     };
-    /// The benchmark on the Cortex-M3 (fixed point).
+    /// The benchmark on the Cortex-M3 (fixed point and soft-float `f32`).
     pub const BENCH_M3: Image = Image {
         bin: "bench",
         target: M3,
+        features: "qemu",
+    };
+    /// The benchmark on the Cortex-M0 (fixed point and soft-float `f32`).
+    pub const BENCH_M0: Image = Image {
+        bin: "bench",
+        target: M0,
+        features: "qemu",
+    };
+    /// The QEMU twin on the Cortex-M3 (netduino2): the whole estimator
+    /// with a Q12.20 twin, the replay and its self-checks.
+    pub const TWIN_M3: Image = Image {
+        bin: "twin",
+        target: M3,
+        features: "qemu",
+    };
+    /// The QEMU twin on the Cortex-M0 (microbit, 16 KiB RAM): the whole
+    /// estimator with a Q12.20 twin, the replay and its self-checks.
+    pub const TWIN_M0: Image = Image {
+        bin: "twin",
+        target: M0,
         features: "qemu",
     };
     /// The real board's firmware (STM32F405, MAX31865, RTT).
@@ -63,7 +86,21 @@ impl Image {
         features: "qemu",
     };
     /// The images a parameter file goes into.
-    pub const ALL: [Image; 5] = [Image::TWIN, Image::BENCH_M4, Image::BENCH_M3, Image::BOARD, Image::SOAK];
+    pub const ALL: [Image; 8] = [
+        Image::TWIN,
+        Image::TWIN_M3,
+        Image::TWIN_M0,
+        Image::BENCH_M4,
+        Image::BENCH_M3,
+        Image::BENCH_M0,
+        Image::BOARD,
+        Image::SOAK,
+    ];
+
+    /// The emulated board the image runs on.
+    pub fn machine(&self) -> crate::qemu::Machine {
+        crate::qemu::machine(self.target)
+    }
 }
 
 /// Where firmware builds go (separate from host builds, which use another
@@ -313,5 +350,21 @@ pub fn on_target_tests(tc: &Toolchain, root: &Path) -> Result<(), String> {
         Ok(())
     } else {
         Err("on-target tests failed".into())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::TARGETS;
+
+    #[test]
+    fn rust_toolchain_toml_names_every_firmware_target() {
+        // rustup installs what the file names: the targets xtask builds for.
+        let text = std::fs::read_to_string(crate::root().join("rust-toolchain.toml")).unwrap();
+        let targets = text.lines().find(|l| l.starts_with("targets")).unwrap();
+        for t in TARGETS {
+            assert!(targets.contains(&format!("\"{t}\"")), "{t} missing from {targets}");
+        }
+        assert!(text.contains("channel = \"stable\""));
     }
 }

@@ -6,9 +6,9 @@
 //!                                                build the board image, flash it with probe-rs
 //! cargo xtask test [--bless]                     everything CI checks (the test command)
 //! cargo xtask build [--params F]                 build every firmware image
-//! cargo xtask fmu [--params F] [--fmi-version 2|3] [--out DIR] [--debug]
+//! cargo xtask fmu [--params F] [--fmi-version 2|3] [--out DIR] [--debug] [--platforms LIST]
 //!                                                the twin as a co-simulation FMU (target/fmu/compensator.fmu)
-//! cargo xtask fmu-check                          the FMU checked by FMPy (part of `test`)
+//! cargo xtask fmu-check                          the FMU checked by FMPy, libcosim and on each platform (part of `test`)
 //! cargo xtask bench [--params F] [--write]       cost (the twin as built for F), footprint and stack on the emulated MCUs
 //! cargo xtask callgrind [--bless]                host instruction counts against the baseline
 //! cargo xtask msrv                               rust-version against the locked dependencies
@@ -46,6 +46,7 @@ mod params;
 mod process;
 mod qemu;
 mod replica;
+mod sweep_check;
 mod telemetry;
 mod toolchain;
 
@@ -161,9 +162,17 @@ enum Command {
         /// the same f32 arithmetic) instead of release
         #[arg(long)]
         debug: bool,
+        /// Platforms to carry a binary for, comma-separated FMI 3.0 platform tuples
+        /// (cross builds need rustup's target and the C cross compiler: docs/fmu.md)
+        /// [default: the host's]
+        #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = ["x86_64-linux", "x86_64-windows", "aarch64-linux"])]
+        platforms: Vec<String>,
     },
-    /// The FMU (FMI 2.0 and 3.0) validated and simulated by FMPy in a venv (part of `test`)
+    /// The FMU (FMI 2.0 and 3.0, every platform) checked by FMPy and libcosim in a venv and
+    /// by a C driver on each platform (part of `test`)
     FmuCheck,
+    /// A sweep's shards mapped over a Dask LocalCluster, merged and compared with the single run (part of `test`)
+    SweepCheck,
     /// Instructions per tick (the twin as built for F), flash, RAM and stack
     Bench {
         #[command(flatten)]
@@ -236,8 +245,10 @@ fn main() -> ExitCode {
             fmi_version,
             out,
             debug,
-        } => cmd_fmu(&params, &fmi_version, out.as_deref(), debug),
+            platforms,
+        } => cmd_fmu(&params, &fmi_version, out.as_deref(), debug, &platforms),
         Command::FmuCheck => cmd_fmu_check(),
+        Command::SweepCheck => cmd_sweep_check(),
         Command::Msrv => msrv::check(&root()).map(|_| 0).map_err(Failure::from),
         Command::Toolchain => toolchain::get(&root(), &firmware::TARGETS)
             .map(|t| {
@@ -326,8 +337,8 @@ fn cmd_build(params: &ParamsArg) -> Outcome {
     Ok(0)
 }
 
-/// `cargo xtask fmu [--params F] [--fmi-version 2|3] [--out DIR] [--debug]`.
-fn cmd_fmu(params: &ParamsArg, fmi_version: &str, out: Option<&Path>, debug: bool) -> Outcome {
+/// `cargo xtask fmu [--params F] [--fmi-version 2|3] [--out DIR] [--debug] [--platforms LIST]`.
+fn cmd_fmu(params: &ParamsArg, fmi_version: &str, out: Option<&Path>, debug: bool, platforms: &[String]) -> Outcome {
     let params = params_file(params)?;
     let version = match fmi_version {
         "3" => compensator_fmu::description::FmiVersion::V3,
@@ -343,7 +354,17 @@ fn cmd_fmu(params: &ParamsArg, fmi_version: &str, out: Option<&Path>, debug: boo
     } else {
         fmu::Profile::Release
     };
-    let path = fmu::build(&root, params.as_deref(), version, profile, &out)?;
+    let platforms = if platforms.is_empty() {
+        vec![compensator_fmu::platforms::Platform::host().ok_or(
+            "this host is none of the FMU's platforms (x86_64-linux, x86_64-windows, aarch64-linux): name them with --platforms",
+        )?]
+    } else {
+        platforms
+            .iter()
+            .filter_map(|p| compensator_fmu::platforms::Platform::named(p))
+            .collect()
+    };
+    let path = fmu::build(&root, params.as_deref(), version, profile, &out, &platforms)?;
     println!("{}", path.display());
     Ok(0)
 }
@@ -356,15 +377,25 @@ fn cmd_fmu_check() -> Outcome {
     Ok(0)
 }
 
+/// `cargo xtask sweep-check`: what `cargo xtask test` checks of the
+/// sweep's scale-out recipe.
+fn cmd_sweep_check() -> Outcome {
+    if let Some(summary) = sweep_check::check(&root())? {
+        eprintln!("xtask: {summary}");
+    }
+    Ok(0)
+}
+
 /// cargo runner: `xtask qemu-runner ELF [args...]` (the arguments after the
 /// ELF are the test binary's; QEMU runs the image as it is).
 fn cmd_qemu_runner(elf: &Path) -> Outcome {
-    let machine = if elf.to_string_lossy().contains("thumbv7m-none-eabi") {
-        qemu::NETDUINO2
-    } else {
-        qemu::NETDUINO
-    };
-    let run = qemu::run(elf, machine, true, Duration::from_secs(300), qemu::Show::Stream)?;
+    let run = qemu::run(
+        elf,
+        qemu::machine_of(elf),
+        true,
+        Duration::from_secs(300),
+        qemu::Show::Stream,
+    )?;
     Ok(run.code)
 }
 
@@ -487,8 +518,14 @@ fn cmd_test(bless: bool) -> Outcome {
             targets: Vec::new(),
         },
     )?;
-    step("FMU: FMI 2.0 and 3.0 built (cargo xtask fmu), validated and simulated by FMPy against compensator step");
+    step(
+        "FMU: FMI 2.0 and 3.0 for three platforms (cargo xtask fmu), checked by FMPy and libcosim against compensator step and the reference, each binary where it runs",
+    );
     if let Some(summary) = fmu::check(&root)? {
+        eprintln!("xtask: {summary}");
+    }
+    step("sweep: shards mapped over a Dask LocalCluster, merged and compared with the single run");
+    if let Some(summary) = sweep_check::check(&root)? {
         eprintln!("xtask: {summary}");
     }
     step("host instruction counts (valgrind callgrind) against the baseline");
@@ -544,10 +581,47 @@ fn cmd_test(bless: bool) -> Outcome {
     }
     drop(csv);
     let decoded = telemetry::read_csv(&csv_path)?;
-    let schedule = replica::Schedule::read(twin.out_dir.as_deref().ok_or("no build script output directory")?)?;
+    let schedule = replica::read_schedule(twin.out_dir.as_deref().ok_or("no build script output directory")?)?;
     let raw = compensator_params::file::load(&root.join("presets/paper.toml")).map_err(|e| e.to_string())?;
     let host = replica::run(&raw, &schedule)?;
     eprintln!("xtask: {}: {}", csv_path.display(), replica::compare(&decoded, &host)?);
+    step(
+        "QEMU: the whole estimator with a Q12.20 twin on the Cortex-M3 (netduino2) and the Cortex-M0 (microbit): the replay and its self-checks",
+    );
+    let mut twin_runs = vec![(firmware::Image::TWIN, run.lines.clone())];
+    for img in [firmware::Image::TWIN_M3, firmware::Image::TWIN_M0] {
+        let elf = &elfs
+            .iter()
+            .find(|(i, _)| *i == img)
+            .ok_or("no fixed-point twin image")?
+            .1;
+        let started = std::time::Instant::now();
+        let r = qemu::run(elf, img.machine(), true, minutes(5), qemu::Show::Quiet)?;
+        if r.code != 0 {
+            for l in &r.lines {
+                eprintln!("{}", telemetry::humanize(l));
+            }
+            return Err(format!(
+                "the twin on {} ({}) exited with {}",
+                img.target,
+                img.machine().name,
+                r.code
+            )
+            .into());
+        }
+        eprintln!(
+            "xtask: the twin on {} ({}) passed: {} ({:.0} s)",
+            img.target,
+            img.machine().name,
+            r.lines
+                .iter()
+                .rev()
+                .find(|l| l.contains("checks:"))
+                .map_or("", String::as_str),
+            started.elapsed().as_secs_f64()
+        );
+        twin_runs.push((img, r.lines));
+    }
     step("QEMU: the soak (1e6 ticks of a seeded walk with injected sensor faults, every tick checked)");
     let soak = &elfs
         .iter()
@@ -598,7 +672,7 @@ fn cmd_test(bless: bool) -> Outcome {
     step("QEMU: the core's tests on the emulated Cortex-M4F");
     firmware::on_target_tests(&tc, &root)?;
     step("QEMU: cost, footprint and stack budgets");
-    bench::check(&elfs, &run.lines)?;
+    bench::check(&elfs, &twin_runs)?;
     eprintln!("\nxtask: all checks passed");
     Ok(0)
 }
@@ -658,6 +732,7 @@ mod tests {
                 fmi_version: "2".into(),
                 out: None,
                 debug: false,
+                platforms: vec![],
             })
         );
         assert_eq!(
@@ -669,16 +744,20 @@ mod tests {
                 "3",
                 "--out",
                 "dist",
-                "--debug"
+                "--debug",
+                "--platforms",
+                "x86_64-linux,aarch64-linux"
             ]),
             Ok(Command::Fmu {
                 params: params(Some("f.toml")),
                 fmi_version: "3".into(),
                 out: Some("dist".into()),
                 debug: true,
+                platforms: vec!["x86_64-linux".into(), "aarch64-linux".into()],
             })
         );
         assert_eq!(parse(&["fmu-check"]), Ok(Command::FmuCheck));
+        assert_eq!(parse(&["sweep-check"]), Ok(Command::SweepCheck));
         assert_eq!(parse(&["callgrind", "--bless"]), Ok(Command::Callgrind { bless: true }));
         assert_eq!(parse(&["msrv"]), Ok(Command::Msrv));
         assert_eq!(parse(&["toolchain"]), Ok(Command::Toolchain));
@@ -716,6 +795,7 @@ mod tests {
         assert_eq!(parse(&["flash", "--seconds", "soon"]), Err(ErrorKind::ValueValidation));
         assert_eq!(parse(&["qemu-runner"]), Err(ErrorKind::MissingRequiredArgument));
         assert_eq!(parse(&["fmu", "--fmi-version", "1"]), Err(ErrorKind::InvalidValue));
+        assert_eq!(parse(&["fmu", "--platforms", "win64"]), Err(ErrorKind::InvalidValue));
         // No command: the help, as an error (exit status 2).
         assert_eq!(parse(&[]), Err(ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand));
     }

@@ -29,6 +29,32 @@ pub const NETDUINO2: Machine = Machine {
     cpu: "cortex-m3",
 };
 
+/// QEMU's BBC micro:bit (nRF51822, Cortex-M0: no hardware divide, no
+/// 32x32->64 multiply, no FPU; 256 KiB flash, 16 KiB RAM).
+pub const MICROBIT: Machine = Machine {
+    name: "microbit",
+    cpu: "cortex-m0",
+};
+
+/// The emulated board of a target: netduinoplus2 (Cortex-M4F) unless the
+/// target is the Cortex-M3's or the Cortex-M0's.
+pub fn machine(target: &str) -> Machine {
+    match target {
+        crate::firmware::M3 => NETDUINO2,
+        crate::firmware::M0 => MICROBIT,
+        _ => NETDUINO,
+    }
+}
+
+/// The emulated board of an ELF built by cargo (its path names the target).
+pub fn machine_of(elf: &Path) -> Machine {
+    let path = elf.to_string_lossy();
+    crate::firmware::TARGETS
+        .iter()
+        .find(|t| path.contains(&format!("/{t}/")))
+        .map_or(NETDUINO, |t| machine(t))
+}
+
 const QEMU: &str = "qemu-system-arm";
 
 /// Makes sure `qemu-system-arm` runs: installs Debian's package when

@@ -2,107 +2,69 @@
 //! beside `compensator step`, and the human-readable log with its numbers
 //! rounded to what the sensor and the model resolve.
 //!
-//! A telemetry line (QEMU twin and board alike, `StateEstimate`'s defmt
-//! format after a time in ms):
+//! Every column, unit, encoding and rounding comes from the record's table
+//! (`compensator::estimator::telemetry`). A telemetry line (QEMU twin and
+//! board alike: a time in ms, then `StateEstimate`'s defmt format, the
+//! record's bytes as defmt prints a byte string):
 //!
 //! ```text
-//! 499 ms t=26.004648 C x=0.0 um v=0.0 mm/s p_a=273.9017 p_b=126.09832 kPa Q_a=0.24067159 Q_b=0.24067156 Q_throt=0.0 Q0=0.48134312 err=-0.5017106 l/min [AT_STOP]
+//! 499 ms telemetry [150, 37, 49, 8, 208, 65, ...]
 //! ```
 //!
-//! The firmware sends full `f32`s (packing them costs what it costs; defmt
-//! prints them in their shortest round-trip form), so the CSV gets every
-//! digit and only the display is rounded: temperature to 0.01 C (one
-//! MAX31865 code is 0.033 C with a PT100 and 430 ohm), displacement to
-//! 0.1 um, pressures to 0.1 kPa, flows to 0.001 l/min, velocity to
-//! 0.001 mm/s: below what one code moves them at the paper preset (up to
-//! 1.3 um, 0.3 kPa and 0.009 l/min per code, from the 4 C steps of the
-//! twin's static table, `cargo xtask run`).
+//! shown as
+//!
+//! ```text
+//! 499 ms t=26.00 C x=0.0 um v=0.000 mm/s p_a=273.9 p_b=126.1 kPa Q_a=0.241 Q_b=0.241 Q_throt=0.000 Q0=0.481 err=-0.502 l/min reseats=0 [AT_STOP]
+//! ```
+//!
+//! (a unit after the last of a run of fields that share it). The CSV gets
+//! every digit the record carries, in SI units: an `f32` field in its
+//! shortest round-trip form, which reads back to the same `f32`.
 
+use compensator::estimator::Flags;
+use compensator::estimator::telemetry::{self, Encoding, FIELDS, Field};
 use std::path::Path;
 
-/// The CSV header, SI units (as `compensator step`'s columns).
-pub const HEADER: [&str; 12] = [
-    "time_s",
-    "t_c",
-    "x_m",
-    "v_m_s",
-    "p_a_pa",
-    "p_b_pa",
-    "q_a_m3s",
-    "q_b_m3s",
-    "q_throt_m3s",
-    "q_total_m3s",
-    "compensation_error_m3s",
-    "flags",
-];
+/// What precedes the record's bytes in a telemetry line.
+const MARK: &str = " ms telemetry [";
+
+/// The CSV header, SI units (as `compensator step`'s columns): `time_s`,
+/// the table's columns, `flags`.
+pub fn header() -> Vec<&'static str> {
+    let mut h = vec!["time_s"];
+    h.extend(FIELDS.iter().map(|f| f.column));
+    h.push("flags");
+    h
+}
 
 /// One telemetry record, in SI units.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Record {
     /// Time since start [s].
     pub time_s: f64,
-    /// Filtered oil temperature [C].
-    pub t_c: f64,
-    /// Plunger displacement [m].
-    pub x_m: f64,
-    /// Plunger velocity [m/s].
-    pub v_m_s: f64,
-    /// Chamber (a) pressure [Pa].
-    pub p_a_pa: f64,
-    /// Chamber (b) pressure [Pa].
-    pub p_b_pa: f64,
-    /// Capillary flow [m^3/s].
-    pub q_a_m3s: f64,
-    /// Orifice flow [m^3/s].
-    pub q_b_m3s: f64,
-    /// Window flow [m^3/s].
-    pub q_throt_m3s: f64,
-    /// Total flow [m^3/s].
-    pub q_total_m3s: f64,
-    /// Compensation error [m^3/s] (NaN without a `[machine]`).
-    pub compensation_error_m3s: f64,
-    /// Flag names joined by `|` (empty: none).
-    pub flags: String,
+    /// The record's fields and flags.
+    pub values: telemetry::Record,
 }
 
-/// l/min per m^3/s.
-const LPM: f64 = 6.0e4;
-
 impl Record {
-    /// The values of the numeric columns, in [`HEADER`] order.
-    pub fn numbers(&self) -> [f64; 11] {
-        [
-            self.time_s,
-            self.t_c,
-            self.x_m,
-            self.v_m_s,
-            self.p_a_pa,
-            self.p_b_pa,
-            self.q_a_m3s,
-            self.q_b_m3s,
-            self.q_throt_m3s,
-            self.q_total_m3s,
-            self.compensation_error_m3s,
-        ]
+    /// Flag names joined by `|` (empty: none).
+    pub fn flags(&self) -> String {
+        self.values.flags.names().collect::<Vec<_>>().join("|")
     }
 
     /// The human-readable line, rounded (see the module docs).
     pub fn display(&self) -> String {
-        let flags = if self.flags.is_empty() { "-" } else { &self.flags };
-        format!(
-            "{} ms t={} C x={} um v={} mm/s p_a={} p_b={} kPa Q_a={} Q_b={} Q_throt={} Q0={} err={} l/min [{flags}]",
-            (self.time_s * 1e3).round(),
-            fixed(self.t_c, 2),
-            fixed(self.x_m * 1e6, 1),
-            fixed(self.v_m_s * 1e3, 3),
-            fixed(self.p_a_pa * 1e-3, 1),
-            fixed(self.p_b_pa * 1e-3, 1),
-            fixed(self.q_a_m3s * LPM, 3),
-            fixed(self.q_b_m3s * LPM, 3),
-            fixed(self.q_throt_m3s * LPM, 3),
-            fixed(self.q_total_m3s * LPM, 3),
-            fixed(self.compensation_error_m3s * LPM, 3),
-        )
+        let mut s = format!("{} ms", (self.time_s * 1e3).round());
+        let values = self.values.values();
+        for (i, (f, v)) in FIELDS.iter().zip(values).enumerate() {
+            s += &format!(" {}={}", f.key, fixed(v * f.scale, f.decimals));
+            let last_of_unit = FIELDS.get(i + 1).is_none_or(|g| g.shown_unit != f.shown_unit);
+            if last_of_unit && !f.shown_unit.is_empty() {
+                s += &format!(" {}", f.shown_unit);
+            }
+        }
+        let flags = self.flags();
+        s + &format!(" [{}]", if flags.is_empty() { "-" } else { &flags })
     }
 }
 
@@ -116,49 +78,66 @@ fn fixed(v: f64, decimals: usize) -> String {
     }
 }
 
+/// A value in its CSV form: an `f32` field's shortest round-trip `f32`
+/// digits, the rest as `f64`.
+fn csv_value(field: &Field, v: f64) -> String {
+    match field.encoding {
+        Encoding::F32 => (v as f32).to_string(),
+        _ => v.to_string(),
+    }
+}
+
+/// [`csv_value`] read back.
+fn parse_value(field: &Field, text: &str) -> Option<f64> {
+    match field.encoding {
+        Encoding::F32 => text.parse::<f32>().ok().map(f64::from),
+        _ => text.parse().ok(),
+    }
+}
+
 /// Where the telemetry message starts in a log line (after a level or
-/// timestamp prefix): the digits before `" ms t="`.
+/// timestamp prefix): the digits before [`MARK`].
 fn message_start(line: &str) -> Option<usize> {
-    let at = line.find(" ms t=")?;
+    let at = line.find(MARK)?;
     let digits = line[..at].bytes().rev().take_while(u8::is_ascii_digit).count();
     (digits > 0).then_some(at - digits)
 }
 
-/// The record of a telemetry line, or `None` for any other line.
-pub fn parse(line: &str) -> Option<Record> {
-    let msg = &line[message_start(line)?..];
-    let mut words = msg.split_whitespace();
-    let ms: f64 = words.next()?.parse().ok()?;
-    let get = |key: &str| -> Option<f64> {
-        let w = msg
-            .split_whitespace()
-            .find_map(|w| w.strip_prefix(key)?.strip_prefix('='))?;
-        w.parse::<f64>().ok()
+/// The record of a telemetry line; `Ok(None)` for any other line.
+///
+/// # Errors
+///
+/// A telemetry line whose bytes do not make a record of this table (cut
+/// short, or sent by a firmware built from another table), described.
+pub fn parse(line: &str) -> Result<Option<Record>, String> {
+    let Some(start) = message_start(line) else {
+        return Ok(None);
     };
-    let (t, x, v, pa, pb) = (get("t")?, get("x")?, get("v")?, get("p_a")?, get("p_b")?);
-    let (qa, qb, qt, q0, err) = (get("Q_a")?, get("Q_b")?, get("Q_throt")?, get("Q0")?, get("err")?);
-    let flags = msg.rsplit_once('[')?.1.strip_suffix(']')?.trim();
-    Some(Record {
+    let msg = &line[start..];
+    let (ms, rest) = msg.split_once(MARK).ok_or("no telemetry mark")?;
+    let ms: f64 = ms.parse().map_err(|_| format!("telemetry time {ms:?}"))?;
+    let list = rest
+        .trim_end()
+        .strip_suffix(']')
+        .ok_or_else(|| format!("telemetry record not closed: {line}"))?;
+    let bytes: Vec<u8> = list
+        .split(',')
+        .map(|b| b.trim().parse::<u8>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("telemetry record bytes: {line}"))?;
+    let values = telemetry::Record::decode(&bytes).map_err(|e| e.to_string())?;
+    Ok(Some(Record {
         time_s: ms * 1e-3,
-        t_c: t,
-        x_m: x * 1e-6,
-        v_m_s: v * 1e-3,
-        p_a_pa: pa * 1e3,
-        p_b_pa: pb * 1e3,
-        q_a_m3s: qa / LPM,
-        q_b_m3s: qb / LPM,
-        q_throt_m3s: qt / LPM,
-        q_total_m3s: q0 / LPM,
-        compensation_error_m3s: err / LPM,
-        flags: if flags == "-" { String::new() } else { flags.to_string() },
-    })
+        values,
+    }))
 }
 
 /// `line` with a telemetry message rounded for reading; other lines as
-/// they are.
+/// they are (a telemetry line that does not decode says why).
 pub fn humanize(line: &str) -> String {
     match (message_start(line), parse(line)) {
-        (Some(start), Some(r)) => format!("{}{}", &line[..start], r.display()),
+        (Some(start), Ok(Some(r))) => format!("{}{}", &line[..start], r.display()),
+        (_, Err(e)) => format!("{line} ({e})"),
         _ => line.to_string(),
     }
 }
@@ -176,23 +155,24 @@ impl CsvFile {
     pub fn create(path: &Path) -> Result<CsvFile, String> {
         let mut writer = csv::Writer::from_path(path).map_err(|e| format!("{}: {e}", path.display()))?;
         writer
-            .write_record(HEADER)
+            .write_record(header())
             .map_err(|e| format!("{}: {e}", path.display()))?;
         Ok(CsvFile { writer, rows: 0 })
     }
 
     /// Appends the record of `line` if it is a telemetry line.
     pub fn line(&mut self, line: &str) -> Result<(), String> {
-        match parse(line) {
+        match parse(line)? {
             Some(r) => self.record(&r),
             None => Ok(()),
         }
     }
 
-    /// Appends one record (numbers in their shortest round-trip form).
+    /// Appends one record.
     pub fn record(&mut self, r: &Record) -> Result<(), String> {
-        let mut row: Vec<String> = r.numbers().iter().map(|v| v.to_string()).collect();
-        row.push(r.flags.clone());
+        let mut row = vec![r.time_s.to_string()];
+        row.extend(FIELDS.iter().zip(r.values.values()).map(|(f, v)| csv_value(f, v)));
+        row.push(r.flags());
         self.writer.write_record(&row).map_err(|e| e.to_string())?;
         self.writer.flush().map_err(|e| e.to_string())?;
         self.rows += 1;
@@ -203,75 +183,162 @@ impl CsvFile {
 /// Reads a telemetry CSV written by [`CsvFile`] back into records.
 pub fn read_csv(path: &Path) -> Result<Vec<Record>, String> {
     let mut reader = csv::Reader::from_path(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let header: Vec<String> = reader
+    let found: Vec<String> = reader
         .headers()
         .map_err(|e| e.to_string())?
         .iter()
         .map(str::to_string)
         .collect();
-    if header != HEADER {
-        return Err(format!("{}: header {header:?}", path.display()));
+    if found != header() {
+        return Err(format!("{}: header {found:?}, expected {:?}", path.display(), header()));
     }
     let mut out = Vec::new();
-    for row in reader.records() {
+    for (i, row) in reader.records().enumerate() {
         let row = row.map_err(|e| e.to_string())?;
-        let n: Vec<f64> = (0..11)
-            .map(|i| row.get(i).and_then(|v| v.parse().ok()).ok_or(format!("row {row:?}")))
-            .collect::<Result<_, _>>()?;
+        let at = |c: usize| row.get(c).unwrap_or_default();
+        let bad = |c: usize| format!("{}: row {}, column {}: {:?}", path.display(), i + 1, header()[c], at(c));
+        let time_s = at(0).parse().map_err(|_| bad(0))?;
+        let mut values = [0.0; FIELDS.len()];
+        for (k, f) in FIELDS.iter().enumerate() {
+            values[k] = parse_value(f, at(k + 1)).ok_or_else(|| bad(k + 1))?;
+        }
+        let flags_col = FIELDS.len() + 1;
+        let mut flags = Flags::empty();
+        for name in at(flags_col).split('|').filter(|n| !n.is_empty()) {
+            let bit = Flags::NAMES
+                .iter()
+                .position(|n| *n == name)
+                .ok_or_else(|| bad(flags_col))?;
+            flags.insert(Flags(1 << bit));
+        }
         out.push(Record {
-            time_s: n[0],
-            t_c: n[1],
-            x_m: n[2],
-            v_m_s: n[3],
-            p_a_pa: n[4],
-            p_b_pa: n[5],
-            q_a_m3s: n[6],
-            q_b_m3s: n[7],
-            q_throt_m3s: n[8],
-            q_total_m3s: n[9],
-            compensation_error_m3s: n[10],
-            flags: row.get(11).unwrap_or_default().to_string(),
+            time_s,
+            values: telemetry::Record::from_values(values, flags),
         });
     }
     Ok(out)
 }
 
+/// The documentation's table of the record's columns (docs/firmware.md,
+/// between its `telemetry-columns` markers; the test that keeps it
+/// current is its only user).
+#[cfg(test)]
+fn columns_markdown() -> String {
+    let mut s = String::from(
+        "| column | unit | sent as | shown as | description |\n| --- | --- | --- | --- | --- |\n\
+         | `time_s` | s | the line's time in ms (`u32`) | `499 ms` | Time since start. |\n",
+    );
+    for f in &FIELDS {
+        let step = fixed(f.resolution() * f.scale, f.decimals);
+        let shown = if f.shown_unit.is_empty() {
+            format!("`{}=`, to {step}", f.key)
+        } else {
+            format!("`{}=` in {}, to {step}", f.key, f.shown_unit)
+        };
+        s += &format!(
+            "| `{}` | {} | {} | {} | {} |\n",
+            f.column,
+            f.unit,
+            f.encoding.describe(),
+            shown,
+            f.doc.trim()
+        );
+    }
+    // `\|`: a bar inside a table cell, even in code.
+    s + "| `flags` | - | `u16` bits | `[AT_STOP\\|SPIKE]`, `[-]` for none | The condition flags' names joined by `\\|`. |\n"
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use compensator::estimator::StateEstimate;
 
-    /// A line of the twin's log (tests/snapshots/twin.log before rounding).
-    const LINE: &str = "INFO  12999 ms t=35.789177 C x=12.860147 um v=0.03813392 mm/s p_a=196.20572 p_b=203.79424 kPa Q_a=0.30710542 Q_b=0.3069253 Q_throt=0.0917632 Q0=0.7057939 err=-1.0280564 l/min [-]";
+    /// An estimate as the twin's log has one at 12.999 s.
+    fn estimate(flags: Flags) -> StateEstimate {
+        StateEstimate {
+            tick: 12999,
+            temperature: 35.789177,
+            t_probe: 35.31,
+            x: 12.860147e-6,
+            v: 0.03813392e-3,
+            p_a: 196205.72,
+            p_b: 203794.24,
+            q_a: 0.30710542 / 6e4,
+            q_b: 0.3069253 / 6e4,
+            q_throt: 0.0917632 / 6e4,
+            q_total: 0.7057939 / 6e4,
+            compensation_error: -1.0280564 / 6e4,
+            x_equilibrium: 12.9e-6,
+            dx_dt: 3.7e-5,
+            reseats: 2,
+            deadline_misses: 0,
+            uncertainty: compensator::uncertainty::Uncertainty {
+                t_oil: 0.31,
+                x: 7.8e-6,
+                p_a: 1275.8,
+                p_b: 1275.8,
+                q_total: 9.7e-7,
+                compensation_error: 2.1e-7,
+            },
+            flags,
+        }
+    }
+
+    /// The log line the firmware sends for `e` at `ms` (defmt prints a
+    /// byte string as Rust's `Debug` does).
+    fn line(prefix: &str, ms: u32, e: &StateEstimate) -> String {
+        format!("{prefix}{ms} ms telemetry {:?}", telemetry::encode(e))
+    }
 
     #[test]
     fn a_telemetry_line_decodes_to_si_units() {
-        let r = parse(LINE).unwrap();
+        let e = estimate(Flags::empty());
+        let l = line("INFO  ", 12999, &e);
+        let r = parse(&l).unwrap().unwrap();
         assert_eq!(r.time_s, 12.999);
-        assert_eq!(r.t_c, 35.789177);
-        assert!((r.x_m - 12.860147e-6).abs() < 1e-18);
-        assert!((r.v_m_s - 0.03813392e-3).abs() < 1e-18);
-        assert_eq!((r.p_a_pa, r.p_b_pa), (196205.72, 203794.24));
-        // 0.7057939 l/min = 1.17632317e-5 m^3/s.
-        assert!((r.q_total_m3s - 1.176_323_166_666_666_7e-5).abs() < 1e-18);
-        assert!(r.flags.is_empty());
-        let flagged = LINE
-            .replace("[-]", "[AT_STOP|SPIKE]")
-            .replace("err=-1.0280564", "err=NaN");
-        let r = parse(&flagged).unwrap();
-        assert_eq!(r.flags, "AT_STOP|SPIKE");
-        assert!(r.compensation_error_m3s.is_nan());
+        assert_eq!(r.values.t_oil_c, f64::from(35.789177f32));
+        assert_eq!(r.values.t_probe_c, f64::from(35.31f32));
+        assert_eq!(r.values.x_sd_m, f64::from(7.8e-6f32));
+        assert_eq!(r.values.x_m, f64::from(12.860147e-6f32));
+        assert_eq!(r.values.p_a_pa, f64::from(196205.72f32));
+        assert_eq!(r.values.reseats, 2.0);
+        assert_eq!(r.values, telemetry::Record::of(&e));
+        assert!(r.flags().is_empty());
+        let mut flagged = estimate(Flags::AT_STOP);
+        flagged.flags.insert(Flags::SPIKE);
+        flagged.compensation_error = f32::NAN;
+        let r = parse(&line("INFO  ", 1, &flagged)).unwrap().unwrap();
+        assert_eq!(r.flags(), "AT_STOP|SPIKE");
+        assert!(r.values.compensation_error_m3s.is_nan());
         // A probe-rs line (timestamp and level first) decodes the same.
-        let board = format!("0.500000 INFO {}", &LINE[6..]);
-        assert_eq!(parse(&board).unwrap().p_a_pa, 196205.72);
-        assert!(parse("INFO  checkpoint 26.0 C: x 0.0 um").is_none());
-        assert!(parse("INFO  replaying 74.0 s: ticks of 1.0 ms").is_none());
+        let board = line("0.500000 INFO ", 12999, &e);
+        assert_eq!(parse(&board).unwrap().unwrap().values, telemetry::Record::of(&e));
+        assert!(parse("INFO  checkpoint 26.0 C: x 0.0 um").unwrap().is_none());
+        assert!(parse("INFO  replaying 74.0 s: ticks of 1.0 ms").unwrap().is_none());
+    }
+
+    #[test]
+    fn a_line_that_is_not_a_record_of_this_table_is_an_error() {
+        let l = line("INFO  ", 5, &estimate(Flags::empty()));
+        let short = l.replacen("[", "[1, ", 1);
+        assert!(
+            parse(&short).unwrap_err().contains("bytes"),
+            "{}",
+            parse(&short).unwrap_err()
+        );
+        let mut bytes = telemetry::encode(&estimate(Flags::empty()));
+        bytes[0] ^= 0xFF;
+        let other = format!("INFO  5 ms telemetry {bytes:?}");
+        assert!(parse(&other).unwrap_err().contains("layout"));
+        assert!(humanize(&other).contains("different tables"));
+        assert!(parse("INFO  5 ms telemetry [1, 2, x]").is_err());
     }
 
     #[test]
     fn the_readable_line_is_rounded_to_what_the_sensor_resolves() {
         assert_eq!(
-            humanize(LINE),
-            "INFO  12999 ms t=35.79 C x=12.9 um v=0.038 mm/s p_a=196.2 p_b=203.8 kPa Q_a=0.307 Q_b=0.307 Q_throt=0.092 Q0=0.706 err=-1.028 l/min [-]"
+            humanize(&line("INFO  ", 12999, &estimate(Flags::empty()))),
+            "INFO  12999 ms t_probe=35.31 t=35.79 u_t=0.310 C x=12.9 u_x=7.80 um v=0.038 mm/s p_a=196.2 u_p_a=1.28 p_b=203.8 u_p_b=1.28 kPa Q_a=0.307 Q_b=0.307 Q_throt=0.092 Q0=0.706 u_Q0=0.0582 err=-1.028 u_err=0.0126 l/min reseats=2 missed=0 [-]"
         );
         assert_eq!(fixed(-0.0001, 3), "0.000");
         assert_eq!(fixed(-0.0006, 3), "-0.001");
@@ -282,21 +349,67 @@ mod tests {
     fn the_csv_has_the_header_and_reads_back_exactly() {
         let path = std::env::temp_dir().join(format!("xtask-telemetry-{}.csv", std::process::id()));
         let mut csv = CsvFile::create(&path).unwrap();
-        csv.line(LINE).unwrap();
+        let a = estimate(Flags::empty());
+        let mut b = estimate(Flags::AT_STOP);
+        b.flags.insert(Flags::SPIKE);
+        csv.line(&line("INFO  ", 12999, &a)).unwrap();
         csv.line("INFO  not telemetry").unwrap();
-        csv.line(&LINE.replace("[-]", "[AT_STOP]")).unwrap();
+        csv.line(&line("INFO  ", 13499, &b)).unwrap();
         assert_eq!(csv.rows, 2);
         drop(csv);
         let text = std::fs::read_to_string(&path).unwrap();
         assert_eq!(
             text.lines().next().unwrap(),
-            "time_s,t_c,x_m,v_m_s,p_a_pa,p_b_pa,q_a_m3s,q_b_m3s,q_throt_m3s,q_total_m3s,compensation_error_m3s,flags"
+            "time_s,t_probe_c,t_oil_c,t_oil_sd_c,x_m,x_sd_m,v_m_s,p_a_pa,p_a_sd_pa,p_b_pa,p_b_sd_pa,q_a_m3s,q_b_m3s,q_throt_m3s,q_total_m3s,q_total_sd_m3s,compensation_error_m3s,compensation_error_sd_m3s,reseats,deadline_misses,flags"
+        );
+        assert!(
+            text.lines()
+                .nth(1)
+                .unwrap()
+                .starts_with("12.999,35.31,35.789177,0.31,0.000012860147,")
         );
         let back = read_csv(&path).unwrap();
         assert_eq!(
             back,
-            vec![parse(LINE).unwrap(), parse(&LINE.replace("[-]", "[AT_STOP]")).unwrap()]
+            vec![
+                parse(&line("", 12999, &a)).unwrap().unwrap(),
+                parse(&line("", 13499, &b)).unwrap().unwrap()
+            ]
         );
         let _ = std::fs::remove_file(&path);
+    }
+
+    /// The column table in docs/firmware.md and the header the README and
+    /// the docs print are the table's (`XTASK_WRITE_DOCS=1` rewrites the
+    /// column table).
+    #[test]
+    fn the_docs_show_the_tables_columns() {
+        let root = crate::root();
+        let path = root.join("docs/firmware.md");
+        let doc = std::fs::read_to_string(&path).unwrap();
+        let (begin, end) = (
+            "<!-- BEGIN GENERATED: telemetry-columns -->\n",
+            "<!-- END GENERATED: telemetry-columns -->",
+        );
+        let (head, rest) = doc
+            .split_once(begin)
+            .expect("docs/firmware.md has the telemetry-columns markers");
+        let (_, tail) = rest
+            .split_once(end)
+            .expect("docs/firmware.md has the telemetry-columns end marker");
+        let current = format!("{head}{begin}{}{end}{tail}", columns_markdown());
+        if std::env::var_os("XTASK_WRITE_DOCS").is_some() {
+            std::fs::write(&path, &current).unwrap();
+            return;
+        }
+        assert!(
+            doc == current,
+            "docs/firmware.md's telemetry columns are stale: run `XTASK_WRITE_DOCS=1 cargo test -p xtask the_docs`"
+        );
+        let csv_header = header().join(",");
+        for file in ["README.md", "docs/firmware.md"] {
+            let text = std::fs::read_to_string(root.join(file)).unwrap();
+            assert!(text.contains(&csv_header), "{file} shows the CSV header {csv_header}");
+        }
     }
 }

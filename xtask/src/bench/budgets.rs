@@ -2,16 +2,31 @@
 //! them (`cargo xtask bench`, and `cargo xtask test` through
 //! [`super::check`]).
 
-use super::Firmware;
 use super::measure::Built;
+use super::{Firmware, M0_TWIN, M3_TWIN};
 
 /// The firmware's budgets.
 pub const BUDGET_INSTRUCTIONS: f64 = 3000.0;
 /// The twin's plain tick on the paper preset (the configuration its build
 /// chooses) [instructions].
 pub const BUDGET_TWIN_PAPER: f64 = 1600.0;
-/// Flash budget [bytes].
+/// Flash budget of the board image, what a user flashes: a 64 KiB part
+/// holds it [bytes].
 pub const BUDGET_FLASH: u64 = 64 * 1024;
+/// Flash budget of the QEMU twin image: the board's estimator and, on top,
+/// the replay's harness the board has not (its schedule, checkpoints and
+/// self-checks, about 7.5 KiB of code and tables, and the start-up
+/// characteristic it prints, about 7 KiB) [bytes].
+pub const BUDGET_QEMU_TWIN_FLASH: u64 = 72 * 1024;
+
+/// The flash budget of the image labelled `label` [bytes].
+pub fn flash_budget(label: &str) -> u64 {
+    if label == super::QEMU_TWIN {
+        BUDGET_QEMU_TWIN_FLASH
+    } else {
+        BUDGET_FLASH
+    }
+}
 /// Static RAM budget [bytes].
 pub const BUDGET_RAM: u64 = 8 * 1024;
 /// Peak stack budget [bytes]. The peak is reached once, at start: `main`
@@ -23,6 +38,19 @@ pub const BUDGET_RAM: u64 = 8 * 1024;
 /// The board's stack has the 64 KiB CCM to itself (`link/memory-board.x`),
 /// so 6 KiB keeps a margin of ten.
 pub const BUDGET_STACK: u64 = 6 * 1024;
+
+/// The Q12.20 twin's plain tick on the Cortex-M3, built for the paper
+/// preset (SDIRK3, one step per tick) [instructions].
+pub const BUDGET_FIXED_TWIN_M3: f64 = 4000.0;
+/// The Q12.20 twin's tick against the soft-float `f32` one, built as for
+/// the file, on the FPU-less cores: at most this fraction of it.
+pub const BUDGET_FIXED_OVER_SOFT: f64 = 0.5;
+/// Flash of a fixed-point core's twin image (the whole estimator): the
+/// Cortex-M0 board's 256 KiB (nRF51822) [bytes].
+pub const BUDGET_FIXED_FLASH: u64 = 256 * 1024;
+/// Static RAM and peak stack together of a fixed-point core's twin image:
+/// the Cortex-M0 board's 16 KiB [bytes].
+pub const BUDGET_FIXED_RAM: u64 = 16 * 1024;
 
 /// The estimator's tick on the Cortex-M4F, with or without telemetry
 /// packing, over every workload [instructions].
@@ -63,12 +91,25 @@ impl TwinBudget {
     }
 }
 
+/// The Q12.20 twin against the soft-float `f32` one on an FPU-less core,
+/// as built [instructions per tick, mean].
+#[derive(Debug, Clone)]
+pub struct FixedTwinBudget {
+    /// `Cortex-M3`, `Cortex-M0`.
+    pub core: &'static str,
+    pub fixed: f64,
+    pub fixed_worst: f64,
+    pub soft: f64,
+}
+
 /// The measurements the budgets bound, and the budgets missed.
 #[derive(Debug, Clone)]
 pub struct Budget {
     /// With telemetry, then without.
     pub estimator: Vec<EstimatorBudget>,
     pub twin: TwinBudget,
+    /// The Cortex-M3's, then the Cortex-M0's.
+    pub fixed: Vec<FixedTwinBudget>,
     /// One line per budget missed, in the budget table's order.
     pub over: Vec<String>,
 }
@@ -80,13 +121,11 @@ impl Budget {
         let mut over = Vec::new();
         let mut estimator = Vec::new();
         for telemetry in [true, false] {
-            let rows: Vec<_> = fw.m4.estimator.iter().filter(|e| e.telemetry == telemetry).collect();
-            let first = rows.first().ok_or("the bench image reported no estimator tick cost")?;
-            let e = EstimatorBudget {
-                telemetry,
-                mean: first.mean,
-                worst: rows.iter().map(|e| e.worst).fold(0.0, f64::max),
-            };
+            let (mean, worst) = fw
+                .m4
+                .estimator("f32", telemetry)
+                .ok_or("the bench image reported no estimator tick cost")?;
+            let e = EstimatorBudget { telemetry, mean, worst };
             if e.worst > BUDGET_INSTRUCTIONS {
                 over.push(format!(
                     "{}: worst {:.0} instructions > {BUDGET_INSTRUCTIONS:.0}",
@@ -117,8 +156,55 @@ impl Budget {
                 twin.worst
             ));
         }
-        for f in &fw.footprints {
-            if f.flash > BUDGET_FLASH {
+        let mut fixed = Vec::new();
+        for (core, costs) in [("Cortex-M3", &fw.m3), ("Cortex-M0", &fw.m0)] {
+            let q = costs
+                .twin(&twin.built.config, "q12.20")
+                .ok_or_else(|| format!("the {core} bench reported no Q12.20 twin"))?;
+            let soft = costs
+                .twin(&twin.built.config, "f32-soft")
+                .ok_or_else(|| format!("the {core} bench reported no soft-float twin"))?;
+            if q.mean > BUDGET_FIXED_OVER_SOFT * soft.mean {
+                over.push(format!(
+                    "Q12.20 twin on the {core}: mean {:.0} instructions > {BUDGET_FIXED_OVER_SOFT} x soft-float f32 {:.0}",
+                    q.mean, soft.mean
+                ));
+            }
+            if core == "Cortex-M3" && twin.on_paper_preset() && q.worst > BUDGET_FIXED_TWIN_M3 {
+                over.push(format!(
+                    "Q12.20 twin tick on the Cortex-M3 (paper preset): worst {:.0} instructions > {BUDGET_FIXED_TWIN_M3:.0}",
+                    q.worst
+                ));
+            }
+            fixed.push(FixedTwinBudget {
+                core,
+                fixed: q.mean,
+                fixed_worst: q.worst,
+                soft: soft.mean,
+            });
+        }
+        for (f, stack) in fw
+            .footprints
+            .iter()
+            .filter(|f| f.label == M3_TWIN || f.label == M0_TWIN)
+            .zip(fw.fixed_stacks)
+        {
+            if f.flash > BUDGET_FIXED_FLASH {
+                over.push(format!("flash of the {}: {} bytes", f.label, f.flash));
+            }
+            if f.ram + stack > BUDGET_FIXED_RAM {
+                over.push(format!(
+                    "static RAM and stack of the {}: {} + {stack} bytes",
+                    f.label, f.ram
+                ));
+            }
+        }
+        for f in fw
+            .footprints
+            .iter()
+            .filter(|f| f.label != M3_TWIN && f.label != M0_TWIN)
+        {
+            if f.flash > flash_budget(f.label) {
                 over.push(format!("flash of the {}: {} bytes", f.label, f.flash));
             }
             if f.ram > BUDGET_RAM {
@@ -128,7 +214,12 @@ impl Budget {
         if fw.stack > BUDGET_STACK {
             over.push(format!("peak stack {} bytes", fw.stack));
         }
-        Ok(Budget { estimator, twin, over })
+        Ok(Budget {
+            estimator,
+            twin,
+            fixed,
+            over,
+        })
     }
 }
 
@@ -139,17 +230,31 @@ mod tests {
     use crate::bench::measure::{Costs, tests::lines};
     use crate::bench::report::budget_table;
 
+    /// The soft-float twin of the FPU-less cores' fixtures (mean 6000).
+    const SOFT: &str =
+        "[measure] twin scheme=sdirk3 substeps=1 scalar=f32-soft ticks=201 total=200000 worst=1100 graded=0 ok=true";
+
     fn firmware(extra: &[&str], flash: u64, stack: u64) -> Firmware {
         let costs = || Costs::parse(&lines(extra)).unwrap();
+        let fixed = || Costs::parse(&lines(&[extra, &[SOFT]].concat())).unwrap();
         Firmware {
             m4: costs(),
-            m3: costs(),
+            m3: fixed(),
+            m0: fixed(),
             stack,
-            footprints: vec![Footprint {
-                label: "board image",
-                flash,
-                ram: 1104,
-            }],
+            fixed_stacks: [5000, 6000],
+            footprints: vec![
+                Footprint {
+                    label: "board image",
+                    flash,
+                    ram: 1104,
+                },
+                Footprint {
+                    label: M0_TWIN,
+                    flash: 90_000,
+                    ram: 300,
+                },
+            ],
         }
     }
 
@@ -165,8 +270,12 @@ mod tests {
              | estimator tick, no telemetry, Cortex-M4F f32 (step and ramps) | mean 1500, worst 2700 instructions | <= 3000 |\n\
              | twin tick alone, as built for paper.toml (sdirk3 x1, f32), Cortex-M4F | mean 1020, worst 1020 instructions (the graded tick after an abrupt step: 6000) | <= 1600 (paper preset) |\n\
              | twin tick through a 1 C/s ramp across the opening (releases), Cortex-M4F | mean 900, worst 2220 instructions | measured (the estimator defers its job then) |\n\
+             | twin tick as built (sdirk3 x1), Cortex-M3, Q12.20 against soft-float f32 | mean 0 (worst 6) against 6000 instructions: 0.00 | <= 0.5, worst <= 4000 (paper preset) |\n\
+             | twin tick as built (sdirk3 x1), Cortex-M0, Q12.20 against soft-float f32 | mean 0 (worst 6) against 6000 instructions: 0.00 | <= 0.5 |\n\
              | flash, board image | 48.6 KiB | <= 64 KiB |\n\
              | static RAM, board image | 1104 bytes | <= 8 KiB |\n\
+             | flash, Cortex-M0 twin image | 87.9 KiB | <= 256 KiB |\n\
+             | static RAM and peak stack, Cortex-M0 twin image | 300 + 5000 bytes | <= 16 KiB |\n\
              | peak stack, QEMU twin run (stack painting) | 4580 bytes | <= 6 KiB |\n"
         );
     }

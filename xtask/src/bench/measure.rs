@@ -104,7 +104,7 @@ pub struct EventCost {
     pub worst: f64,
 }
 
-/// One estimator piece, called once [instructions].
+/// One estimator piece [instructions per call].
 #[derive(Debug, Clone)]
 #[cfg_attr(not(feature = "host"), allow(dead_code))]
 pub struct PieceCost {
@@ -115,6 +115,8 @@ pub struct PieceCost {
 /// The estimator's tick through one workload [instructions per tick].
 #[derive(Debug, Clone)]
 pub struct EstimatorCost {
+    /// The twin's scalar type (`f32`, `f32-soft`, `q12.20`).
+    pub scalar: String,
     /// With telemetry packing.
     pub telemetry: bool,
     pub mean: f64,
@@ -128,6 +130,9 @@ pub struct Costs {
     pub built: Option<Built>,
     pub events: Vec<EventCost>,
     pub pieces: Vec<PieceCost>,
+    /// The arithmetic of the Q12.20 tick and what it competes with, one
+    /// operation each (`[measure] fixed`).
+    pub operations: Vec<PieceCost>,
     /// Per workload (the step first, then the ramps), with and without telemetry.
     pub estimator: Vec<EstimatorCost>,
     /// Instructions per SysTick count.
@@ -150,6 +155,7 @@ impl Costs {
             built: None,
             events: vec![],
             pieces: vec![],
+            operations: vec![],
             estimator: vec![],
             per_count: k,
         };
@@ -197,13 +203,26 @@ impl Costs {
                         worst: m.num("worst")? * k,
                     });
                 }
+                // One fixed-point (or comparison) operation, `calls` times.
+                "fixed" => out.operations.push(PieceCost {
+                    name: m.str("name").to_string(),
+                    instructions: m.num("total")? * k / m.num("calls")?,
+                }),
+                // `calls=N`: the piece ran N times, its cost is per call.
                 "piece" => out.pieces.push(PieceCost {
                     name: m.str("name").to_string(),
-                    instructions: m.num("total")? * k,
+                    instructions: m.num("total")? * k
+                        / if m.fields.contains_key("calls") {
+                            m.num("calls")?
+                        } else {
+                            1.0
+                        },
                 }),
                 "estimator" => {
                     let ticks = m.num("ticks")?;
                     out.estimator.push(EstimatorCost {
+                        // The Cortex-M4F's f32 twin unless the line says.
+                        scalar: m.fields.get("scalar").map_or("f32", String::as_str).to_string(),
                         telemetry: m.str("telemetry") == "true",
                         mean: m.num("total")? * k / ticks,
                         worst: m.num("worst")? * k,
@@ -213,6 +232,25 @@ impl Costs {
             }
         }
         Ok(out)
+    }
+
+    /// The estimator's mean over the first workload (the step) and worst
+    /// over every workload, with its twin in `scalar`, with or without
+    /// telemetry, if measured.
+    pub fn estimator(&self, scalar: &str, telemetry: bool) -> Option<(f64, f64)> {
+        let rows: Vec<_> = self
+            .estimator
+            .iter()
+            .filter(|e| e.scalar == scalar && e.telemetry == telemetry)
+            .collect();
+        let first = rows.first()?;
+        Some((first.mean, rows.iter().map(|e| e.worst).fold(0.0, f64::max)))
+    }
+
+    /// One operation's cost (`[measure] fixed name=...`), if measured.
+    #[cfg_attr(not(feature = "host"), allow(dead_code))]
+    pub fn operation(&self, name: &str) -> Option<f64> {
+        self.operations.iter().find(|p| p.name == name).map(|p| p.instructions)
     }
 
     /// The twin's cost in a configuration and scalar type, if measured.
@@ -251,6 +289,7 @@ pub(super) mod tests {
             "INFO  [measure] twin scheme=ros3 substeps=2 scalar=f32 ticks=201 total=1 worst=1 graded=1 ok=true",
             "INFO  [measure] twin-events kind=release scheme=sdirk3 substeps=1 ticks=4000 total=600000 worst=370 ok=true",
             "INFO  [measure] piece name=telemetry total=210",
+            "INFO  [measure] piece name=telemetry-field-u16 calls=16 total=32",
             "INFO  [measure] estimator workload=step scheme=sdirk3 substeps=1 telemetry=true ticks=1000 total=300000 worst=400 worst_tick=3",
             "INFO  [measure] estimator workload=step scheme=sdirk3 substeps=1 telemetry=false ticks=1000 total=250000 worst=300 worst_tick=3",
             "INFO  [measure] estimator workload=ramps scheme=sdirk3 substeps=1 telemetry=false ticks=1000 total=1 worst=450 worst_tick=3",
@@ -281,6 +320,11 @@ pub(super) mod tests {
         assert_eq!(
             (c.pieces[0].name.as_str(), c.pieces[0].instructions),
             ("telemetry", 1260.0)
+        );
+        // A piece run `calls` times costs its total over the calls.
+        assert_eq!(
+            (c.pieces[1].name.as_str(), c.pieces[1].instructions),
+            ("telemetry-field-u16", 12.0)
         );
         let e: Vec<_> = c.estimator.iter().map(|e| (e.telemetry, e.mean, e.worst)).collect();
         assert_eq!(

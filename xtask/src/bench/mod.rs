@@ -5,11 +5,13 @@
 //!   (one nanosecond of emulated time per instruction) and reports SysTick
 //!   counts; its calibration loop of known length converts them (0.168
 //!   counts per instruction on the netduinoplus2 STM32F405, 0.120 on the
-//!   netduino2 STM32F205). Deterministic: the same image gives the same
+//!   netduino2 STM32F205, 0.016 on the microbit nRF51, whose 16 MHz
+//!   SysTick makes one count 62.5 instructions: its per-tick worst cases
+//!   are resolved to that). Deterministic: the same image gives the same
 //!   numbers on every run and machine.
 //! * Flash and static RAM: the ELF sections of the images (`.vector_table`,
 //!   `.text`, `.rodata`, `.data` in flash; `.data`, `.bss`, `.uninit` in RAM).
-//! * Stack: the QEMU twin measures its own peak by stack painting.
+//! * Stack: each core's QEMU twin measures its own peak by stack painting.
 //!
 //! Here the images are run and the commands put together; [`measure`]
 //! reads the images' `[measure]` lines, [`footprint`] their ELF sections,
@@ -45,39 +47,65 @@ pub struct Firmware {
     /// The bench image on the netduinoplus2 (Cortex-M4F).
     m4: Costs,
     /// The bench image on the netduino2 (Cortex-M3).
-    #[cfg_attr(not(feature = "host"), allow(dead_code))]
     m3: Costs,
-    /// Peak stack of the QEMU twin run [bytes].
+    /// The bench image on the microbit (Cortex-M0).
+    m0: Costs,
+    /// Peak stack of the QEMU twin run on the Cortex-M4F [bytes].
     stack: u64,
-    /// The board image's, then the QEMU twin image's.
+    /// Peak stack of the twin runs on the Cortex-M3 and the Cortex-M0 [bytes].
+    fixed_stacks: [u64; 2],
+    /// The board image's, the QEMU twin image's, then the Cortex-M3 and
+    /// Cortex-M0 twin images'.
     footprints: Vec<Footprint>,
 }
 
-/// Runs the bench images on QEMU and reads the footprints. `twin_lines`:
-/// the output of a twin run already made (the snapshot check), else the
-/// twin is run here for its stack peak.
-pub fn measure_firmware(elfs: &[(Image, PathBuf)], twin_lines: Option<&[String]>) -> Result<Firmware, String> {
+/// The footprint label of the Cortex-M3 twin image.
+pub const M3_TWIN: &str = "Cortex-M3 twin image";
+/// The footprint label of the Cortex-M4F QEMU twin image.
+pub const QEMU_TWIN: &str = "QEMU twin image";
+/// The footprint label of the Cortex-M0 twin image.
+pub const M0_TWIN: &str = "Cortex-M0 twin image";
+
+/// Runs the bench images on QEMU and reads the footprints. `twin_runs`:
+/// the output of twin runs already made (the snapshot check, the fixed-point
+/// cores' replays), else each twin is run here for its stack peak.
+pub fn measure_firmware(elfs: &[(Image, PathBuf)], twin_runs: &[(Image, Vec<String>)]) -> Result<Firmware, String> {
     let find = |img: Image| {
         elfs.iter()
             .find(|(i, _)| *i == img)
             .map(|(_, p)| p.clone())
-            .ok_or_else(|| format!("missing image {}", img.bin))
+            .ok_or_else(|| format!("missing image {} ({})", img.bin, img.target))
     };
-    let m4 = Costs::parse(&run_image(&find(Image::BENCH_M4)?, qemu::NETDUINO)?)?;
-    let m3 = Costs::parse(&run_image(&find(Image::BENCH_M3)?, qemu::NETDUINO2)?)?;
-    let stack = match twin_lines {
-        Some(lines) => stack_peak(lines),
-        None => stack_peak(&run_image(&find(Image::TWIN)?, qemu::NETDUINO)?),
-    }
-    .ok_or("the twin reported no stack peak")?;
+    let bench = |img: Image| -> Result<Costs, String> { Costs::parse(&run_image(&find(img)?, img.machine())?) };
+    let (m4, m3, m0) = (
+        bench(Image::BENCH_M4)?,
+        bench(Image::BENCH_M3)?,
+        bench(Image::BENCH_M0)?,
+    );
+    let peak = |img: Image| -> Result<u64, String> {
+        match twin_runs.iter().find(|(i, _)| *i == img) {
+            Some((_, lines)) => stack_peak(lines),
+            None => stack_peak(&run_image(&find(img)?, img.machine())?),
+        }
+        .ok_or_else(|| format!("the twin on {} reported no stack peak", img.target))
+    };
+    let stack = peak(Image::TWIN)?;
+    let fixed_stacks = [peak(Image::TWIN_M3)?, peak(Image::TWIN_M0)?];
     let mut footprints = Vec::new();
-    for (img, label) in [(Image::BOARD, "board image"), (Image::TWIN, "QEMU twin image")] {
+    for (img, label) in [
+        (Image::BOARD, "board image"),
+        (Image::TWIN, QEMU_TWIN),
+        (Image::TWIN_M3, M3_TWIN),
+        (Image::TWIN_M0, M0_TWIN),
+    ] {
         footprints.push(footprint(label, &find(img)?)?);
     }
     Ok(Firmware {
         m4,
         m3,
+        m0,
         stack,
+        fixed_stacks,
         footprints,
     })
 }
@@ -93,7 +121,7 @@ pub fn cmd(root: &Path, params: Option<&Path>, write: bool) -> Result<i32, Strin
     eprintln!("xtask: toolchain: {}", tc.description);
     qemu::ensure()?;
     let elfs = crate::firmware::build_all_params(&tc, root, params)?;
-    let fw = measure_firmware(&elfs, None)?;
+    let fw = measure_firmware(&elfs, &[])?;
     let budget = Budget::of(&fw)?;
     let accuracy = accuracy::points(&fw.m4.configs())?;
     let text = report::document(&fw, &budget, &accuracy);
@@ -110,10 +138,11 @@ pub fn cmd(root: &Path, params: Option<&Path>, write: bool) -> Result<i32, Strin
 }
 
 /// The budget check of `cargo xtask test` (firmware measurements only; the
-/// accuracy tables are `cargo xtask bench`'s). `twin_lines`: the output of
-/// the snapshot run, for the stack peak.
-pub fn check(elfs: &[(Image, PathBuf)], twin_lines: &[String]) -> Result<(), String> {
-    let fw = measure_firmware(elfs, Some(twin_lines))?;
+/// accuracy tables are `cargo xtask bench`'s). `twin_runs`: the output of
+/// the twin runs made (the snapshot run, the fixed-point cores' replays),
+/// for the stack peaks.
+pub fn check(elfs: &[(Image, PathBuf)], twin_runs: &[(Image, Vec<String>)]) -> Result<(), String> {
+    let fw = measure_firmware(elfs, twin_runs)?;
     let budget = Budget::of(&fw)?;
     eprint!("{}", report::budget_table(&fw, &budget));
     if budget.over.is_empty() {
