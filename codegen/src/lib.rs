@@ -18,6 +18,7 @@
 //!
 //! The QEMU images' build enables `replay`; the board image's does not, and
 //! its build script compiles no reference.
+#![deny(missing_docs)]
 
 pub mod replay;
 

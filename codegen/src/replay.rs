@@ -2,7 +2,7 @@
 //! ranges ([`adapt`]), the schedule's text form that the host-side replica
 //! reads ([`Schedule`]), and (feature `replay`) the Rust constants the twin
 //! image checks itself with, from the independent reference
-//! ([`Replay::rust`], [`expectations`]).
+//! (`Replay::rust`, `expectations`).
 //!
 //! The faults the replay injects are the shared table of
 //! `compensator_testbench::faults`; their times are the template's, the
@@ -35,10 +35,10 @@ pub const WARM_UP_RATE: f64 = 0.5;
 /// observer has settled on the new level by then.
 pub const HOLD_LAGS: f64 = 4.0;
 
-/// Shortest and longest hold [s].
+/// Shortest and longest hold \[s\].
 pub const HOLD_RANGE: (f64, f64) = (3.0, 120.0);
 
-/// How long each level is held for a probe of time constant `lag` [s]
+/// How long each level is held for a probe of time constant `lag` \[s\]
 /// (both lags): [`HOLD_LAGS`] of them, within [`HOLD_RANGE`].
 pub fn hold_time(lag: f64) -> f64 {
     (HOLD_LAGS * lag).clamp(HOLD_RANGE.0, HOLD_RANGE.1)
@@ -52,23 +52,23 @@ pub fn transition_rate(est: &RawEstimator) -> f64 {
     est.max_oil_rate.clamp(0.2, 5.0)
 }
 
-/// The ramp checkpoints' spacing [s].
+/// The ramp checkpoints' spacing \[s\].
 pub const RAMP_CHECK_EVERY: f64 = 10.0;
 
 /// Time the estimate needs to leave the validated range after the oil did
-/// [s], in probe time constants (the probe's lag, then the observer's).
+/// \[s\], in probe time constants (the probe's lag, then the observer's).
 pub const OUT_OF_RANGE_LAGS: f64 = 2.0;
 
-/// Margin kept inside the oil range by the replay's temperatures [C]: a
+/// Margin kept inside the oil range by the replay's temperatures \[C\]: a
 /// sample outside `estimator.oil_min..oil_max` is a sensor fault, not a
 /// temperature.
 pub const OIL_MARGIN: f64 = 1.0;
 
-/// Room the out-of-range hold needs beyond the validated range [C].
+/// Room the out-of-range hold needs beyond the validated range \[C\].
 pub const OUT_OF_RANGE_ROOM: f64 = 2.0;
 
 /// How far the template's out-of-range hold lies beyond the validated
-/// range (90 C against 78 C) [C].
+/// range (90 C against 78 C) \[C\].
 pub const OUT_OF_RANGE_DEPTH: f64 = 12.0;
 
 /// The template's pieces for levels `levels`: (start s, end s, from C, to
@@ -104,12 +104,12 @@ pub fn pieces(levels: &[f64], hold: f64, warm_up: f64, transition: f64) -> Vec<(
 pub struct Schedule<T = f64> {
     /// (start s, end s, from C, to C).
     pub pieces: Vec<(T, T, T, T)>,
-    /// What the injected spike adds to the temperature [C].
+    /// What the injected spike adds to the temperature \[C\].
     pub spike: T,
 }
 
 impl Schedule<f64> {
-    /// Temperature at `t` [s] (the last piece's end value after it).
+    /// Temperature at `t` \[s\] (the last piece's end value after it).
     pub fn temperature_at(&self, t: f64) -> f64 {
         for &(t0, t1, a, b) in &self.pieces {
             if t >= t0 && t < t1 {
@@ -170,7 +170,7 @@ pub struct Replay {
     /// When OUT_OF_RANGE must be raised (from s, to s); `None` when the
     /// oil range leaves no room outside the validated one.
     pub out_of_range: Option<(f64, f64)>,
-    /// The probe's time constant, both lags [s].
+    /// The probe's time constant, both lags \[s\].
     pub lag: f64,
     /// What could not be adapted (for build warnings).
     pub notes: Vec<String>,
@@ -269,7 +269,7 @@ pub fn adapt(raw: &RawParams) -> Replay {
     }
 }
 
-/// Half a MAX31865 code in degrees at `t` [C]: `(R_ref / 2^16) / (dR/dt)`,
+/// Half a MAX31865 code in degrees at `t` \[C\]: `(R_ref / 2^16) / (dR/dt)`,
 /// with the device's Callendar-Van Dusen slope.
 pub fn half_code(est: &RawEstimator, t: f64) -> f64 {
     (est.rtd_reference / 65536.0) / est.rtd_slope(t)

@@ -62,7 +62,7 @@ pub fn phi_derivatives<T: Float>(params: &Params<T>, a: T) -> Derivatives<T> {
     }
 }
 
-/// `Phi(A)` of Eq. (16) [m].
+/// `Phi(A)` of Eq. (16) \[m\].
 #[inline]
 pub fn phi<T: Float>(params: &Params<T>, a: T) -> T {
     phi_derivatives(params, a).value
@@ -71,13 +71,13 @@ pub fn phi<T: Float>(params: &Params<T>, a: T) -> T {
 /// The terms of the series at one temperature.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Terms<T> {
-    /// Temperature [C].
+    /// Temperature \[C\].
     pub temperature: T,
     /// `A1`, `A2` of the chosen reading [sqrt(Pa)].
     pub a_terms: [T; 2],
     /// `rho1`, `rho2` [kg/m^3].
     pub rho_terms: [T; 2],
-    /// `x(0)`, `x(1)`, `x(2)` [m] (Eqs. 19-21).
+    /// `x(0)`, `x(1)`, `x(2)` \[m\] (Eqs. 19-21).
     pub x: [T; 3],
     /// `Q_throt(0..2)` [m^3/s] (Eqs. 25-26 and the second order).
     pub q_throt: [T; 3],
@@ -97,12 +97,12 @@ impl<T: Float> Terms<T> {
         s
     }
 
-    /// Series displacement up to `order` (0, 1 or 2), without stops [m].
+    /// Series displacement up to `order` (0, 1 or 2), without stops \[m\].
     pub fn x_series(&self, order: usize) -> T {
         Self::sum(&self.x, order)
     }
 
-    /// Series displacement clamped to the stops [m].
+    /// Series displacement clamped to the stops \[m\].
     pub fn x(&self, order: usize) -> (T, Stop) {
         clamp_to_stops(self.x_series(order), self.stroke)
     }
@@ -127,7 +127,7 @@ impl<T: Float> Terms<T> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Expansion<T> {
     params: Params<T>,
-    /// Reference temperature [C].
+    /// Reference temperature \[C\].
     pub t0: T,
     /// The reading of `A1`, `A2`.
     pub reading: Reading,
@@ -140,7 +140,7 @@ pub struct Expansion<T> {
 }
 
 impl<T: Float> Expansion<T> {
-    /// Prepares the expansion about `t0` [C].
+    /// Prepares the expansion about `t0` \[C\].
     ///
     /// # Errors
     ///
@@ -159,7 +159,7 @@ impl<T: Float> Expansion<T> {
         })
     }
 
-    /// The series terms at temperature `t` [C].
+    /// The series terms at temperature `t` \[C\].
     ///
     /// # Errors
     ///
@@ -241,7 +241,7 @@ impl<T: Float> Expansion<T> {
 /// Temperature sensitivities at one temperature (Eqs. 30-31).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sensitivity<T> {
-    /// Temperature [C].
+    /// Temperature \[C\].
     pub temperature: T,
     /// `dx/dt = Phi'(A) dA/dt` of the free branch [m/K] (Eq. 31).
     pub dx_dt_branch: T,
@@ -253,7 +253,7 @@ pub struct Sensitivity<T> {
     pub stop: Stop,
 }
 
-/// Sensitivities of the equilibrium to temperature at `t` [C] (Eqs. 30-31).
+/// Sensitivities of the equilibrium to temperature at `t` \[C\] (Eqs. 30-31).
 ///
 /// # Errors
 ///
@@ -298,7 +298,7 @@ pub struct Monotonicity<T> {
     pub monotonic: bool,
     /// Sign of `dx/dt` where monotonic (+1 rising, -1 falling, 0 otherwise).
     pub sign: i8,
-    /// The sample where `|dx/dt|` is smallest (the closest to violating Eq. 32) [C].
+    /// The sample where `|dx/dt|` is smallest (the closest to violating Eq. 32) \[C\].
     pub worst_temperature: T,
     /// `dx/dt` at that sample [m/K].
     pub worst_dx_dt: T,
@@ -310,7 +310,7 @@ pub struct Monotonicity<T> {
 pub const MAX_MONOTONICITY_SAMPLES: u32 = 100_000;
 
 /// Checks Eq. (32), `Phi'(A(t)) dA/dt != 0` with one sign, on `samples`
-/// evenly spaced temperatures of `[lo, hi]` [C] (clamped to
+/// evenly spaced temperatures of `[lo, hi]` \[C\] (clamped to
 /// `2..=MAX_MONOTONICITY_SAMPLES`).
 ///
 /// # Errors

@@ -31,11 +31,11 @@ pub struct Compensation<T> {
     /// Window area of Eq. (9) that would make the error zero [m^2]
     /// (negative when the branches alone already oversupply).
     pub required_area: T,
-    /// Displacement that opens `required_area`, `f_throt / (pi d)` [m].
+    /// Displacement that opens `required_area`, `f_throt / (pi d)` \[m\].
     pub required_x: T,
 }
 
-/// Laminar leakage of the machine at `t` [C]: `dQ_ref mu(t_ref) / mu(t)` [m^3/s].
+/// Laminar leakage of the machine at `t` \[C\]: `dQ_ref mu(t_ref) / mu(t)` [m^3/s].
 ///
 /// # Errors
 ///
@@ -57,7 +57,7 @@ pub fn losses_for<T: Float>(machine: &Machine<T>, mu_ref: T, mu: T) -> Result<T,
     finite(machine.leakage_reference * mu_ref / mu, "losses")
 }
 
-/// Demand, supply, error and the Eq. (9) window at `t` [C].
+/// Demand, supply, error and the Eq. (9) window at `t` \[C\].
 ///
 /// # Errors
 ///

@@ -46,15 +46,15 @@ pub struct Equilibrium<T> {
     pub fluid: FluidState<T>,
     /// Redistribution parameter `A(t)` [sqrt(Pa)].
     pub a: T,
-    /// Pressure in chamber (a) [Pa].
+    /// Pressure in chamber (a) \[Pa\].
     pub p_a: T,
-    /// Pressure in chamber (b) [Pa].
+    /// Pressure in chamber (b) \[Pa\].
     pub p_b: T,
-    /// `p_b - p_a` [Pa].
+    /// `p_b - p_a` \[Pa\].
     pub dp_ab: T,
-    /// Plunger displacement, clamped to the stops [m].
+    /// Plunger displacement, clamped to the stops \[m\].
     pub x: T,
-    /// Displacement of the force balance without stops, `Phi(A) - x0` [m].
+    /// Displacement of the force balance without stops, `Phi(A) - x0` \[m\].
     pub x_free: T,
     /// Which stop, if any, holds the plunger.
     pub stop: Stop,
@@ -76,7 +76,7 @@ pub fn branch_fraction<T: Float>(a_hat: T) -> (T, T) {
     (T::from_f64(2.0) / (a_hat + s), s)
 }
 
-/// Chamber pressure difference `p_b - p_a` [Pa] for `A` [sqrt(Pa)] and `dp` [Pa]
+/// Chamber pressure difference `p_b - p_a` \[Pa\] for `A` [sqrt(Pa)] and `dp` \[Pa\]
 /// (the bracket of Eq. 5, evaluated without cancellation).
 #[inline]
 pub fn pressure_difference<T: Float>(a: T, dp: T) -> T {
@@ -179,7 +179,7 @@ pub fn equilibrium_for<T: Float>(params: &Params<T>, fluid: FluidState<T>, a: T)
     })
 }
 
-/// The quasi-static equilibrium at temperature `t` [C].
+/// The quasi-static equilibrium at temperature `t` \[C\].
 ///
 /// # Errors
 ///
@@ -192,7 +192,7 @@ pub fn equilibrium<T: Float>(params: &Params<T>, t: T) -> Result<Equilibrium<T>,
 }
 
 /// The balance temperature `t0` where `p_a = p_b` (Eq. 2), i.e.
-/// `A(t0) = sqrt(dp / 2)`, searched in `[lo, hi]` [C] by bisection.
+/// `A(t0) = sqrt(dp / 2)`, searched in `[lo, hi]` \[C\] by bisection.
 ///
 /// `A` falls monotonically with temperature for every valid parameter set
 /// (viscosity and density both fall), so the root is unique when bracketed.

@@ -19,13 +19,13 @@ use crate::scalar::Float;
 
 /// Offset between degrees Celsius and kelvin.
 pub const KELVIN_OFFSET: f64 = 273.15;
-/// Lowest kinematic viscosity for which ASTM D341's form holds [cSt].
+/// Lowest kinematic viscosity for which ASTM D341's form holds \[cSt\].
 pub const WALTHER_MIN_CST: f64 = 2.0;
-/// Highest kinematic viscosity accepted [cSt] (beyond: the oil is a solid
+/// Highest kinematic viscosity accepted \[cSt\] (beyond: the oil is a solid
 /// for any hydraulic purpose, and `f32` loses the double exponential).
 pub const WALTHER_MAX_CST: f64 = 1.0e6;
 
-/// Reference temperature of the cancellation-free Walther form [C].
+/// Reference temperature of the cancellation-free Walther form \[C\].
 pub const WALTHER_REFERENCE_C: f64 = 40.0;
 
 /// The oil's temperature laws.
@@ -45,7 +45,7 @@ pub struct Oil<T> {
     pub density_15: T,
     /// Volumetric expansion coefficient `e` [1/K].
     pub expansion: T,
-    /// Effective bulk modulus `beta_e` [Pa].
+    /// Effective bulk modulus `beta_e` \[Pa\].
     pub bulk_modulus: T,
     /// `a - b log10(T_ref)` at [`WALTHER_REFERENCE_C`], computed in `f64`.
     walther_u_ref: T,
@@ -54,7 +54,7 @@ pub struct Oil<T> {
 /// The oil's state at one temperature.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FluidState<T> {
-    /// Temperature [C].
+    /// Temperature \[C\].
     pub temperature: T,
     /// Kinematic viscosity `nu` [m^2/s].
     pub kinematic_viscosity: T,
@@ -89,7 +89,7 @@ pub struct Derivatives<T> {
 
 impl<T: Float> Oil<T> {
     /// An oil from its constants (Walther `a`, `b` [-], density at 15 C
-    /// [kg/m^3], expansion [1/K], bulk modulus [Pa]), given in `f64` so that
+    /// [kg/m^3], expansion [1/K], bulk modulus \[Pa\]), given in `f64` so that
     /// the reference term of the Walther form is exact to `f64` precision.
     pub fn new(walther_a: f64, walther_b: f64, density_15: f64, expansion: f64, bulk_modulus: f64) -> Self {
         let u_ref = walther_a - walther_b * libm::log10(WALTHER_REFERENCE_C + KELVIN_OFFSET);
@@ -200,7 +200,7 @@ impl<T: Float> Oil<T> {
         })
     }
 
-    /// State and derivatives at `t` [C] (one Walther evaluation).
+    /// State and derivatives at `t` \[C\] (one Walther evaluation).
     ///
     /// # Errors
     ///
@@ -221,7 +221,7 @@ impl<T: Float> Oil<T> {
         })
     }
 
-    /// Viscosity, density and dynamic viscosity at `t` [C].
+    /// Viscosity, density and dynamic viscosity at `t` \[C\].
     ///
     /// # Errors
     ///

@@ -17,9 +17,9 @@ use crate::scalar::{Float, Real};
 /// Laminar throttle (capillary).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Capillary<T> {
-    /// Bore [m].
+    /// Bore \[m\].
     pub diameter: T,
-    /// Length [m].
+    /// Length \[m\].
     pub length: T,
 }
 
@@ -41,7 +41,7 @@ impl<T: Float> Capillary<T> {
 /// Turbulent throttle (sharp-edged orifice).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Orifice<T> {
-    /// Bore [m].
+    /// Bore \[m\].
     pub diameter: T,
     /// Discharge coefficient `C_d` [-].
     pub discharge_coefficient: T,
@@ -61,7 +61,7 @@ impl<T: Float> Orifice<T> {
         density / (T::from_f64(2.0) * cf * cf)
     }
 
-    /// Signed flow for a pressure drop `dp` [Pa] at density `rho` [kg/m^3]:
+    /// Signed flow for a pressure drop `dp` \[Pa\] at density `rho` [kg/m^3]:
     /// `C_d f sqrt(2 |dp| / rho) sign(dp)` [m^3/s].
     #[inline]
     pub fn flow(&self, dp: T, density: T) -> T {
@@ -73,14 +73,14 @@ impl<T: Float> Orifice<T> {
 /// The window opened by the plunger (Eq. 7): area `pi d x`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Slot<T> {
-    /// Window diameter `d` [m].
+    /// Window diameter `d` \[m\].
     pub diameter: T,
     /// Discharge coefficient `eta` [-].
     pub discharge_coefficient: T,
 }
 
 impl<T: Float> Slot<T> {
-    /// Open area `f_throt = pi d x` [m^2] at opening `x` [m] (zero when closed).
+    /// Open area `f_throt = pi d x` [m^2] at opening `x` \[m\] (zero when closed).
     #[inline]
     pub fn area(&self, x: T) -> T {
         T::from_f64(core::f64::consts::PI) * self.diameter * x.max(T::ZERO)
@@ -144,14 +144,14 @@ impl<T: Float> FlowLaws<T> {
         }
     }
 
-    /// Flow through the capillary for the pressure drop `drop` [Pa] across
+    /// Flow through the capillary for the pressure drop `drop` \[Pa\] across
     /// it: `drop / R_l` [m^3/s].
     #[inline]
     pub fn capillary_flow(&self, drop: T) -> T {
         drop * self.capillary_conductance
     }
 
-    /// Signed flow through the orifice for the pressure drop `drop` [Pa]
+    /// Signed flow through the orifice for the pressure drop `drop` \[Pa\]
     /// across it: `C_d f sqrt(2 |drop| / rho) sign(drop)` [m^3/s]
     /// ([`Orifice::flow`] with the oil's density in the coefficient).
     #[inline]
@@ -159,7 +159,7 @@ impl<T: Float> FlowLaws<T> {
         self.orifice_factor * drop.abs().sqrt().copysign(drop)
     }
 
-    /// Flow through the window at the opening `x` [m] (zero when closed):
+    /// Flow through the window at the opening `x` \[m\] (zero when closed):
     /// `eta pi d x sqrt(2 dp / rho)` [m^3/s] ([`Slot::flow`], Eq. 7).
     #[inline]
     pub fn window_flow(&self, x: T) -> T {

@@ -93,14 +93,14 @@ impl From<ParamError> for UncertaintyError {
 /// band of 95 % is +-1.96 of each.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Uncertainty {
-    /// Of the oil temperature [C].
+    /// Of the oil temperature \[C\].
     pub t_oil: f32,
-    /// Of the displacement [m] (of the free displacement: see the module
+    /// Of the displacement \[m\] (of the free displacement: see the module
     /// docs for the band at a stop).
     pub x: f32,
-    /// Of the chamber (a) pressure [Pa].
+    /// Of the chamber (a) pressure \[Pa\].
     pub p_a: f32,
-    /// Of the chamber (b) pressure [Pa].
+    /// Of the chamber (b) pressure \[Pa\].
     pub p_b: f32,
     /// Of the total flow [m^3/s].
     pub q_total: f32,
@@ -126,9 +126,9 @@ impl Uncertainty {
 /// with the temperature's variance.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct UncertaintyTable {
-    /// First grid temperature [C].
+    /// First grid temperature \[C\].
     pub t0: f32,
-    /// Grid spacing [C].
+    /// Grid spacing \[C\].
     pub step: f32,
     /// `dy/dT` of each output at each grid temperature [unit/K] (NaN where
     /// the model refuses the temperature).
@@ -137,7 +137,7 @@ pub struct UncertaintyTable {
     /// parameters [unit] (interpolated as a deviation, not a variance: it
     /// is the nearer to linear in temperature).
     pub sd_params: [[f32; OUTPUTS]; GRID],
-    /// The probe's standard deviation: class tolerance and resolution [C].
+    /// The probe's standard deviation: class tolerance and resolution \[C\].
     pub sd_probe: [f32; GRID],
     /// The device has a `[machine]` (else the compensation error and its
     /// uncertainty are NaN).
@@ -192,7 +192,7 @@ const MAX_FIELDS: usize = CORE_FIELDS.len() + MACHINE_FIELDS.len();
 
 impl UncertaintyTable {
     /// The table for the device `raw` (its `[probe]` and `[tolerances]`)
-    /// over `t_min..=t_max` [C], with the converter's resolution
+    /// over `t_min..=t_max` \[C\], with the converter's resolution
     /// `resolution(t)` [C per code] at each grid temperature.
     ///
     /// # Errors
@@ -305,7 +305,7 @@ impl UncertaintyTable {
         Ok(table)
     }
 
-    /// The standard uncertainties at the estimated oil temperature `t` [C]
+    /// The standard uncertainties at the estimated oil temperature `t` \[C\]
     /// whose observer variance is `var_observer` [C^2]: the grid
     /// interpolated linearly (clamped to its ends), infinite where a
     /// neighbouring grid point is one the model refuses.

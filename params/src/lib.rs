@@ -4,9 +4,10 @@
 //!
 //! This crate is the single place where the format is defined. The core
 //! (`compensator`) re-exports it as `compensator::params`; the command-line
-//! tools read files with [`file::parse`]; the firmware's build script turns a
-//! file into checked constants with the same reader, so a device is flashed
-//! only with a parameter set that passed the same validation.
+//! tools read files with `file::parse` (feature `toml`); the firmware's
+//! build script turns a file into checked constants with the same reader,
+//! so a device is flashed only with a parameter set that passed the same
+//! validation.
 //!
 //! Every field carries its plausible range beside its unit and default
 //! ([`Field::min`], [`Field::max`], [`Field::kind`]); validation checks

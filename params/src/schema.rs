@@ -475,7 +475,7 @@ impl RawProbe {
         self.check_fields()
     }
 
-    /// Half-width of the probe's tolerance at `t` [C]: `a + b |t|` [C]
+    /// Half-width of the probe's tolerance at `t` \[C\]: `a + b |t|` \[C\]
     /// (IEC 60751's class limits).
     pub fn tolerance_at(&self, t: f64) -> f64 {
         self.tolerance_a + self.tolerance_b * t.abs()
@@ -899,7 +899,7 @@ fn finite(n: Named) -> Result<f64, ParamError> {
 /// `log10(313.15)`: Walther's temperature term at 40 C.
 pub(crate) const LOG10_T40: f64 = 2.495752416037327;
 
-/// Plausible kinematic viscosity of the oil at 40 C [cSt] (the ISO 3448
+/// Plausible kinematic viscosity of the oil at 40 C \[cSt\] (the ISO 3448
 /// grades' reference temperature): from the thinnest oil Walther's law
 /// describes (2 cSt) to far beyond the heaviest gear oils (ISO VG 3200).
 pub const VISCOSITY_40C_CST: (f64, f64) = (2.0, 1.0e5);
@@ -1074,7 +1074,7 @@ impl RawEstimator {
         Ok(())
     }
 
-    /// Resistance [ohm] of the RTD at `t` [C] by Callendar-Van Dusen with
+    /// Resistance \[ohm\] of the RTD at `t` \[C\] by Callendar-Van Dusen with
     /// this section's `rtd_r0`, `rtd_a`, `rtd_b`, `rtd_c` (IEC 60751 form:
     /// the `C` term below 0 C only).
     pub fn rtd_resistance(&self, t: f64) -> f64 {

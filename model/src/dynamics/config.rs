@@ -35,10 +35,10 @@ pub const TARGET_PCT: f64 = 0.05;
 /// measure nothing (the error is a percentage of the step).
 pub const MIN_STEP: f64 = 0.01;
 
-/// Longest probe [s]: the errors of a step arise in its first transient.
+/// Longest probe \[s\]: the errors of a step arise in its first transient.
 pub const MAX_PROBE: f64 = 0.5;
 
-/// The probe steps `(from, to)` [C] over a validated range: both ways
+/// The probe steps `(from, to)` \[C\] over a validated range: both ways
 /// across it, from its middle to either end and back, and between its
 /// quarter points both ways. Outside the validated range the twin's
 /// promise is its end state (the closed-form equilibrium), not its
@@ -90,8 +90,8 @@ fn run(p: &Params<f64>, config: TwinConfig, from: f64, to: f64, out: &mut [f64])
 /// Longest probe in ticks (the probe is cut at [`MAX_PROBE`] or here).
 const MAX_TICKS: usize = 500;
 
-/// Chooses the substeps per `tick` [s] of the SDIRK3 twin for `params`
-/// over the validated range `valid` [C]. Probe temperatures the oil model
+/// Chooses the substeps per `tick` \[s\] of the SDIRK3 twin for `params`
+/// over the validated range `valid` \[C\]. Probe temperatures the oil model
 /// refuses are left out.
 ///
 /// # Errors

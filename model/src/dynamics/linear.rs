@@ -113,7 +113,7 @@ pub fn hurwitz_quartic<T: Real>(a: &[T; 4]) -> bool {
 /// The linearised dynamics at an equilibrium.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Linearisation<F> {
-    /// Temperature [C].
+    /// Temperature \[C\].
     pub temperature: F,
     /// Eigenvalues [1/s], real part descending.
     pub eigenvalues: [Complex<F>; 4],
@@ -133,7 +133,7 @@ pub struct Linearisation<F> {
     pub on_stop: bool,
 }
 
-/// The model-unit Jacobian of the free motion at the equilibrium of `t` [C].
+/// The model-unit Jacobian of the free motion at the equilibrium of `t` \[C\].
 ///
 /// # Errors
 ///
@@ -151,7 +151,7 @@ pub fn jacobian_at_equilibrium<F: Float>(model: &Model<F>, t: F) -> Result<[[F; 
     .jacobian(&y))
 }
 
-/// Linearises the FSI model at the equilibrium of `t` [C].
+/// Linearises the FSI model at the equilibrium of `t` \[C\].
 ///
 /// # Errors
 ///

@@ -41,7 +41,7 @@ use crate::scalar::Float;
 /// ([`reduced::ReducedTwin`]): the oil temperature in, one tick, the state
 /// out (SI units).
 pub trait Dynamic<F: Float> {
-    /// Sets the oil temperature [C] for the following ticks.
+    /// Sets the oil temperature \[C\] for the following ticks.
     ///
     /// # Errors
     /// [`ModelError`] when the oil model refuses the temperature or a
@@ -54,6 +54,6 @@ pub trait Dynamic<F: Float> {
     /// [`StepError`] when a step fails (a singular stage, a non-finite or
     /// diverged state); the state is left as before the tick.
     fn tick(&mut self) -> Result<TickReport, StepError>;
-    /// The state: `x` [m], `v` [m/s], `p_a`, `p_b` [Pa].
+    /// The state: `x` \[m\], `v` [m/s], `p_a`, `p_b` \[Pa\].
     fn state(&self) -> DynamicState<F>;
 }

@@ -88,7 +88,7 @@ pub struct ReducedTwin<F, T> {
 }
 
 impl<F: Float, T: Real> ReducedTwin<F, T> {
-    /// At rest in the equilibrium of `temperature` [C].
+    /// At rest in the equilibrium of `temperature` \[C\].
     ///
     /// # Errors
     ///
@@ -107,7 +107,7 @@ impl<F: Float, T: Real> ReducedTwin<F, T> {
         })
     }
 
-    /// Sets the oil temperature [C] for the following ticks.
+    /// Sets the oil temperature \[C\] for the following ticks.
     ///
     /// # Errors
     ///

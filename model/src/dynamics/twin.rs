@@ -39,7 +39,7 @@ pub const MAX_SUBSTEPS: u8 = 64;
 pub struct TwinConfig {
     /// One-step scheme.
     pub scheme: Scheme,
-    /// Tick length [s].
+    /// Tick length \[s\].
     pub tick: f64,
     /// Steps per tick, `1..=MAX_SUBSTEPS`.
     pub substeps: u8,
@@ -64,7 +64,7 @@ impl TwinConfig {
         Ok(())
     }
 
-    /// The step length in the model's time unit `time_unit` [s].
+    /// The step length in the model's time unit `time_unit` \[s\].
     pub fn step(&self, time_unit: f64) -> f64 {
         self.tick / self.substeps as f64 / time_unit
     }
@@ -217,7 +217,7 @@ pub struct Twin<F, T> {
 }
 
 impl<F: Float, T: Real> Twin<F, T> {
-    /// A twin at rest in the quasi-static equilibrium of `temperature` [C].
+    /// A twin at rest in the quasi-static equilibrium of `temperature` \[C\].
     ///
     /// # Errors
     ///
@@ -251,7 +251,7 @@ impl<F: Float, T: Real> Twin<F, T> {
         })
     }
 
-    /// Changes the tick to `tick` [s], keeping the scheme, the substeps per
+    /// Changes the tick to `tick` \[s\], keeping the scheme, the substeps per
     /// tick, the state and the coefficients: a tick that adapts, for a
     /// caller whose steps are not whole ticks (an FMU's communication
     /// steps). A shorter tick is at least as accurate as the configured
@@ -276,7 +276,7 @@ impl<F: Float, T: Real> Twin<F, T> {
         Ok(())
     }
 
-    /// Sets the supply and outlet pressures `p_p`, `p_c` [Pa] for the
+    /// Sets the supply and outlet pressures `p_p`, `p_c` \[Pa\] for the
     /// following ticks: the drop across the compensator changes from the
     /// design's `dp` (`operating.pressure_drop`, the model's pressure
     /// unit, which stays). Per call: two divisions and the chamber
@@ -340,7 +340,7 @@ impl<F: Float, T: Real> Twin<F, T> {
         &self.coefficients
     }
 
-    /// Sets the oil temperature [C] for the following ticks. On error the
+    /// Sets the oil temperature \[C\] for the following ticks. On error the
     /// previous coefficients stay in force.
     ///
     /// # Errors

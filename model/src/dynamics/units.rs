@@ -17,28 +17,28 @@ use crate::scalar::{Float, Real};
 /// type `F` (so that an `f32` firmware never runs soft-double code).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Scales<F> {
-    /// Time unit `T = sqrt(m / c)` [s].
+    /// Time unit `T = sqrt(m / c)` \[s\].
     pub time: F,
-    /// Length unit: the stroke [m].
+    /// Length unit: the stroke \[m\].
     pub length: F,
     /// Velocity unit `V = a_x L / T` [m/s].
     pub velocity: F,
-    /// Pressure unit `dp` [Pa].
+    /// Pressure unit `dp` \[Pa\].
     pub pressure: F,
-    /// Pressure origin `p_c` [Pa].
+    /// Pressure origin `p_c` \[Pa\].
     pub outlet_pressure: F,
 }
 
 /// A state in SI units.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DynamicState<F> {
-    /// Plunger displacement `x` [m].
+    /// Plunger displacement `x` \[m\].
     pub x: F,
     /// Plunger velocity `v` [m/s].
     pub v: F,
-    /// Chamber (a) pressure [Pa].
+    /// Chamber (a) pressure \[Pa\].
     pub p_a: F,
-    /// Chamber (b) pressure [Pa].
+    /// Chamber (b) pressure \[Pa\].
     pub p_b: F,
 }
 

@@ -10,22 +10,22 @@ use crate::sensor::max31865::{Mains, resolution};
 use crate::uncertainty::{UncertaintyError, UncertaintyTable};
 use core::borrow::Borrow;
 
-/// A closed range of temperatures [C], `min..=max`.
+/// A closed range of temperatures \[C\], `min..=max`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TemperatureRange {
-    /// Lower end [C].
+    /// Lower end \[C\].
     pub min: f32,
-    /// Upper end [C].
+    /// Upper end \[C\].
     pub max: f32,
 }
 
 impl TemperatureRange {
-    /// `min..=max` [C].
+    /// `min..=max` \[C\].
     pub const fn new(min: f32, max: f32) -> Self {
         TemperatureRange { min, max }
     }
 
-    /// `t` [C] lies within the range, ends included (`false` for NaN).
+    /// `t` \[C\] lies within the range, ends included (`false` for NaN).
     #[inline]
     pub fn contains(self, t: f32) -> bool {
         t >= self.min && t <= self.max
@@ -77,9 +77,9 @@ pub struct EstimatorConfig<U = UncertaintyTable> {
     pub spikes: SpikeSettings,
     /// The uncertainty table over the oil range (or a reference to it).
     pub uncertainty: U,
-    /// Validated temperature range [C].
+    /// Validated temperature range \[C\].
     pub valid: TemperatureRange,
-    /// Range where the oil model is used at all [C].
+    /// Range where the oil model is used at all \[C\].
     pub oil: TemperatureRange,
     /// Ticks between telemetry records (0: never).
     pub telemetry_every: u32,
@@ -103,7 +103,7 @@ impl EstimatorConfig<UncertaintyTable> {
         Self::with_sample_period(raw, reading_period(&raw.estimator))
     }
 
-    /// As [`EstimatorConfig::new`], for readings every `sample_period` [s]
+    /// As [`EstimatorConfig::new`], for readings every `sample_period` \[s\]
     /// (a recorded log's rate).
     ///
     /// # Errors
@@ -179,25 +179,25 @@ impl<U: Borrow<UncertaintyTable> + Copy> EstimatorConfig<U> {
         })
     }
 
-    /// Tick [s].
+    /// Tick \[s\].
     pub fn tick(&self) -> f32 {
         self.twin.tick as f32
     }
 
-    /// The period of the readings the observer is designed for [s].
+    /// The period of the readings the observer is designed for \[s\].
     pub fn sample_period(&self) -> f64 {
         f64::from(self.observer.sample_period)
     }
 
     /// Ticks between samples of a source that delivers one every `period`
-    /// [s] (at least one).
+    /// \[s\] (at least one).
     pub fn ticks_per(&self, period: f32) -> u32 {
         let n = period / self.tick() + 0.5;
         if n >= 1.0 { n as u32 } else { 1 }
     }
 }
 
-/// The period of the MAX31865's readings at the estimator's tick [s]: its
+/// The period of the MAX31865's readings at the estimator's tick \[s\]: its
 /// conversion period for the mains filter, rounded to a whole number of
 /// ticks (at least one; the converter is read on the tick its reading is
 /// due).
@@ -208,7 +208,7 @@ pub fn reading_period(e: &RawEstimator) -> f64 {
 }
 
 /// The observer's settings for the parameter set `raw` with readings every
-/// `sample_period` [s] through a MAX31865 (its resolution at the middle of
+/// `sample_period` \[s\] through a MAX31865 (its resolution at the middle of
 /// the validated range).
 pub fn observer_settings(raw: &RawParams, sample_period: f64) -> ObserverSettings {
     let e = &raw.estimator;

@@ -9,17 +9,17 @@ use crate::uncertainty::Uncertainty;
 pub struct StateEstimate {
     /// Tick counter.
     pub tick: u32,
-    /// Estimated oil temperature [C] (the observer's, inside the oil range).
+    /// Estimated oil temperature \[C\] (the observer's, inside the oil range).
     pub temperature: f32,
-    /// The probe's last accepted reading [C].
+    /// The probe's last accepted reading \[C\].
     pub t_probe: f32,
-    /// Plunger displacement [m].
+    /// Plunger displacement \[m\].
     pub x: f32,
     /// Plunger velocity [m/s].
     pub v: f32,
-    /// Chamber (a) pressure [Pa].
+    /// Chamber (a) pressure \[Pa\].
     pub p_a: f32,
-    /// Chamber (b) pressure [Pa].
+    /// Chamber (b) pressure \[Pa\].
     pub p_b: f32,
     /// Flow leaving chamber (a) through its capillary [m^3/s].
     pub q_a: f32,
@@ -31,7 +31,7 @@ pub struct StateEstimate {
     pub q_total: f32,
     /// `Q0 - (Q_work + dQ_lost(t))` [m^3/s]; NaN without a `[machine]`.
     pub compensation_error: f32,
-    /// Quasi-static equilibrium displacement at this temperature [m].
+    /// Quasi-static equilibrium displacement at this temperature \[m\].
     pub x_equilibrium: f32,
     /// `dx/dt` of the equilibrium branch (Eq. 31) [m/K].
     pub dx_dt: f32,

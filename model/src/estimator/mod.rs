@@ -101,7 +101,7 @@ use jobs::{Design, Job, Statics};
 /// 11 %/K at 0 C) then follows a step at 70 C/s (0 C) to 300 C/s (80 C).
 pub const TWIN_SLEW: f32 = 0.008;
 
-/// Band [C] the filtered temperature must stay within to count as steady
+/// Band \[C\] the filtered temperature must stay within to count as steady
 /// for the consistency check. Over the band the closed form moves by
 /// `|dx/dt| * 0.05 K`: 0.12 % of the stroke on the paper preset (37 um/K,
 /// 1.5 mm), below 1 % on designs whose free displacement changes by up to
@@ -127,7 +127,7 @@ pub const SETTLE_TIME_CONSTANTS: f32 = 10.0;
 /// re-seated 3 of 5,456 correct twins still on their way.
 pub const STOP_SETTLE_TIME_CONSTANTS: f32 = 150.0;
 
-/// Longest settling window [s] [`STOP_SETTLE_TIME_CONSTANTS`] may give: the
+/// Longest settling window \[s\] [`STOP_SETTLE_TIME_CONSTANTS`] may give: the
 /// slowest time constant linearised at a closed-stop state can be seconds
 /// (a mode the stop holds still), and a window of minutes would leave a
 /// wrong state unchecked that long. [`SETTLE_TIME_CONSTANTS`] of it still
@@ -208,7 +208,7 @@ pub struct Estimator<T = f32, U = UncertaintyTable> {
 
 impl<U: Borrow<UncertaintyTable> + Copy> Estimator<f32, U> {
     /// An estimator with an `f32` twin at rest in the equilibrium of
-    /// `initial` [C]: [`Estimator::with_scalar`] for `f32`.
+    /// `initial` \[C\]: [`Estimator::with_scalar`] for `f32`.
     ///
     /// # Errors
     ///
@@ -219,7 +219,7 @@ impl<U: Borrow<UncertaintyTable> + Copy> Estimator<f32, U> {
 }
 
 impl<T: Real, U: Borrow<UncertaintyTable> + Copy> Estimator<T, U> {
-    /// An estimator at rest in the equilibrium of `initial` [C], which must
+    /// An estimator at rest in the equilibrium of `initial` \[C\], which must
     /// be a temperature the oil model accepts. Eq. (32) is checked once here
     /// over the validated range (201 samples; a range the oil model refuses
     /// in part is not an error, it raises `NOT_UNIQUE`).
@@ -286,7 +286,7 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy> Estimator<T, U> {
     }
 
     /// The time constant of the twin's slowest mode at the last Stability
-    /// job [s]: `1 / sigma`, with `sigma` a lower bound (within 25 %) of the
+    /// job \[s\]: `1 / sigma`, with `sigma` a lower bound (within 25 %) of the
     /// smallest decay rate `-Re(lambda)` of the linearisation at the
     /// equilibrium. Infinite while the linearisation is not stable.
     pub fn slowest_time_constant(&self) -> f32 {

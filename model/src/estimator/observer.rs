@@ -105,28 +105,28 @@ impl core::error::Error for DesignError {}
 /// `[probe]` section and `estimator.max_oil_rate`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ObserverSettings {
-    /// The probe's first-order time constant `tau_p` [s].
+    /// The probe's first-order time constant `tau_p` \[s\].
     pub time_constant: f64,
-    /// A second lag in series, the well's `tau_w` [s] (0: none).
+    /// A second lag in series, the well's `tau_w` \[s\] (0: none).
     pub well_time_constant: f64,
-    /// Standard deviation of one reading's noise [C].
+    /// Standard deviation of one reading's noise \[C\].
     pub noise: f64,
-    /// The converter's resolution, one code [C] (quantization variance
+    /// The converter's resolution, one code \[C\] (quantization variance
     /// `resolution^2 / 12`).
     pub resolution: f64,
     /// The oil's largest plausible rate of change [C/s].
     pub max_rate: f64,
-    /// The estimator's tick [s].
+    /// The estimator's tick \[s\].
     pub tick: f64,
-    /// The period of the readings [s] (the gains are per reading).
+    /// The period of the readings \[s\] (the gains are per reading).
     pub sample_period: f64,
-    /// Width of the oil's temperature range [C] (`oil_max - oil_min`): the
+    /// Width of the oil's temperature range \[C\] (`oil_max - oil_min`): the
     /// largest change the oil can make, which bounds how far one reading
     /// can move ([`ObserverDesign::gate`]).
     pub span: f64,
 }
 
-/// Time constant of a probe read without lag [s]: well below a reading
+/// Time constant of a probe read without lag \[s\]: well below a reading
 /// period, so that the readings are the oil's temperature
 /// ([`ObserverSettings::without_lag`]).
 pub const NO_LAG: f64 = 0.01;
@@ -168,9 +168,9 @@ pub struct ModeGains {
 /// [`ObserverSettings`] ([`ObserverDesign::new`]), in `f32` for the tick.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ObserverDesign {
-    /// The tick [s].
+    /// The tick \[s\].
     pub tick: f32,
-    /// The period of the readings the gains are designed for [s].
+    /// The period of the readings the gains are designed for \[s\].
     pub sample_period: f32,
     /// Whether the model has the well's lag.
     pub well: bool,
@@ -178,14 +178,14 @@ pub struct ObserverDesign {
     /// T_well) + well_rate r` (rows of the transition sum to one over the
     /// temperatures: written as increments of differences).
     pub well_oil: f32,
-    /// See `well_oil` [s].
+    /// See `well_oil` \[s\].
     pub well_rate: f32,
     /// Per-tick transition of `T_probe`: `dT_probe = probe_oil (T_oil -
     /// T_probe) + probe_well (T_well - T_probe) + probe_rate r`.
     pub probe_oil: f32,
     /// See `probe_oil`.
     pub probe_well: f32,
-    /// See `probe_oil` [s].
+    /// See `probe_oil` \[s\].
     pub probe_rate: f32,
     /// Hold mode.
     pub hold: ModeGains,
@@ -200,11 +200,13 @@ pub struct ObserverDesign {
     /// its whole range moves the probe by `span (1 - e^(-t / tau_p)) <=
     /// span t / tau_p` in `t` ([`ObserverDesign::gate`]).
     pub gate_rate: f32,
-    /// The readings' own scatter the gate allows on top [C]: six standard
+    /// The readings' own scatter the gate allows on top \[C\]: six standard
     /// deviations of the difference of two readings, `6 sqrt(2 R)`.
     pub gate_noise: f32,
     /// The largest rate the estimate may hold [C/s]: twice the oil's
-    /// largest plausible rate ([`RATE_LIMIT`]).
+    /// largest plausible rate (`estimator.max_oil_rate`); the state is
+    /// projected onto `|r| <= rate_limit` after each update (a constrained
+    /// Kalman filter by projection, Simon 2010).
     pub rate_limit: f32,
     /// Weight of a reading in the innovations' running mean square, `1 -
     /// e^(-T_s / (tau_p + tau_w))` ([`OilObserver::variance`]).
@@ -365,7 +367,7 @@ impl ObserverDesign {
     }
 
     /// The largest change of the reading the oil can explain `ticks` after
-    /// the last accepted one [C]: `gate_rate t + gate_noise`. A reading
+    /// the last accepted one \[C\]: `gate_rate t + gate_noise`. A reading
     /// further from the last accepted one is out of band (a spike, or after
     /// enough agreeing ones a step of the reading itself, where the observer
     /// restarts), whatever the spike threshold: inverting the probe's lag,
@@ -430,7 +432,7 @@ pub struct OilObserver {
 }
 
 impl OilObserver {
-    /// At rest at `initial` [C] (oil, well and probe), rate 0, in the fast
+    /// At rest at `initial` \[C\] (oil, well and probe), rate 0, in the fast
     /// mode: the first readings are followed quickly, and the estimate's
     /// variance starts at the fast mode's.
     pub const fn new(initial: f32) -> Self {
@@ -453,7 +455,7 @@ impl OilObserver {
         }
     }
 
-    /// The estimated oil temperature [C].
+    /// The estimated oil temperature \[C\].
     #[inline]
     pub fn oil(&self) -> f32 {
         self.oil
@@ -464,18 +466,18 @@ impl OilObserver {
         self.rate
     }
 
-    /// The estimated well temperature [C] (the oil's without a well).
+    /// The estimated well temperature \[C\] (the oil's without a well).
     pub fn well(&self) -> f32 {
         self.well
     }
 
-    /// The estimated probe temperature [C] (what the next reading is
+    /// The estimated probe temperature \[C\] (what the next reading is
     /// expected to be, without noise).
     pub fn probe(&self) -> f32 {
         self.probe
     }
 
-    /// The last accepted reading [C].
+    /// The last accepted reading \[C\].
     pub fn last_reading(&self) -> f32 {
         self.last_reading
     }
@@ -518,7 +520,7 @@ impl OilObserver {
         self.since_reading = self.since_reading.saturating_add(1);
     }
 
-    /// A reading `y` [C] (finite: the caller rejects the rest): gated
+    /// A reading `y` \[C\] (finite: the caller rejects the rest): gated
     /// against the last accepted reading by the spike settings, the
     /// threshold no wider than [`ObserverDesign::gate`] (a spike is
     /// rejected; the `limit + 1`-th agreeing out-of-band reading is a real

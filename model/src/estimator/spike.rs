@@ -26,7 +26,7 @@ pub enum Verdict {
 /// and `spike_limit`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SpikeSettings {
-    /// Spike threshold [C].
+    /// Spike threshold \[C\].
     pub threshold: f32,
     /// Consecutive agreeing out-of-band readings rejected before a step is
     /// taken as real.
@@ -43,7 +43,7 @@ pub struct SpikeGate {
 }
 
 impl SpikeGate {
-    /// No out-of-band reading yet; `initial` [C] is the first candidate.
+    /// No out-of-band reading yet; `initial` \[C\] is the first candidate.
     pub const fn new(initial: f32) -> Self {
         SpikeGate {
             spikes: 0,
@@ -51,8 +51,8 @@ impl SpikeGate {
         }
     }
 
-    /// Judges the reading `y` [C] against the expected reading `expected`
-    /// [C] (both finite: the caller rejects the rest).
+    /// Judges the reading `y` \[C\] against the expected reading `expected`
+    /// \[C\] (both finite: the caller rejects the rest).
     #[inline]
     pub fn offer(&mut self, settings: &SpikeSettings, expected: f32, y: f32) -> Verdict {
         let threshold = settings.threshold;

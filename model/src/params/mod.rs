@@ -22,17 +22,17 @@ use crate::throttle::{Capillary, Orifice, Slot};
 /// The plunger and its spring.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Plunger<T> {
-    /// Diameter `D` [m].
+    /// Diameter `D` \[m\].
     pub diameter: T,
-    /// Moving mass `m` [kg].
+    /// Moving mass `m` \[kg\].
     pub mass: T,
     /// Viscous friction `b` [N s/m] (the hydraulic damping comes on top).
     pub damping: T,
     /// Spring rate `c` [N/m].
     pub spring_rate: T,
-    /// Initial spring compression `x0` [m].
+    /// Initial spring compression `x0` \[m\].
     pub preload: T,
-    /// Travel between the stops, `x_max` [m].
+    /// Travel between the stops, `x_max` \[m\].
     pub stroke: T,
 }
 
@@ -58,7 +58,7 @@ pub struct Machine<T> {
     pub working_flow: T,
     /// Volumetric loss at `leakage_temperature` [m^3/s].
     pub leakage_reference: T,
-    /// Reference temperature of the loss [C].
+    /// Reference temperature of the loss \[C\].
     pub leakage_temperature: T,
 }
 
@@ -87,9 +87,9 @@ pub struct Params<T> {
     pub volume_a: T,
     /// Volume of chamber (b) at `x = 0` [m^3].
     pub volume_b: T,
-    /// Constant drop `dp = p_p - p_c` [Pa] (Eq. 10).
+    /// Constant drop `dp = p_p - p_c` \[Pa\] (Eq. 10).
     pub pressure_drop: T,
-    /// Outlet pressure `p_c` [Pa].
+    /// Outlet pressure `p_c` \[Pa\].
     pub outlet_pressure: T,
     /// The driven machine, if described.
     pub machine: Option<Machine<T>>,
@@ -215,7 +215,7 @@ impl<T: Float> Params<T> {
         Ok(params)
     }
 
-    /// Inlet pressure `p_p = p_c + dp` [Pa].
+    /// Inlet pressure `p_p = p_c + dp` \[Pa\].
     #[inline]
     pub fn inlet_pressure(&self) -> T {
         self.outlet_pressure + self.pressure_drop

@@ -69,10 +69,10 @@ pub const REG_FAULT_STATUS: u8 = 0x07;
 /// Added to a register address to write it.
 pub const WRITE: u8 = 0x80;
 
-/// Time between two fault-detection cycles after the one at start-up [s]
+/// Time between two fault-detection cycles after the one at start-up \[s\]
 /// (what [`Settings::from_params`] sets).
 pub const DIAGNOSIS_INTERVAL: f32 = 10.0;
-/// Longest conversion after a return to automatic conversion [s]: the
+/// Longest conversion after a return to automatic conversion \[s\]: the
 /// datasheet's single-conversion time with the 50 Hz filter (66 ms max;
 /// 55 ms at 60 Hz).
 pub const FIRST_CONVERSION: f32 = 0.066;
@@ -160,7 +160,7 @@ impl Mains {
         }
     }
 
-    /// Time between two readings in automatic conversion mode [s].
+    /// Time between two readings in automatic conversion mode \[s\].
     pub fn conversion_period(self) -> f32 {
         match self {
             Mains::Hz50 => 1.0 / 50.0,
@@ -196,9 +196,9 @@ impl<E: core::fmt::Debug> core::error::Error for Error<E> {}
 /// The converter's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Settings {
-    /// RTD resistance at 0 C [ohm] (100 for a PT100).
+    /// RTD resistance at 0 C \[ohm\] (100 for a PT100).
     pub r0: f32,
-    /// Reference resistor [ohm] (430 on the usual PT100 boards).
+    /// Reference resistor \[ohm\] (430 on the usual PT100 boards).
     pub reference: f32,
     /// Wiring.
     pub wires: Wires,
@@ -206,7 +206,7 @@ pub struct Settings {
     pub mains: Mains,
     /// Callendar-Van Dusen coefficients of the element.
     pub cvd: Cvd,
-    /// Temperatures outside which the converter flags a fault [C]
+    /// Temperatures outside which the converter flags a fault \[C\]
     /// (its high and low thresholds).
     pub fault_band: (f32, f32),
     /// Readings between two fault-detection cycles after the one at
@@ -304,7 +304,7 @@ pub fn resolution(raw: &RawEstimator, t: f64) -> f64 {
     raw.rtd_reference / 32768.0 / raw.rtd_slope(t)
 }
 
-/// The 15-bit code of resistance `r` [ohm] (rounded to the nearest code,
+/// The 15-bit code of resistance `r` \[ohm\] (rounded to the nearest code,
 /// as the converter's ADC does), saturated to the code range.
 pub fn code_of(settings: &Settings, r: f32) -> u16 {
     let c = r / settings.reference * 32768.0 + 0.5;
@@ -505,7 +505,7 @@ impl<SPI: SpiDevice> Max31865<SPI> {
         Ok(word >> 1)
     }
 
-    /// Reads the temperature [C] of the latest conversion.
+    /// Reads the temperature \[C\] of the latest conversion.
     ///
     /// # Errors
     ///

@@ -46,7 +46,7 @@ impl core::fmt::Display for SensorFault {
 
 impl core::error::Error for SensorFault {}
 
-/// A source of oil temperature samples [C].
+/// A source of oil temperature samples \[C\].
 ///
 /// `Ok(Some(t))`: a new sample; `Ok(None)`: nothing new since the last call
 /// (the estimator keeps its filtered value); `Err(fault)`: the sample is

@@ -40,7 +40,7 @@ impl Cvd {
     /// The standard curve of IEC 60751 (alpha = 0.00385).
     pub const IEC_60751: Cvd = Cvd { a: A, b: B, c: C };
 
-    /// Resistance [ohm] of an element with `r0` [ohm] at 0 C, at `t` [C].
+    /// Resistance \[ohm\] of an element with `r0` \[ohm\] at 0 C, at `t` [C].
     pub fn resistance(&self, r0: f32, t: f32) -> f32 {
         let mut r = 1.0 + self.a * t + self.b * t * t;
         if t < 0.0 {
@@ -49,8 +49,8 @@ impl Cvd {
         r0 * r
     }
 
-    /// Temperature [C] of an element with `r0` [ohm] at 0 C reading `r`
-    /// [ohm]; `None` outside the IEC 60751 range (-200..850 C), where the
+    /// Temperature [C] of an element with `r0` \[ohm\] at 0 C reading `r`
+    /// \[ohm\]; `None` outside the IEC 60751 range (-200..850 C), where the
     /// curve has no root, or for a non-finite or non-positive resistance.
     pub fn temperature(&self, r0: f32, r: f32) -> Option<f32> {
         if !(r > 0.0 && r.is_finite() && r0 > 0.0 && r0.is_finite()) {
@@ -75,7 +75,7 @@ impl Cvd {
         ((T_MIN - 0.5..=T_MAX + 0.5).contains(&t) && t.is_finite()).then_some(t)
     }
 
-    /// `dR/dt` [ohm/C] at `t` [C] of an element with `r0` [ohm] at 0 C.
+    /// `dR/dt` [ohm/C] at `t` [C] of an element with `r0` \[ohm\] at 0 C.
     pub fn slope(&self, r0: f32, t: f32) -> f32 {
         let mut d = self.a + 2.0 * self.b * t;
         if t < 0.0 {
@@ -85,13 +85,13 @@ impl Cvd {
     }
 }
 
-/// Resistance [ohm] of an IEC 60751 RTD with `r0` [ohm] at 0 C, at `t` [C].
+/// Resistance \[ohm\] of an IEC 60751 RTD with `r0` \[ohm\] at 0 C, at `t` [C].
 pub fn resistance(r0: f32, t: f32) -> f32 {
     Cvd::IEC_60751.resistance(r0, t)
 }
 
-/// Temperature [C] of an IEC 60751 RTD with `r0` [ohm] at 0 C reading `r`
-/// [ohm] (see [`Cvd::temperature`]).
+/// Temperature [C] of an IEC 60751 RTD with `r0` \[ohm\] at 0 C reading `r`
+/// \[ohm\] (see [`Cvd::temperature`]).
 pub fn temperature(r0: f32, r: f32) -> Option<f32> {
     Cvd::IEC_60751.temperature(r0, r)
 }

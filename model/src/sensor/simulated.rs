@@ -43,7 +43,7 @@ impl embedded_hal::spi::Error for BusError {
 #[derive(Clone, Copy, Debug)]
 pub struct SimulatedMax31865 {
     settings: Settings,
-    /// Oil temperature at the RTD [C].
+    /// Oil temperature at the RTD \[C\].
     pub temperature: f32,
     /// Fault cause present (status bits, 0 = none).
     pub fault: u8,
@@ -62,7 +62,7 @@ pub struct SimulatedMax31865 {
 }
 
 impl SimulatedMax31865 {
-    /// A converter with `settings` and its RTD at `temperature` [C].
+    /// A converter with `settings` and its RTD at `temperature` \[C\].
     pub fn new(settings: Settings, temperature: f32) -> Self {
         SimulatedMax31865 {
             settings,
