@@ -350,7 +350,7 @@ mod tests {
 
     /// The paper preset's design with a design office's tolerances.
     fn device() -> RawParams {
-        let text = include_str!("../../presets/model-example.toml");
+        let text = include_str!("../presets/model-example.toml");
         let raw = compensator_params::file::parse(text).unwrap();
         assert!(raw.tolerances.any());
         raw

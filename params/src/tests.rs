@@ -483,7 +483,7 @@ fn misspelt_keys_and_sections_get_the_nearest_valid_name() {
     assert_eq!(nearest_path("plunger.bulk_modulus"), Some("fluid.bulk_modulus"));
     assert_eq!(nearest_path("estimator.oil_mx"), Some("estimator.oil_max"));
     assert_eq!(nearest_path("something.else"), None);
-    let preset = include_str!("../../presets/paper.toml");
+    let preset = include_str!("../presets/paper.toml");
     let typo = preset.replace("spring_rate", "sping_rate");
     assert_eq!(
         parse(&typo).unwrap_err().to_string(),
