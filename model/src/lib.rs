@@ -52,3 +52,8 @@ pub mod uncertainty;
 pub use error::ModelError;
 pub use params::{ParamError, Params, RawParams};
 pub use scalar::{Float, Real};
+
+/// The examples of the crate's README, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

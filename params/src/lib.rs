@@ -28,3 +28,9 @@ pub use text::{Compact, ECHO_MAX, Echo};
 
 #[cfg(test)]
 mod tests;
+
+/// The examples of the crate's README (they read TOML), compiled and run as
+/// doctests.
+#[cfg(all(doctest, feature = "toml"))]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
