@@ -74,10 +74,10 @@ fn docs_parameters_md_holds_the_current_tables() {
     );
 }
 
-/// The issue's cases, each named by the field that is wrong (before this,
-/// by another field, a temperature argument, or not at all).
+/// Inputs that used to be refused by another field, a temperature
+/// argument, or not at all: each is now named by the field that is wrong.
 #[test]
-fn the_issues_cases_name_the_wrong_field() {
+fn formerly_misreported_inputs_name_the_wrong_field() {
     use host_tests::matrix::{base_text, edited};
     let base = base_text();
     let field = |path: &str| fields().find(|f| f.path == path).unwrap();
@@ -138,7 +138,7 @@ fn the_issues_cases_name_the_wrong_field() {
 /// `indicators` (which used to exit 1 with the ODE library's message on a
 /// tiny density).
 #[test]
-fn the_cli_refuses_the_issues_cases_by_the_wrong_fields_name() {
+fn the_cli_refuses_formerly_misreported_inputs_by_the_wrong_fields_name() {
     use host_tests::matrix::{base_text, edited};
     let base = base_text();
     let dir = std::env::temp_dir().join(format!("compensator-bad-matrix-{}", std::process::id()));

@@ -521,7 +521,7 @@ fn a_correct_twin_is_never_reseated_across_the_envelope() {
 
 #[test]
 fn a_cooling_step_onto_the_closed_stop_ends_on_the_reference() {
-    // The natural cases: the estimate ends at the reference
+    // Cooling steps onto the closed stop: the estimate ends at the reference
     // equilibrium, whether the twin gets there by itself or, on a false
     // equilibrium, the check puts it there (today's twin needs it).
     let raw = paper_raw();
@@ -541,7 +541,7 @@ fn a_cooling_step_onto_the_closed_stop_ends_on_the_reference() {
     eprintln!("closed-stop case 38.78 -> 33.32 C: {n} re-seats");
 }
 
-/// The issue's `closed-stop-false-equilibrium.toml` (a design within 0.2
+/// `host-tests/cases/twin/closed-stop-false-equilibrium.toml` (a design within 0.2
 /// decade of `presets/model-example.toml`; its cooling step 38.78 ->
 /// 33.32 C ends on the closed stop at p_a = 301,365 Pa, p_b = 447 Pa).
 fn closed_stop_case() -> RawParams {

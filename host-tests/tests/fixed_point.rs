@@ -1,12 +1,11 @@
-//! Fixed point over the whole oil range (issue 7, "Fixed point near zero
-//! flow"): every fixed-point quantity of the twin's tick path keeps its
+//! Fixed point over the whole oil range, near zero flow included: every fixed-point quantity of the twin's tick path keeps its
 //! range and its resolution from the oil range's bottom (-20 C) to its top
 //! (150 C, or where a thin oil leaves Walther's range), on the presets and
 //! on the survey's designs at the ends of every coefficient's range.
 //!
-//! * the regularised orifice law near zero flow in Q12.20 (the issue's
-//!   first symptom: 2048 at `u = 5e-4`);
-//! * the issue's CLI case: the paper preset held at -15 C;
+//! * the regularised orifice law near zero flow in Q12.20 (its
+//!   first failure: 2048 at `u = 5e-4`);
+//! * the CLI's case of a cold hold: the paper preset held at -15 C;
 //! * holds at both ends of the oil range, and steps into hot oil, against
 //!   the closed form;
 //! * the ranges: every coefficient and every arithmetic result of the tick
@@ -123,7 +122,7 @@ fn assert_held(raw: &RawParams, t: f64, r: &Response, what: &str) {
 
 #[test]
 fn paper_preset_held_at_minus_15_c_stays_at_its_equilibrium() {
-    // The issue's CLI case: `compensator step --params presets/paper.toml
+    // A cold hold through the CLI: `compensator step --params presets/paper.toml
     // --from -15 --to -15 --precision fixed` (the CLI's default
     // configuration), which jumped to 88 MPa after one tick.
     let raw = compensator_cli::load(&repo_root().join("presets/paper.toml")).unwrap();

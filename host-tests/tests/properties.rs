@@ -1,4 +1,4 @@
-//! Property tests (issue 10 section 2): properties of the model that hold
+//! Property tests: properties of the model that hold
 //! for every plausible design and every temperature of its validated
 //! range, checked with `proptest` on random designs.
 //!

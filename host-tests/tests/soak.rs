@@ -1,4 +1,4 @@
-//! The soak with faults (issue 10 §3), bounded for CI: the estimator on the
+//! The soak with faults, bounded for CI: the estimator on the
 //! paper preset through the QEMU soak image's walk (same seed, same ticks:
 //! the host twin of `cargo xtask test`'s QEMU soak step), and the `f32` twin
 //! against the `f64` twin on the paper preset and random designs.
