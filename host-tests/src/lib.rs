@@ -6,6 +6,7 @@
 //! reference.
 
 pub mod accuracy;
+pub mod band;
 pub mod bench;
 pub mod board;
 pub mod coverage;

@@ -24,8 +24,11 @@
 //! u^2(y) = (dy/dT)^2 (u^2_observer + u^2_probe) + g' V g,   g_i = dy/dtheta_i
 //! ```
 //!
-//! with `V` the parameters' covariance. The sensitivities are central
-//! differences over one standard uncertainty of each parameter, computed
+//! with `V` the parameters' covariance. `g' V g` is `sum_c (g . L_c)^2`
+//! over the columns of `V`'s Cholesky factor `L` (`V = L L'`), each
+//! `g . L_c` a central difference across `+-L_c`: a joint displacement of
+//! one standard deviation of the device population (for uncorrelated
+//! fields, one field by its standard uncertainty), computed
 //! in `f64` on a grid of [`GRID`] temperatures over the oil range once
 //! ([`UncertaintyTable::new`]: the firmware's build script does it on the
 //! host); per refresh the estimator interpolates the grid linearly (ten
@@ -235,15 +238,54 @@ impl UncertaintyTable {
                 n += 1;
             }
         }
-        // Which of each field's perturbed parameter sets are valid devices.
+        // The covariance's square root: V = L L' (Cholesky, lower
+        // triangular, fields in schema order). Column c of L is a joint
+        // displacement of one standard deviation: the c-th field by its
+        // conditional standard uncertainty, the later ones by what their
+        // correlation with it carries along. g' V g = sum_c (g . L_c)^2,
+        // and g . L_c is the difference across +-L_c: each difference
+        // moves the device along the population's own spread, so a nearly
+        // perfectly correlated pair (a calibrated Walther law, +0.99998)
+        // is moved along its ridge and not across it by the full marginal
+        // uncertainty of one member, whose curvature would not cancel.
+        // Uncorrelated fields give L = diag(sigma): one field at a time.
+        let mut chol = [[0.0f64; MAX_FIELDS]; MAX_FIELDS];
+        for j in 0..n {
+            let cov = |a: usize, b: usize| raw.tolerances.correlation(paths[a], paths[b]) * sigmas[a] * sigmas[b];
+            let d = cov(j, j) - (0..j).map(|k| chol[j][k] * chol[j][k]).sum::<f64>();
+            // Semi-definite (a field fully determined by earlier ones):
+            // no displacement of its own. Parsed files are checked to be
+            // semi-definite (`compensator_params::file`); a pivot below
+            // rounding is taken as zero.
+            let d = if d > 1e-18 * cov(j, j) { libm::sqrt(d) } else { 0.0 };
+            chol[j][j] = d;
+            for i in j + 1..n {
+                let s = cov(i, j) - (0..j).map(|k| chol[i][k] * chol[j][k]).sum::<f64>();
+                chol[i][j] = if d > 0.0 { s / d } else { 0.0 };
+            }
+        }
+        // `raw` moved by `sign` times column `c`.
+        let along = |c: usize, sign: f64| {
+            let mut r = *raw;
+            for (i, path) in paths.iter().enumerate().take(n).skip(c) {
+                if chol[i][c] != 0.0 {
+                    r = moved(&r, path, sign * chol[i][c]);
+                }
+            }
+            r
+        };
+        // Which of the displaced parameter sets are valid devices.
         let mut up = [false; MAX_FIELDS];
         let mut down = [false; MAX_FIELDS];
-        for i in 0..n {
-            up[i] = Params::<f64>::new(&moved(raw, paths[i], sigmas[i])).is_ok();
-            down[i] = Params::<f64>::new(&moved(raw, paths[i], -sigmas[i])).is_ok();
-            if !up[i] && !down[i] {
+        for c in 0..n {
+            if chol[c][c] == 0.0 {
+                continue;
+            }
+            up[c] = Params::<f64>::new(&along(c, 1.0)).is_ok();
+            down[c] = Params::<f64>::new(&along(c, -1.0)).is_ok();
+            if !up[c] && !down[c] {
                 let tol = uncertain_fields(raw)
-                    .find(|(f, _)| f.path == paths[i])
+                    .find(|(f, _)| f.path == paths[c])
                     .map_or("tolerances", |(f, _)| f.tolerance_path);
                 return Err(UncertaintyError::Tolerance(tol));
             }
@@ -260,31 +302,27 @@ impl UncertaintyTable {
             let (Ok(hi), Ok(lo)) = (outputs(&nominal, t + h), outputs(&nominal, t - h)) else {
                 continue;
             };
-            let mut grad = [[0.0f64; MAX_FIELDS]; OUTPUTS];
+            let mut var = [0.0f64; OUTPUTS];
             let mut ok = true;
-            for i in 0..n {
-                let s = sigmas[i];
-                let yu = if up[i] {
-                    outputs_of(&moved(raw, paths[i], s), t)
-                } else {
-                    None
-                };
-                let yd = if down[i] {
-                    outputs_of(&moved(raw, paths[i], -s), t)
-                } else {
-                    None
-                };
+            for c in 0..n {
+                if chol[c][c] == 0.0 {
+                    continue;
+                }
+                let yu = if up[c] { outputs_of(&along(c, 1.0), t) } else { None };
+                let yd = if down[c] { outputs_of(&along(c, -1.0), t) } else { None };
+                // g . L_c: the output's change over one standard
+                // deviation along the column.
                 let g: [f64; OUTPUTS] = match (yu, yd) {
-                    (Some(u), Some(d)) => core::array::from_fn(|o| (u[o] - d[o]) / (2.0 * s)),
-                    (Some(u), None) => core::array::from_fn(|o| (u[o] - y0[o]) / s),
-                    (None, Some(d)) => core::array::from_fn(|o| (y0[o] - d[o]) / s),
+                    (Some(u), Some(d)) => core::array::from_fn(|o| (u[o] - d[o]) / 2.0),
+                    (Some(u), None) => core::array::from_fn(|o| u[o] - y0[o]),
+                    (None, Some(d)) => core::array::from_fn(|o| y0[o] - d[o]),
                     (None, None) => {
                         ok = false;
                         break;
                     }
                 };
                 for o in 0..OUTPUTS {
-                    grad[o][i] = g[o];
+                    var[o] += g[o] * g[o];
                 }
             }
             if !ok {
@@ -292,14 +330,7 @@ impl UncertaintyTable {
             }
             for o in 0..OUTPUTS {
                 table.slope[k][o] = ((hi[o] - lo[o]) / (2.0 * h)) as f32;
-                let mut var = 0.0;
-                for i in 0..n {
-                    for j in 0..n {
-                        let r = raw.tolerances.correlation(paths[i], paths[j]);
-                        var += grad[o][i] * r * sigmas[i] * sigmas[j] * grad[o][j];
-                    }
-                }
-                table.sd_params[k][o] = libm::sqrt(var.max(0.0)) as f32;
+                table.sd_params[k][o] = libm::sqrt(var[o]) as f32;
             }
         }
         Ok(table)
