@@ -1,14 +1,14 @@
 //! Build script of the firmware package: a thin driver over
 //! `compensator-codegen`, whose functions host tests call too.
 //!
-//! 1. Puts the memory layout on the linker's search path as `memory.x`:
-//!    `link/memory-qemu.x` (STM32F405: 1 MiB flash, 128 KiB RAM) for the
-//!    QEMU images (the Cortex-M3 benchmark runs on QEMU's `netduino2`, an
-//!    STM32F205 with the same map), `link/memory-board.x` for the board
-//!    image (feature `board`: the stack alone in the core-coupled RAM, so
-//!    that an overflow faults instead of corrupting `.bss`). No `memory.x`
-//!    may sit in the workspace root: the linker runs there and would find
-//!    it before the search path.
+//! 1. The memory layout: the workspace root's `memory.x` is the board's
+//!    (STM32F405: the stack alone in the core-coupled RAM, so that an
+//!    overflow faults instead of corrupting `.bss`), and the linker, which
+//!    runs in the workspace root, reads it for every image. The QEMU
+//!    images get their machine's differences as `--defsym` link arguments
+//!    ([`QEMU_LAYOUTS`]): QEMU's STM32F405 and STM32F205 (`netduinoplus2`,
+//!    `netduino2`) model no CCM, and the Cortex-M0 image runs on the
+//!    nRF51 of `microbit`.
 //! 2. For the firmware images (features `qemu`, `board`; host builds
 //!    include no parameter file), reads the parameter file named by
 //!    `COMPENSATOR_PARAMS` (default `presets/paper.toml`; a relative path
@@ -30,6 +30,22 @@
 use std::path::PathBuf;
 use std::{env, fs};
 
+/// The QEMU machines' layouts where they differ from the board's
+/// `memory.x` (the symbols it reads): `stm32` for `netduinoplus2` and
+/// `netduino2` (1 MiB flash at 0x0800_0000 as the board, 128 KiB of SRAM
+/// used, the stack at its top: QEMU 7.2 maps no CCM at 0x1000_0000), and
+/// `microbit` (nRF51822: 256 KiB flash at 0, 16 KiB SRAM).
+const QEMU_LAYOUTS: [(&str, &[(&str, u32)]); 2] = [
+    (
+        "stm32",
+        &[("__qemu_flash_origin", 0x0800_0000), ("__qemu_flash_length", 1024 << 10), ("__qemu_ram_length", 128 << 10)],
+    ),
+    (
+        "microbit",
+        &[("__qemu_flash_origin", 0), ("__qemu_flash_length", 256 << 10), ("__qemu_ram_length", 16 << 10)],
+    ),
+];
+
 fn main() {
     let manifest = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").unwrap());
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
@@ -38,17 +54,16 @@ fn main() {
     let qemu = env::var_os("CARGO_FEATURE_QEMU").is_some();
     println!("cargo:rerun-if-changed=build.rs");
 
-    if target.starts_with("thumb") {
-        let layout = if board {
-            "link/memory-board.x"
-        } else if target.starts_with("thumbv6m") {
-            "link/memory-microbit.x"
-        } else {
-            "link/memory-qemu.x"
-        };
-        fs::copy(manifest.join(layout), out.join("memory.x")).expect("copy the memory layout");
-        println!("cargo:rustc-link-search={}", out.display());
-        println!("cargo:rerun-if-changed={layout}");
+    println!("cargo:rerun-if-changed=memory.x");
+    if target.starts_with("thumb") && !board {
+        let machine = if target.starts_with("thumbv6m") { "microbit" } else { "stm32" };
+        for (name, symbols) in QEMU_LAYOUTS {
+            if name == machine {
+                for (symbol, value) in symbols {
+                    println!("cargo:rustc-link-arg=--defsym={symbol}={value:#x}");
+                }
+            }
+        }
     }
 
     if !(board || qemu) {

@@ -27,7 +27,7 @@
 //! fault-detection cycle runs at start-up and every 10 s.
 //!
 //! Conventions: the stack sits alone in the core-coupled RAM
-//! (`link/memory-board.x`: an overflow faults instead of corrupting `.bss`); a
+//! (the root's `memory.x`: an overflow faults instead of corrupting `.bss`); a
 //! `HardFault` is logged with its registers, then halts at a breakpoint
 //! under a debugger or resets the chip without one; debug builds keep the
 //! debug port clocked in sleep (`wfi`) so that RTT and reflashing keep

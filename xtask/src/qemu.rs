@@ -23,7 +23,7 @@ pub const NETDUINO: Machine = Machine {
     cpu: "cortex-m4",
 };
 /// QEMU's Netduino 2 (STM32F205, Cortex-M3, no FPU): the same memory map
-/// as the STM32F405, so one memory layout (`link/memory-qemu.x`) serves both targets.
+/// as the STM32F405, so one layout (`memory.x` with the QEMU STM32s' stack in SRAM) serves both targets.
 pub const NETDUINO2: Machine = Machine {
     name: "netduino2",
     cpu: "cortex-m3",

@@ -35,7 +35,7 @@ pub const BUDGET_RAM: u64 = 8 * 1024;
 /// moves in (4.3-4.8 KiB since the twin carries its graded-piece scheme,
 /// its flow unit and the stop events; frames in the disassembly: `main`
 /// 3.0 KiB, `Twin::new` 1.1 KiB, a twin tick's about 0.5 KiB).
-/// The board's stack has the 64 KiB CCM to itself (`link/memory-board.x`),
+/// The board's stack has the 64 KiB CCM to itself (the root's `memory.x`),
 /// so 6 KiB keeps a margin of ten.
 pub const BUDGET_STACK: u64 = 6 * 1024;
 
