@@ -38,11 +38,19 @@ use std::{env, fs};
 const QEMU_LAYOUTS: [(&str, &[(&str, u32)]); 2] = [
     (
         "stm32",
-        &[("__qemu_flash_origin", 0x0800_0000), ("__qemu_flash_length", 1024 << 10), ("__qemu_ram_length", 128 << 10)],
+        &[
+            ("__qemu_flash_origin", 0x0800_0000),
+            ("__qemu_flash_length", 1024 << 10),
+            ("__qemu_ram_length", 128 << 10),
+        ],
     ),
     (
         "microbit",
-        &[("__qemu_flash_origin", 0), ("__qemu_flash_length", 256 << 10), ("__qemu_ram_length", 16 << 10)],
+        &[
+            ("__qemu_flash_origin", 0),
+            ("__qemu_flash_length", 256 << 10),
+            ("__qemu_ram_length", 16 << 10),
+        ],
     ),
 ];
 
@@ -56,7 +64,11 @@ fn main() {
 
     println!("cargo:rerun-if-changed=memory.x");
     if target.starts_with("thumb") && !board {
-        let machine = if target.starts_with("thumbv6m") { "microbit" } else { "stm32" };
+        let machine = if target.starts_with("thumbv6m") {
+            "microbit"
+        } else {
+            "stm32"
+        };
         for (name, symbols) in QEMU_LAYOUTS {
             if name == machine {
                 for (symbol, value) in symbols {
