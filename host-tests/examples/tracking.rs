@@ -5,10 +5,12 @@
 //! four with a well lag of 0.5-2 times it, noise 0.02 C), each at 0.5 and
 //! 0.05 C/s over the validated range.
 //!
-//!     cargo run --release -p host-tests --example tracking -- [DESIGNS] [SEED]
+//!     cargo run --release -p host-tests --example tracking -- [DESIGNS] [SEED] [PROBES]
 //!
-//! Defaults: 40 random designs, seed 1. Goals: once two probe time constants
-//! have passed, |x - x_ref| <= 0.5 % of the stroke at 0.5 C/s and 0.15 % at
+//! Defaults: 40 random designs, seed 1, random probes. `PROBES` = `8s`
+//! gives every design the goals' probe instead: an 8 s time constant, no
+//! well lag, noise 0.02 C. Goals: once two probe time constants have
+//! passed, |x - x_ref| <= 0.5 % of the stroke at 0.5 C/s and 0.15 % at
 //! 0.05 C/s.
 
 use host_tests::random::{Rng, physical_params};
@@ -19,6 +21,14 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let arg = |i: usize, d: u64| args.get(i).and_then(|a| a.parse().ok()).unwrap_or(d);
     let (count, seed) = (arg(0, 40) as usize, arg(1, 1));
+    let fixed_probe = match args.get(2).map(String::as_str) {
+        None | Some("random") => false,
+        Some("8s") => true,
+        Some(other) => {
+            eprintln!("PROBES: expected random or 8s, found {other}");
+            std::process::exit(2);
+        }
+    };
     let mut paper = compensator_cli::load(&host_tests::repo_root().join("presets/paper.toml")).expect("paper preset");
     paper.probe.time_constant = 8.0;
     paper.probe.well_time_constant = 0.0;
@@ -39,6 +49,10 @@ fn main() {
         } else {
             0.0
         };
+        if fixed_probe {
+            raw.probe.time_constant = 8.0;
+            raw.probe.well_time_constant = 0.0;
+        }
         raw.probe.noise = 0.02;
         designs.push(raw);
     }
