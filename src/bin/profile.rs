@@ -1,7 +1,8 @@
-//! The profile image: `cargo xtask profile`.
+//! The profile image. Its trace runner (once `cargo xtask profile`) is
+//! not in this tree; `cargo xtask build` does not build this image.
 //!
-//! Runs two sections, each between two calls of [`mark`], which `cargo
-//! xtask profile` finds in QEMU's instruction trace (`-singlestep -d
+//! Runs two sections, each between two calls of [`mark`], which a trace
+//! runner finds in QEMU's instruction trace (`-singlestep -d
 //! exec`) to attribute every instruction executed inside a section to its
 //! function and source line:
 //!
@@ -31,7 +32,7 @@ type Scalar = f32;
 #[cfg(not(target_abi = "eabihf"))]
 type Scalar = compensator::scalar::Fixed;
 
-/// The section boundary `cargo xtask profile` looks for (by its symbol).
+/// The section boundary a trace runner looks for (by its symbol).
 #[inline(never)]
 #[unsafe(no_mangle)]
 pub extern "C" fn profile_mark(section: u32) {
