@@ -13,6 +13,7 @@ pub mod coverage;
 pub mod fixed_audit;
 pub mod identify_study;
 pub mod matrix;
+pub mod observability;
 pub mod probe;
 pub mod random;
 pub mod settling;
