@@ -10,7 +10,6 @@
 //! the propagation, not the model.
 
 use compensator::Params;
-use compensator::equilibrium::equilibrium;
 use compensator::estimator::EstimatorConfig;
 use compensator::params::{RawParams, RawTolerances};
 use compensator::uncertainty::UncertaintyTable;
@@ -79,14 +78,14 @@ pub fn table(raw: &RawParams) -> UncertaintyTable {
         .table()
 }
 
-/// x_free, p_a and the total flow (the window extended past the stops, as
-/// the uncertainty table takes it) of `raw` at `t`.
+/// x_free, p_a, p_b and the total flow (the window extended past the
+/// stops) of `raw` at `t`: the table's own outputs
+/// ([`compensator::uncertainty::outputs`]), so that only the propagation
+/// differs.
 pub fn outputs(raw: &RawParams, t: f64) -> [f64; 4] {
     let p = Params::<f64>::new(raw).expect("valid parameters");
-    let e = equilibrium(&p, t).expect("the equilibrium");
-    let velocity = (2.0 * p.pressure_drop / e.fluid.density).sqrt();
-    let per_x = p.slot.discharge_coefficient * std::f64::consts::PI * p.slot.diameter * velocity;
-    [e.x_free, e.p_a, e.p_b, e.q_total + per_x * (e.x_free - e.x)]
+    let y = compensator::uncertainty::outputs(&p, t).expect("the equilibrium");
+    [y[0], y[1], y[2], y[3]]
 }
 
 /// `sqrt(g' V g)` of each output at `t` with the gradient by central

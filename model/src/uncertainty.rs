@@ -149,8 +149,13 @@ pub struct UncertaintyTable {
 
 /// The reported quantities at `t` for `p`: `x_free`, `p_a`, `p_b`, the
 /// total flow with the window extended linearly past the stops, the
-/// compensation error (NaN without a machine).
-fn outputs(p: &Params<f64>, t: f64) -> Result<[f64; OUTPUTS], ModelError> {
+/// compensation error (NaN without a machine): [`OUTPUT_NAMES`], what the
+/// table propagates.
+///
+/// # Errors
+///
+/// The equilibrium's, where the model refuses `t`.
+pub fn outputs(p: &Params<f64>, t: f64) -> Result<[f64; OUTPUTS], ModelError> {
     let eq = equilibrium(p, t)?;
     let velocity = libm::sqrt(2.0 * p.pressure_drop / eq.fluid.density);
     let per_x = p.slot.discharge_coefficient * core::f64::consts::PI * p.slot.diameter * velocity;
