@@ -339,13 +339,14 @@ impl Run {
         let tau = 1.0 / slowest;
         let raw = &self.raw.estimator;
         // The spike gate (and, through the driver, a detection cycle and
-        // its restart), the observer's settling (its fast mode decays with
-        // the probe's time constant, its hold mode over a hundred of them),
+        // its restart), the observer's settling (its gains' schedule from
+        // the fast mode to the hold mode, the hold mode over a hundred
+        // probe time constants),
         // the twin's slew over the oil's viscosity range (a Fluid job on at
         // least every other tick), the twin's settling.
         let period = sensor_every as f64 * tick;
         let spikes = (raw.spike_limit + 12.0) * period;
-        let filter = 100.0 * self.raw.probe.time_constant + 1.0;
+        let filter = f64::from(self.cfg.observer.schedule_time()) + 100.0 * self.raw.probe.time_constant + 1.0;
         let mu = |t: f64| self.p.oil.state(t as f32).map(|f| f64::from(f.dynamic_viscosity));
         let (Ok(cold), Ok(hot)) = (mu(raw.oil_min.max(-20.0)), mu(raw.oil_max.min(150.0))) else {
             return;

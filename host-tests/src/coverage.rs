@@ -26,8 +26,10 @@ use compensator::params::{CORE_FIELDS, RawParams, RawTolerances};
 use compensator::sensor::max31865::{Settings, code_of};
 
 /// How long each sample holds its temperature before it is read, in probe
-/// time constants (`probe.time_constant + probe.well_time_constant`): the
-/// observer's fast mode has decayed to `e^-6` of its weight.
+/// time constants (`probe.time_constant + probe.well_time_constant`), and
+/// at least until the observer's gains are at the end of their schedule
+/// from the fast mode to the hold mode (`ObserverDesign::schedule_time`:
+/// 42 s for the default 8 s probe, within the 48 s).
 pub const HOLD_TIME_CONSTANTS: f64 = 6.0;
 
 /// The reported quantities checked, in [`Uncertainty`](compensator::uncertainty::Uncertainty) order.
@@ -152,7 +154,7 @@ impl Sample {
 /// The estimate of `nominal`'s estimator (`config`) held at `t` [C], read
 /// through a probe whose error at `t` is `offset` [C] with the file's
 /// noise, quantised by the MAX31865; after [`HOLD_TIME_CONSTANTS`] probe
-/// time constants.
+/// time constants, and no sooner than the end of the observer's schedule.
 pub fn estimate_at(
     p32: &Params<f32>,
     config: EstimatorConfig,
@@ -175,7 +177,8 @@ pub fn estimate_at(
     let mut est = Estimator::new(p32, config, first).map_err(|e| e.to_string())?;
     let every = config.ticks_per(config.sample_period() as f32);
     let lag = nominal.probe.time_constant + nominal.probe.well_time_constant;
-    let ticks = (HOLD_TIME_CONSTANTS * lag / f64::from(config.tick())).ceil() as u32 + 10 * every;
+    let hold = (HOLD_TIME_CONSTANTS * lag).max(f64::from(config.observer.schedule_time()));
+    let ticks = (hold / f64::from(config.tick())).ceil() as u32 + 10 * every;
     let mut last = None;
     for k in 0..ticks {
         let reading = if k % every == 0 { Ok(Some(read(rng)?)) } else { Ok(None) };
