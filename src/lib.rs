@@ -24,7 +24,17 @@ pub mod qemu;
 mod qemu_log;
 
 use compensator::dynamics::{Scheme, TwinConfig};
-use compensator::estimator::EstimatorConfig;
+use compensator::estimator::{Estimator, EstimatorConfig, ObserverDesign};
+use compensator::uncertainty::UncertaintyTable;
+
+/// The estimator's settings as the images hold them: the uncertainty table
+/// and the observer's design by reference to the build's statics in flash
+/// (`UNCERTAINTY`, `OBSERVER`), so that no copy of either (0.75 KiB and
+/// 0.9 KiB) sits on the stack.
+pub type BuiltConfig = EstimatorConfig<&'static UncertaintyTable, &'static ObserverDesign>;
+
+/// The estimator with [`BuiltConfig`], its twin integrating in `T`.
+pub type BuiltEstimator<T = f32> = Estimator<T, &'static UncertaintyTable, &'static ObserverDesign>;
 
 /// Puts the twin configuration chosen at build time (`TWIN_SCHEME`,
 /// `TWIN_SUBSTEPS` of the generated `params.rs`) into `config`, keeping
@@ -32,7 +42,11 @@ use compensator::estimator::EstimatorConfig;
 ///
 /// Errors: an unknown scheme name or a substep count outside
 /// `1..=MAX_SUBSTEPS` (a build script out of step with the model).
-pub fn use_built_twin<U>(config: &mut EstimatorConfig<U>, scheme: &str, substeps: u8) -> Result<(), &'static str> {
+pub fn use_built_twin<U, O>(
+    config: &mut EstimatorConfig<U, O>,
+    scheme: &str,
+    substeps: u8,
+) -> Result<(), &'static str> {
     let scheme = Scheme::from_name(scheme).ok_or("unknown twin scheme")?;
     let twin = TwinConfig {
         scheme,

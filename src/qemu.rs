@@ -68,11 +68,11 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
 /// logged (the field, or what is wrong) and ends the run with exit code 1.
 pub fn built_estimator_config(
     raw: &compensator::params::RawEstimator,
-    observer: compensator::estimator::ObserverDesign,
+    observer: &'static compensator::estimator::ObserverDesign,
     uncertainty: &'static compensator::uncertainty::UncertaintyTable,
     scheme: &str,
     substeps: u8,
-) -> compensator::estimator::EstimatorConfig<&'static compensator::uncertainty::UncertaintyTable> {
+) -> crate::BuiltConfig {
     let mut config = match compensator::estimator::EstimatorConfig::from_parts(raw, observer, uncertainty) {
         Ok(c) => c,
         Err(e) => {

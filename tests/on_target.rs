@@ -126,7 +126,7 @@ mod tests {
         // then the twin forced to the far stop with its pressures swapped:
         // the next round of jobs puts it back on the host's equilibrium.
         let (stroke, dp) = (p.plunger.stroke as f64, p.pressure_drop as f64);
-        let mut config = EstimatorConfig::from_parts(&RAW_PARAMS.estimator, OBSERVER, &UNCERTAINTY).unwrap();
+        let mut config = EstimatorConfig::from_parts(&RAW_PARAMS.estimator, &OBSERVER, &UNCERTAINTY).unwrap();
         compensator_firmware::use_built_twin(&mut config, TWIN_SCHEME, TWIN_SUBSTEPS).unwrap();
         for &(t, _, _, pa, pb, x, _) in EXPECTED.iter().filter(|e| e.0 == 30.0 || e.0 == 60.0) {
             let mut est = Estimator::new(p, config, t).unwrap();
@@ -190,7 +190,7 @@ mod tests {
         assert!((t - 45.0).abs() < 0.05, "read {=f32}", t);
         sensor.device_mut().bus_error = true;
         assert!(sensor.read() == Err(SensorFault::Bus));
-        let mut config = EstimatorConfig::from_parts(&RAW_PARAMS.estimator, OBSERVER, &UNCERTAINTY).unwrap();
+        let mut config = EstimatorConfig::from_parts(&RAW_PARAMS.estimator, &OBSERVER, &UNCERTAINTY).unwrap();
         compensator_firmware::use_built_twin(&mut config, TWIN_SCHEME, TWIN_SUBSTEPS).unwrap();
         let mut est = Estimator::new(p, config, 45.0).unwrap();
         for sample in [

@@ -144,9 +144,9 @@ pub fn params_rs(raw: &RawParams, path: &str, source: &str) -> Result<ParamsRs, 
          probe: {probe},\n    \
          tolerances: ::compensator::params::RawTolerances::NONE,\n}};\n\
          /// The oil-temperature observer designed at build time for the file's probe.\n\
-         pub const OBSERVER: ::compensator::estimator::ObserverDesign = {observer};\n\
+         pub static OBSERVER: ::compensator::estimator::ObserverDesign = {observer};\n\
          /// The observer for a probe without lag (the soak image's walk reads the oil).\n\
-         pub const OBSERVER_WITHOUT_LAG: ::compensator::estimator::ObserverDesign = {direct};\n\
+         pub static OBSERVER_WITHOUT_LAG: ::compensator::estimator::ObserverDesign = {direct};\n\
          /// The uncertainty table built at build time from the file's tolerances.\n\
          pub static UNCERTAINTY: ::compensator::uncertainty::UncertaintyTable = {uncertainty};\n\
          /// Where the parameters came from.\n\
@@ -192,7 +192,7 @@ mod tests {
                 .contains(&format!("time_constant: {:?}", raw.probe.time_constant))
         );
         assert!(g.code.contains(
-            "pub const OBSERVER: ::compensator::estimator::ObserverDesign = ::compensator::estimator::ObserverDesign {"
+            "pub static OBSERVER: ::compensator::estimator::ObserverDesign = ::compensator::estimator::ObserverDesign {"
         ));
         assert!(g.code.contains("hold: ::compensator::estimator::ModeGains {"));
         assert!(g.code.contains("pub static UNCERTAINTY: ::compensator::uncertainty::UncertaintyTable = ::compensator::uncertainty::UncertaintyTable {"));

@@ -193,8 +193,8 @@ fn pieces(params: &Params<f32>) -> Result<(), &'static str> {
     }
 
     // Telemetry packing alone: one estimate, encoded by defmt.
-    let mut config =
-        EstimatorConfig::from_parts(&RAW_PARAMS.estimator, OBSERVER, &UNCERTAINTY).map_err(|_| "estimator settings")?;
+    let mut config = EstimatorConfig::from_parts(&RAW_PARAMS.estimator, &OBSERVER, &UNCERTAINTY)
+        .map_err(|_| "estimator settings")?;
     compensator_firmware::use_built_twin(&mut config, TWIN_SCHEME, TWIN_SUBSTEPS)?;
     let mut est = Estimator::new(params, config, 40.0).map_err(|_| "estimator cannot start")?;
     let e = est.tick(Ok(Some(40.0)));
@@ -271,8 +271,8 @@ fn pieces(params: &Params<f32>) -> Result<(), &'static str> {
 fn estimator_cost<T: Real>(params: &Params<f32>, scalar: &str) -> Result<(), &'static str> {
     use compensator::estimator::{Estimator, EstimatorConfig};
     use core::hint::black_box;
-    let mut config =
-        EstimatorConfig::from_parts(&RAW_PARAMS.estimator, OBSERVER, &UNCERTAINTY).map_err(|_| "estimator settings")?;
+    let mut config = EstimatorConfig::from_parts(&RAW_PARAMS.estimator, &OBSERVER, &UNCERTAINTY)
+        .map_err(|_| "estimator settings")?;
     compensator_firmware::use_built_twin(&mut config, TWIN_SCHEME, TWIN_SUBSTEPS)?;
     for (workload, n) in [("step", 1000u32), ("ramps", 10_000u32)] {
         for telemetry in [true, false] {
@@ -280,7 +280,7 @@ fn estimator_cost<T: Real>(params: &Params<f32>, scalar: &str) -> Result<(), &'s
             config.telemetry_every = if telemetry { 100 } else { 0 };
             let start = if workload == "step" { 30.0 } else { 26.0 };
             let mut est =
-                Estimator::<T, _>::with_scalar(params, config, start).map_err(|_| "estimator cannot start")?;
+                Estimator::<T, _, _>::with_scalar(params, config, start).map_err(|_| "estimator cannot start")?;
             let (mut total, mut worst, mut worst_tick) = (0u32, 0u32, 0u32);
             for k in 0..n {
                 let temperature = if workload == "step" {

@@ -157,7 +157,7 @@ fn main() -> ! {
         Ok(p) => p,
         Err(e) => defmt::panic!("parameters rejected: {=str}", e.field),
     };
-    let mut config = match EstimatorConfig::from_parts(&RAW_PARAMS.estimator, OBSERVER, &UNCERTAINTY) {
+    let mut config = match EstimatorConfig::from_parts(&RAW_PARAMS.estimator, &OBSERVER, &UNCERTAINTY) {
         Ok(c) => c,
         Err(e) => defmt::panic!("estimator settings rejected: {=str}", e.field),
     };
@@ -287,7 +287,7 @@ fn main() -> ! {
 #[inline(never)]
 fn tick_path<S: embedded_hal::spi::SpiDevice>(
     sensor: &mut Max31865<S>,
-    estimator: &mut Estimator<f32, &'static compensator::uncertainty::UncertaintyTable>,
+    estimator: &mut compensator_firmware::BuiltEstimator,
     now: u32,
     elapsed: u32,
     read: bool,

@@ -56,11 +56,11 @@ fn run() -> Result<(), &'static str> {
     }
     profile_mark(1);
 
-    let mut config =
-        EstimatorConfig::from_parts(&RAW_PARAMS.estimator, OBSERVER, &UNCERTAINTY).map_err(|_| "estimator settings")?;
+    let mut config = EstimatorConfig::from_parts(&RAW_PARAMS.estimator, &OBSERVER, &UNCERTAINTY)
+        .map_err(|_| "estimator settings")?;
     compensator_firmware::use_built_twin(&mut config, TWIN_SCHEME, TWIN_SUBSTEPS)?;
     config.telemetry_every = 100;
-    let mut est = Estimator::<Scalar, _>::with_scalar(&params, config, 30.0).map_err(|_| "estimator")?;
+    let mut est = Estimator::<Scalar, _, _>::with_scalar(&params, config, 30.0).map_err(|_| "estimator")?;
     profile_mark(2);
     for k in 0..200u32 {
         let sample = if k % 20 == 0 { Ok(Some(40.0)) } else { Ok(None) };

@@ -63,7 +63,7 @@ fn main() -> ! {
     };
     let config = compensator_firmware::qemu::built_estimator_config(
         &RAW_PARAMS.estimator,
-        OBSERVER_WITHOUT_LAG,
+        &OBSERVER_WITHOUT_LAG,
         &UNCERTAINTY,
         TWIN_SCHEME,
         TWIN_SUBSTEPS,

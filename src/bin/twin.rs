@@ -25,13 +25,13 @@
 
 use compensator::dynamics::linear::linearise;
 use compensator::equilibrium::{balance_temperature, equilibrium};
-use compensator::estimator::{Estimator, EstimatorConfig, Flags, StateEstimate};
+use compensator::estimator::{Estimator, Flags, StateEstimate};
 use compensator::sensor::TemperatureSource;
 use compensator::sensor::max31865::{Max31865, Settings, fault};
 use compensator::sensor::simulated::SimulatedMax31865;
-use compensator::uncertainty::UncertaintyTable;
 use compensator::{Params, asymptotic};
 use compensator_firmware::qemu::{CORE, TwinScalar, exit};
+use compensator_firmware::{BuiltConfig, BuiltEstimator};
 use compensator_testbench::faults::{Expected, FAULTS, Injected, fault_at};
 use compensator_testbench::probe::SimulatedProbe;
 use cortex_m as _; // links the critical-section implementation defmt needs
@@ -110,7 +110,7 @@ fn main() -> ! {
     };
     let config = compensator_firmware::qemu::built_estimator_config(
         &RAW_PARAMS.estimator,
-        OBSERVER,
+        &OBSERVER,
         &UNCERTAINTY,
         TWIN_SCHEME,
         TWIN_SUBSTEPS,
@@ -185,7 +185,7 @@ fn static_characteristic(params: &Params<f32>) {
 /// Part 2: the estimator on the replayed profile; returns whether every
 /// check passed.
 #[inline(never)]
-fn replay(params: &Params<f32>, config: EstimatorConfig<&'static UncertaintyTable>) -> bool {
+fn replay(params: &Params<f32>, config: BuiltConfig) -> bool {
     let raw = &RAW_PARAMS.estimator;
     // The device's sensor settings; the converter's own fault band stays
     // wide, so that the estimator's oil range is what rejects samples.
@@ -211,7 +211,7 @@ fn replay(params: &Params<f32>, config: EstimatorConfig<&'static UncertaintyTabl
         overflow: 0,
     };
     checks.check(sensor.configure().is_ok(), "sensor configuration", 0.0);
-    let mut estimator = match Estimator::<TwinScalar, _>::with_scalar(params, config, start) {
+    let mut estimator = match Estimator::<TwinScalar, _, _>::with_scalar(params, config, start) {
         Ok(e) => e,
         Err(e) => {
             error!("estimator: {}", e);
@@ -352,7 +352,7 @@ fn replay(params: &Params<f32>, config: EstimatorConfig<&'static UncertaintyTabl
 #[inline(never)]
 fn tick_path(
     sensor: &mut Max31865<SimulatedMax31865>,
-    estimator: &mut Estimator<TwinScalar, &'static UncertaintyTable>,
+    estimator: &mut BuiltEstimator<TwinScalar>,
     read: bool,
 ) -> StateEstimate {
     let sample = if read { sensor.read() } else { Ok(None) };

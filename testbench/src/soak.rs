@@ -17,7 +17,7 @@
 
 use compensator::Params;
 use compensator::equilibrium::equilibrium;
-use compensator::estimator::{Estimator, EstimatorConfig, Flags, StateEstimate};
+use compensator::estimator::{Estimator, EstimatorConfig, Flags, ObserverDesign, StateEstimate};
 use compensator::sensor::TemperatureSource;
 use compensator::sensor::max31865::{Max31865, Settings, code_of, fault};
 use compensator::sensor::simulated::SimulatedMax31865;
@@ -251,9 +251,9 @@ impl Limits {
     ///
     /// The oil model leaves no room for a walk (less than 10 C accepted
     /// above the cold levels).
-    pub fn new<U: Borrow<UncertaintyTable> + Copy>(
+    pub fn new<U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Copy>(
         params: &Params<f32>,
-        config: &EstimatorConfig<U>,
+        config: &EstimatorConfig<U, O>,
         settings: &Settings,
     ) -> Result<Limits, &'static str> {
         let settings = Settings {
@@ -641,12 +641,12 @@ pub struct HoldEnd {
 /// The soak: walk, simulated converter behind the real driver, estimator
 /// (its uncertainty table held as `U`: by value on the host, a reference
 /// to flash in the QEMU image), checks.
-pub struct Soak<U = UncertaintyTable> {
+pub struct Soak<U = UncertaintyTable, O = ObserverDesign> {
     /// Timing, ranges, bounds.
     pub limits: Limits,
     walk: Walk,
     sensor: Max31865<SimulatedMax31865>,
-    estimator: Estimator<f32, U>,
+    estimator: Estimator<f32, U, O>,
     params64: Params<f64>,
     machine: bool,
     k: u32,
@@ -664,7 +664,7 @@ pub struct Soak<U = UncertaintyTable> {
     pub stats: Stats,
 }
 
-impl<U: Borrow<UncertaintyTable> + Copy> Soak<U> {
+impl<U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Copy> Soak<U, O> {
     /// A soak of `seed` for the device of `params` (`params64`: the same
     /// parameters in `f64`, for the closed form the holds are checked
     /// against), the estimator `config` and the converter `settings`.
@@ -676,10 +676,10 @@ impl<U: Borrow<UncertaintyTable> + Copy> Soak<U> {
     pub fn new(
         params: &Params<f32>,
         params64: &Params<f64>,
-        config: EstimatorConfig<U>,
+        config: EstimatorConfig<U, O>,
         settings: &Settings,
         seed: u64,
-    ) -> Result<Soak<U>, &'static str> {
+    ) -> Result<Soak<U, O>, &'static str> {
         let limits = Limits::new(params, &config, settings)?;
         let walk = Walk::new(limits, seed);
         let start = walk.segment.to;

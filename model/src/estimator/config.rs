@@ -61,18 +61,20 @@ impl From<ParamError> for ConfigError {
     }
 }
 
-/// Estimator settings in `f32`, with the uncertainty table held as `U`: the
-/// table itself (the default, [`EstimatorConfig::new`]), or a reference to
-/// one in flash (`&'static UncertaintyTable`: the firmware's, which then
-/// keeps 0.75 KiB off its stack; [`EstimatorConfig::from_parts`]).
+/// Estimator settings in `f32`, with the uncertainty table held as `U` and
+/// the observer's design as `O`: each the value itself (the defaults,
+/// [`EstimatorConfig::new`]), or a reference to one in flash (`&'static
+/// UncertaintyTable`, `&'static ObserverDesign`: the firmware's, which then
+/// keeps 0.75 KiB and 0.9 KiB off its stack per copy;
+/// [`EstimatorConfig::from_parts`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct EstimatorConfig<U = UncertaintyTable> {
+pub struct EstimatorConfig<U = UncertaintyTable, O = ObserverDesign> {
     /// The twin's integrator. Its tick is the estimator's (`1 / tick_hz`);
     /// scheme and steps per tick are [`TwinConfig::SHIPPED`]'s unless
     /// changed before [`Estimator::new`](super::Estimator::new).
     pub twin: TwinConfig,
-    /// The oil-temperature observer's design.
-    pub observer: ObserverDesign,
+    /// The oil-temperature observer's design (or a reference to it).
+    pub observer: O,
     /// The spike gate in front of it.
     pub spikes: SpikeSettings,
     /// The uncertainty table over the oil range (or a reference to it).
@@ -119,7 +121,7 @@ impl EstimatorConfig<UncertaintyTable> {
     }
 }
 
-impl<U: Borrow<UncertaintyTable> + Copy> EstimatorConfig<U> {
+impl<U: Borrow<UncertaintyTable> + Copy> EstimatorConfig<U, ObserverDesign> {
     /// The settings for `raw` with an uncertainty table built beforehand
     /// (by a build script: the table does not depend on the tick), the
     /// observer designed here for `raw`'s tick and the MAX31865's
@@ -136,11 +138,19 @@ impl<U: Borrow<UncertaintyTable> + Copy> EstimatorConfig<U> {
             .map_err(ConfigError::Observer)?;
         Ok(Self::from_parts(&raw.estimator, observer, uncertainty)?)
     }
+}
 
+impl<U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Copy> EstimatorConfig<U, O> {
     /// The uncertainty table.
     #[inline]
     pub fn table(&self) -> &UncertaintyTable {
         self.uncertainty.borrow()
+    }
+
+    /// The oil-temperature observer's design.
+    #[inline]
+    pub fn observer_design(&self) -> &ObserverDesign {
+        self.observer.borrow()
     }
 
     /// From the `[estimator]` section and an observer and uncertainty table
@@ -151,7 +161,7 @@ impl<U: Borrow<UncertaintyTable> + Copy> EstimatorConfig<U> {
     ///
     /// A [`ParamError`] naming the first field of `raw` that breaks its
     /// rule (`RawEstimator::validate`).
-    pub fn from_parts(raw: &RawEstimator, observer: ObserverDesign, uncertainty: U) -> Result<Self, ParamError> {
+    pub fn from_parts(raw: &RawEstimator, observer: O, uncertainty: U) -> Result<Self, ParamError> {
         raw.validate()?;
         let tick = 1.0 / raw.tick_hz;
         let telemetry_every = if raw.telemetry_hz > 0.0 {
@@ -186,7 +196,7 @@ impl<U: Borrow<UncertaintyTable> + Copy> EstimatorConfig<U> {
 
     /// The period of the readings the observer is designed for \[s\].
     pub fn sample_period(&self) -> f64 {
-        f64::from(self.observer.sample_period)
+        f64::from(self.observer_design().sample_period)
     }
 
     /// Ticks between samples of a source that delivers one every `period`

@@ -6,9 +6,9 @@
 //! oil-temperature observer's prediction and the tick counter advance by
 //! the elapsed ticks, not silently by one.
 
-use super::Estimator;
 #[cfg(doc)]
 use super::Flags;
+use super::{Estimator, ObserverDesign};
 use crate::scalar::Real;
 use crate::sensor::SensorFault;
 use crate::uncertainty::UncertaintyTable;
@@ -23,7 +23,7 @@ use core::borrow::Borrow;
 /// ([`Estimator::lost_ticks`]) and flagged like any miss.
 pub const MAX_CATCH_UP: u32 = 8;
 
-impl<T: Real, U: Borrow<UncertaintyTable> + Copy> Estimator<T, U> {
+impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Copy> Estimator<T, U, O> {
     /// One tick that starts `elapsed` tick periods after the previous one
     /// (`1`: on time; `0` is taken as `1`). A later tick missed `elapsed -
     /// 1` deadlines: they are counted
@@ -45,7 +45,7 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy> Estimator<T, U> {
                 // A failed step is the next tick's to handle (it restarts
                 // the twin, flagged): nothing to add here.
                 let _ = self.twin.tick();
-                self.observer.predict(&self.config.observer);
+                self.observer.predict(self.config.observer_design());
             }
             // The tick counter (telemetry's cadence, staleness) follows real
             // time; a record due inside the gap goes out with this tick.

@@ -19,7 +19,7 @@ use crate::throttle::FlowLaws;
 use crate::uncertainty::{Uncertainty, UncertaintyTable};
 use core::borrow::Borrow;
 
-use super::{EstimatorConfig, OilObserver};
+use super::{EstimatorConfig, ObserverDesign, OilObserver};
 
 /// The temperature-only jobs, one per tick in turn (the uncertainty's
 /// depends on the observer's variance too).
@@ -173,10 +173,10 @@ impl Statics {
 /// Runs `job` at the estimated oil temperature `t` [C], updating
 /// `statics`. On an error the job's previous results stay in force.
 #[allow(clippy::too_many_arguments, reason = "the tick's state, borrowed apart")]
-pub(super) fn run<T: Real, U: Borrow<UncertaintyTable> + Copy>(
+pub(super) fn run<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Copy>(
     job: Job,
     p: &Params<f32>,
-    config: &EstimatorConfig<U>,
+    config: &EstimatorConfig<U, O>,
     twin: &mut Twin<f32, T>,
     design: Design,
     t: f32,
@@ -269,7 +269,7 @@ pub(super) fn run<T: Real, U: Borrow<UncertaintyTable> + Copy>(
             };
         }
         Job::Uncertainty => {
-            statics.uncertainty = config.table().at(t, observer.variance(&config.observer));
+            statics.uncertainty = config.table().at(t, observer.variance(config.observer_design()));
         }
     }
     Ok(())

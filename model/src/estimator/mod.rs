@@ -157,9 +157,9 @@ pub const P_TOLERANCE: f32 = 1e-2;
 /// FPU, [`Fixed`](crate::scalar::Fixed) where there is none); everything
 /// else (observer, jobs, flows) is `f32`.
 #[derive(Clone, Copy, Debug)]
-pub struct Estimator<T = f32, U = UncertaintyTable> {
+pub struct Estimator<T = f32, U = UncertaintyTable, O = ObserverDesign> {
     params: Params<f32>,
-    config: EstimatorConfig<U>,
+    config: EstimatorConfig<U, O>,
     twin: Twin<f32, T>,
     /// The oil-temperature observer (steps 1-2 of the tick).
     observer: OilObserver,
@@ -206,19 +206,19 @@ pub struct Estimator<T = f32, U = UncertaintyTable> {
     deferred: u32,
 }
 
-impl<U: Borrow<UncertaintyTable> + Copy> Estimator<f32, U> {
+impl<U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Copy> Estimator<f32, U, O> {
     /// An estimator with an `f32` twin at rest in the equilibrium of
     /// `initial` \[C\]: [`Estimator::with_scalar`] for `f32`.
     ///
     /// # Errors
     ///
     /// As [`Estimator::with_scalar`].
-    pub fn new(params: &Params<f32>, config: EstimatorConfig<U>, initial: f32) -> Result<Self, ModelError> {
+    pub fn new(params: &Params<f32>, config: EstimatorConfig<U, O>, initial: f32) -> Result<Self, ModelError> {
         Self::with_scalar(params, config, initial)
     }
 }
 
-impl<T: Real, U: Borrow<UncertaintyTable> + Copy> Estimator<T, U> {
+impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Copy> Estimator<T, U, O> {
     /// An estimator at rest in the equilibrium of `initial` \[C\], which must
     /// be a temperature the oil model accepts. Eq. (32) is checked once here
     /// over the validated range (201 samples; a range the oil model refuses
@@ -232,7 +232,7 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy> Estimator<T, U> {
     ///   temperature ([`crate::fluid::Oil::state`]);
     /// * a temperature-only job fails at `initial` (the equilibrium, its
     ///   sensitivity or the machine's losses not finite).
-    pub fn with_scalar(params: &Params<f32>, config: EstimatorConfig<U>, initial: f32) -> Result<Self, ModelError> {
+    pub fn with_scalar(params: &Params<f32>, config: EstimatorConfig<U, O>, initial: f32) -> Result<Self, ModelError> {
         let monotonic = asymptotic::monotonicity(params, config.valid.min, config.valid.max, 201)
             .map(|m| m.monotonic)
             .unwrap_or(false);
@@ -314,11 +314,13 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy> Estimator<T, U> {
     /// refreshes it in the job rotation, [`StateEstimate::uncertainty`]).
     pub fn uncertainty_now(&self) -> Uncertainty {
         let t = self.observer.oil();
-        self.config.table().at(t, self.observer.variance(&self.config.observer))
+        self.config
+            .table()
+            .at(t, self.observer.variance(self.config.observer_design()))
     }
 
     /// The settings.
-    pub fn config(&self) -> &EstimatorConfig<U> {
+    pub fn config(&self) -> &EstimatorConfig<U, O> {
         &self.config
     }
 
@@ -344,7 +346,7 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy> Estimator<T, U> {
         }
         self.tick = self.tick.wrapping_add(1);
         self.since_sample = self.since_sample.saturating_add(1);
-        let design = &self.config.observer;
+        let design = self.config.observer_design();
         self.observer.predict(design);
         match sample {
             Ok(Some(t)) if t.is_finite() && self.config.oil.contains(t) => {
