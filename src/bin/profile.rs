@@ -1,17 +1,16 @@
-//! The profile image. Its trace runner (once `cargo xtask profile`) is
-//! not in this tree; `cargo xtask build` does not build this image.
+//! The profile image, run by `cargo xtask profile` (`xtask/src/profile.rs`,
+//! docs/profile.md); `cargo xtask build` does not build this image.
 //!
-//! Runs two sections, each between two calls of [`mark`], which a trace
-//! runner finds in QEMU's instruction trace (`-singlestep -d
-//! exec`) to attribute every instruction executed inside a section to its
-//! function and source line:
+//! Runs two sections, each between two calls of [`profile_mark`], which the
+//! runner finds in QEMU's instruction trace (`-singlestep -d exec,nochain`)
+//! to charge every instruction executed inside a section to its function:
 //!
 //! 1. `twin`: the twin as built for the parameter file, in the core's
 //!    arithmetic (Q12.20 without an FPU, `f32` with one), 200 ticks of the
 //!    bench's 30 -> 40 C step after its graded first tick;
 //! 2. `estimator`: the estimator's tick (twin, filter, rotating job,
 //!    consistency check; telemetry packed every 100 ticks) over the
-//!    bench's step workload, 1,000 ticks.
+//!    bench's step workload, 200 ticks.
 #![no_std]
 #![no_main]
 

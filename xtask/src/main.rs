@@ -10,6 +10,8 @@
 //!                                                the twin as a co-simulation FMU (target/fmu/compensator.fmu)
 //! cargo xtask fmu-check                          the FMU checked by FMPy, libcosim and on each platform (part of `test`)
 //! cargo xtask bench [--params F] [--write]       cost (the twin as built for F), footprint and stack on the emulated MCUs
+//! cargo xtask profile [--params F] [--core C]... [--top N]
+//!                                                instructions per function of the twin's and the estimator's tick
 //! cargo xtask callgrind [--bless]                host instruction counts against the baseline
 //! cargo xtask msrv                               rust-version against the locked dependencies
 //! cargo xtask target-tests                       the core's tests on the emulated Cortex-M4F
@@ -44,6 +46,7 @@ mod msrv;
 mod panic_free;
 mod params;
 mod process;
+mod profile;
 mod qemu;
 mod replica;
 mod sweep_check;
@@ -181,6 +184,18 @@ enum Command {
         #[arg(long)]
         write: bool,
     },
+    /// Instructions per function of the twin's and the estimator's tick on the
+    /// emulated cores (every executed instruction, from QEMU's trace)
+    Profile {
+        #[command(flatten)]
+        params: ParamsArg,
+        /// Cores to profile (repeatable) [default: all three]
+        #[arg(long = "core", value_name = "C", value_parser = ["m4f", "m3", "m0"])]
+        cores: Vec<String>,
+        /// Functions listed per section
+        #[arg(long, value_name = "N", default_value_t = 15)]
+        top: usize,
+    },
     /// Host instruction counts (valgrind) against the baseline
     Callgrind {
         /// Rewrite the baseline instead of checking against it
@@ -257,6 +272,7 @@ fn main() -> ExitCode {
             })
             .map_err(Failure::from),
         Command::QemuRunner { elf, args: _ } => cmd_qemu_runner(&elf),
+        Command::Profile { params, cores, top } => cmd_profile(&params, &cores, top),
         Command::Callgrind { bless } => callgrind::check(&root(), bless).map(|_| 0).map_err(Failure::from),
         Command::Fuzz {
             seconds,
@@ -331,6 +347,25 @@ fn cmd_run(params: &ParamsArg, csv_path: Option<&Path>) -> Outcome {
 }
 
 /// `cargo xtask build [--params F]`.
+/// `cargo xtask profile [--params F] [--core C]... [--top N]`.
+fn cmd_profile(params: &ParamsArg, cores: &[String], top: usize) -> Outcome {
+    let params = params_file(params)?;
+    let targets: Vec<&'static str> = if cores.is_empty() {
+        firmware::TARGETS.to_vec()
+    } else {
+        cores
+            .iter()
+            .map(|c| match c.as_str() {
+                "m3" => firmware::M3,
+                "m0" => firmware::M0,
+                _ => firmware::M4,
+            })
+            .collect()
+    };
+    profile::cmd(&root(), params.as_deref(), &targets, top)?;
+    Ok(0)
+}
+
 fn cmd_build(params: &ParamsArg) -> Outcome {
     let params = params_file(params)?;
     firmware::build_all(&root(), params.as_deref())?;
@@ -673,6 +708,8 @@ fn cmd_test(bless: bool) -> Outcome {
     firmware::on_target_tests(&tc, &root)?;
     step("QEMU: cost, footprint and stack budgets");
     bench::check(&elfs, &twin_runs)?;
+    step("QEMU: the profile runner on the Cortex-M4F (instructions per function, docs/profile.md)");
+    profile::cmd(&root, None, &[firmware::M4], 5)?;
     eprintln!("\nxtask: all checks passed");
     Ok(0)
 }
@@ -725,6 +762,15 @@ mod tests {
                 write: true,
             })
         );
+        assert_eq!(
+            parse(&["profile", "--core", "m0", "--core", "m4f", "--top", "3"]),
+            Ok(Command::Profile {
+                params: params(None),
+                cores: vec!["m0".into(), "m4f".into()],
+                top: 3,
+            })
+        );
+        assert_eq!(parse(&["profile", "--core", "m7"]), Err(ErrorKind::InvalidValue));
         assert_eq!(
             parse(&["fmu"]),
             Ok(Command::Fmu {

@@ -110,7 +110,7 @@ pub fn budget_table(fw: &Firmware, budget: &Budget) -> String {
 #[cfg(feature = "host")]
 /// Core cycles per executed instruction, per core, for the tick-rate
 /// table: the executed instruction mix of the estimator's tick (measured on
-/// `src/bin/profile.rs` by a trace runner not in this tree: carried over) weighted by each core's cycle counts
+/// `src/bin/profile.rs` by an earlier trace runner: carried over; `cargo xtask profile` counts per function, not cycles) weighted by each core's cycle counts
 /// (Arm's Technical Reference Manuals: Cortex-M0 DDI 0432C table 3-1,
 /// Cortex-M3 DDI 0337I table 18-1, Cortex-M4 DDI 0439B table 3-1),
 /// rounded up, with zero-wait-state memory.
@@ -176,9 +176,10 @@ pub fn cores_section(fw: &Firmware) -> String {
         "\n### The highest tick rate each core sustains\n\nWith 50 % headroom: the worst estimator tick (telemetry included) in the core's arithmetic \
          (f32 with the FPU, Q12.20 without) may take half of the tick's period, at the core's cycles \
          per instruction (the estimator tick's executed instruction mix weighted by the core's cycle \
-         counts from Arm's Technical Reference Manuals, zero-wait-state memory; the mix was measured by a trace \
-         runner of `src/bin/profile.rs` that is not in this tree, so the factors are carried over, not \
-         re-measured by a command here): rate = clock / (2 x cycles per instruction x worst instructions).\n"
+         counts from Arm's Technical Reference Manuals, zero-wait-state memory; the mix was measured on \
+         `src/bin/profile.rs` by an earlier trace runner; `cargo xtask profile`, docs/profile.md, traces \
+         the same image and charges each instruction to its function but does not weigh instructions \
+         by their cycles, so the factors are carried over, not re-measured by a command here): rate = clock / (2 x cycles per instruction x worst instructions).\n"
     );
     let _ = write!(
         t,

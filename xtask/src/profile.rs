@@ -1,0 +1,349 @@
+//! `cargo xtask profile`: where the firmware's instructions go, function by
+//! function.
+//!
+//! The profile image (`src/bin/profile.rs`) runs two sections between calls
+//! of its `profile_mark`: 200 ticks of the twin as built, then 200 ticks of
+//! the estimator (telemetry every 100). QEMU runs it one instruction per
+//! translation block without chaining (`-singlestep -d exec,nochain`), so
+//! that its log has one `Trace` line per executed instruction with the
+//! guest's program counter; the runner streams that log (never to disk: the
+//! Cortex-M0's run is several million lines), finds the sections by the
+//! entry address of `profile_mark` and charges every instruction to the
+//! function whose symbol covers its address (inlined code counts to the
+//! function it was inlined into). The counts are exact instruction counts,
+//! the same measure as `cargo xtask bench` (`-icount shift=0`), not samples.
+
+use crate::firmware::{self, Image};
+use crate::qemu::Machine;
+use object::{Object, ObjectSymbol, SymbolKind};
+use std::collections::HashMap;
+use std::io::{BufRead, BufReader, Read};
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::Duration;
+
+/// Ticks in each section of the profile image (`src/bin/profile.rs`).
+pub const TICKS: u64 = 200;
+
+/// The sections, in the order the image runs them.
+pub const SECTIONS: [&str; 2] = ["twin tick", "estimator tick"];
+
+/// The function symbols of an ELF: `(start, end, name)`, sorted by start,
+/// the Thumb bit cleared, names demangled without their hash.
+#[derive(Debug, Default)]
+pub struct Symbols {
+    ranges: Vec<(u64, u64, String)>,
+}
+
+impl Symbols {
+    /// The text symbols of `elf` (the ELF's bytes).
+    ///
+    /// # Errors
+    ///
+    /// The bytes are not an ELF `object` reads.
+    pub fn of_elf(elf: &[u8]) -> Result<Self, String> {
+        let file = object::File::parse(elf).map_err(|e| format!("not an ELF: {e}"))?;
+        let symbols = file
+            .symbols()
+            .filter(|s| s.kind() == SymbolKind::Text && s.size() > 0)
+            .filter_map(|s| {
+                let name = s.name().ok()?;
+                Some((s.address() & !1, s.size(), name.to_string()))
+            });
+        Ok(Self::new(symbols))
+    }
+
+    /// From `(address, size, mangled name)` triples.
+    pub fn new(symbols: impl IntoIterator<Item = (u64, u64, String)>) -> Self {
+        let mut ranges: Vec<(u64, u64, String)> = symbols
+            .into_iter()
+            .map(|(a, size, name)| {
+                (
+                    a & !1,
+                    (a & !1) + size,
+                    format!("{:#}", rustc_demangle::demangle(&name)),
+                )
+            })
+            .collect();
+        ranges.sort_by_key(|r| r.0);
+        Symbols { ranges }
+    }
+
+    /// The function holding `pc`, if a symbol covers it.
+    pub fn at(&self, pc: u64) -> Option<&str> {
+        let i = self.ranges.partition_point(|r| r.0 <= pc);
+        let r = self.ranges.get(i.checked_sub(1)?)?;
+        (pc < r.1).then_some(r.2.as_str())
+    }
+
+    /// The start address of the function named `name` (demangled).
+    pub fn address(&self, name: &str) -> Option<u64> {
+        self.ranges.iter().find(|r| r.2 == name).map(|r| r.0)
+    }
+}
+
+/// Instructions per function in one section.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Section {
+    /// Instructions executed in the section.
+    pub total: u64,
+    /// Per function (`?` for an address no symbol covers).
+    pub functions: HashMap<String, u64>,
+}
+
+/// The guest program counter of a QEMU `-d exec` line (`Trace 0: 0x... [flags/PC/...] name`).
+pub fn pc_of(line: &str) -> Option<u64> {
+    let rest = line.strip_prefix("Trace ")?;
+    let inside = rest.split_once('[')?.1;
+    let pc = inside.split('/').nth(1)?;
+    u64::from_str_radix(pc.trim_end_matches(']'), 16).ok()
+}
+
+/// Charges the trace's instructions to the sections between the entries
+/// of the function at `mark` (an entry opens a section, the next closes
+/// it; the marker's own instructions are not counted).
+///
+/// # Errors
+///
+/// Fewer marks than two per section, or an odd number (the image did not
+/// run to its end).
+pub fn attribute(trace: impl BufRead, symbols: &Symbols, mark: u64, sections: usize) -> Result<Vec<Section>, String> {
+    let mut out = vec![Section::default(); sections];
+    let mut marks = 0usize;
+    let mut names: HashMap<u64, &str> = HashMap::new();
+    for line in trace.lines() {
+        let line = line.map_err(|e| format!("trace: {e}"))?;
+        let Some(pc) = pc_of(&line) else { continue };
+        if pc == mark {
+            marks += 1;
+            continue;
+        }
+        if marks.is_multiple_of(2) {
+            continue;
+        }
+        let Some(section) = out.get_mut(marks / 2) else {
+            continue;
+        };
+        let name = *names.entry(pc).or_insert_with(|| symbols.at(pc).unwrap_or("?"));
+        if name == "profile_mark" {
+            continue;
+        }
+        section.total += 1;
+        *section.functions.entry(name.to_string()).or_insert(0) += 1;
+    }
+    if marks != 2 * sections {
+        return Err(format!(
+            "the trace has {marks} section marks, expected {}",
+            2 * sections
+        ));
+    }
+    Ok(out)
+}
+
+/// Runs the profile image `elf` on `machine` and charges its instructions.
+///
+/// # Errors
+///
+/// QEMU cannot start, the image fails (non-zero exit: its defmt log says
+/// why under `cargo xtask qemu-runner`), or its marks are missing.
+pub fn run(elf: &Path, machine: Machine, timeout: Duration) -> Result<Vec<Section>, String> {
+    let bytes = std::fs::read(elf).map_err(|e| format!("{}: {e}", elf.display()))?;
+    let symbols = Symbols::of_elf(&bytes)?;
+    let mark = symbols
+        .address("profile_mark")
+        .ok_or_else(|| format!("{}: no profile_mark symbol", elf.display()))?;
+    let mut child = Command::new("qemu-system-arm")
+        .args(["-machine", machine.name, "-cpu", machine.cpu])
+        .args(["-nographic", "-monitor", "none", "-serial", "none"])
+        .args(["-semihosting-config", "enable=on,target=native"])
+        .args(["-singlestep", "-d", "exec,nochain", "-D", "/dev/stderr"])
+        .arg("-kernel")
+        .arg(elf)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("qemu-system-arm: {e}"))?;
+    let pid = child.id();
+    let mut stdout = child.stdout.take().expect("piped");
+    // The defmt frames are not decoded here: drained so that QEMU never blocks.
+    let drain = std::thread::spawn(move || {
+        let mut sink = Vec::new();
+        let _ = stdout.read_to_end(&mut sink);
+    });
+    let watchdog = std::thread::spawn(move || {
+        std::thread::sleep(timeout);
+        let _ = Command::new("kill").arg(pid.to_string()).status();
+    });
+    let stderr = BufReader::with_capacity(1 << 20, child.stderr.take().expect("piped"));
+    let sections = attribute(stderr, &symbols, mark, SECTIONS.len());
+    let status = child.wait().map_err(|e| format!("qemu-system-arm: {e}"))?;
+    let _ = drain.join();
+    drop(watchdog);
+    if !status.success() {
+        return Err(format!(
+            "{}: the profile image exited with {status} (run it with `cargo xtask qemu-runner {}` to see its log)",
+            elf.display(),
+            elf.display()
+        ));
+    }
+    sections
+}
+
+/// The report: per core and section, instructions per tick and the `top`
+/// functions.
+pub fn report(results: &[(&str, Vec<Section>)], top: usize) -> String {
+    let mut s = String::new();
+    for (core, sections) in results {
+        for (name, section) in SECTIONS.iter().zip(sections) {
+            s += &format!(
+                "\n### {core}: {name} ({} instructions per tick, mean over {TICKS})\n\n| function | per tick | share |\n| --- | ---: | ---: |\n",
+                per_tick(section.total)
+            );
+            let mut rows: Vec<(&String, &u64)> = section.functions.iter().collect();
+            rows.sort_by(|a, b| b.1.cmp(a.1).then(a.0.cmp(b.0)));
+            let shown: u64 = rows.iter().take(top).map(|r| *r.1).sum();
+            for (f, n) in rows.iter().take(top) {
+                s += &format!("| `{f}` | {} | {:.1} % |\n", per_tick(**n), share(**n, section.total));
+            }
+            if rows.len() > top {
+                let rest = section.total - shown;
+                s += &format!(
+                    "| {} other functions | {} | {:.1} % |\n",
+                    rows.len() - top,
+                    per_tick(rest),
+                    share(rest, section.total)
+                );
+            }
+        }
+    }
+    s
+}
+
+fn per_tick(n: u64) -> String {
+    format!("{:.1}", n as f64 / TICKS as f64)
+}
+
+fn share(n: u64, total: u64) -> f64 {
+    if total == 0 {
+        0.0
+    } else {
+        100.0 * n as f64 / total as f64
+    }
+}
+
+/// The profile image for `target`.
+pub fn image(target: &'static str) -> Image {
+    Image {
+        bin: "profile",
+        target,
+        features: "qemu",
+    }
+}
+
+/// `cargo xtask profile`: builds the profile image for each of `targets`,
+/// runs it and prints the report.
+///
+/// # Errors
+///
+/// No toolchain, a build fails, or a run fails ([`run`]).
+pub fn cmd(root: &Path, params: Option<&Path>, targets: &[&'static str], top: usize) -> Result<(), String> {
+    crate::qemu::ensure()?;
+    let tc = crate::toolchain::get(root, targets)?;
+    let mut results = Vec::new();
+    for &target in targets {
+        let image = image(target);
+        let elf = firmware::build(&tc, root, &image, params)?;
+        let core = core_name(target);
+        eprintln!("xtask: profiling {core} ({target}, QEMU {})", image.machine().name);
+        results.push((core, run(&elf, image.machine(), Duration::from_secs(1800))?));
+    }
+    println!("{}", report(&results, top));
+    Ok(())
+}
+
+/// The core a target is profiled on.
+pub fn core_name(target: &str) -> &'static str {
+    match target {
+        firmware::M3 => "Cortex-M3",
+        firmware::M0 => "Cortex-M0",
+        _ => "Cortex-M4F",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn symbols() -> Symbols {
+        Symbols::new([
+            (0x0800_0101, 0x20, "profile_mark".to_string()),
+            (
+                0x0800_0201,
+                0x40,
+                "_ZN11compensator5mathf5exp1017hee4bb093ed8cfc4aE".to_string(),
+            ),
+            (0x0800_0300, 0x10, "tick".to_string()),
+        ])
+    }
+
+    fn line(pc: u64) -> String {
+        format!("Trace 0: 0x7eff7c197200 [00800400/{pc:08x}/00000010/ff000201] whatever\n")
+    }
+
+    #[test]
+    fn the_program_counter_is_the_second_field_in_brackets() {
+        assert_eq!(
+            pc_of("Trace 0: 0x7eff7c197200 [00800400/080078f0/00000010/ff000201] profile_mark"),
+            Some(0x0800_78f0)
+        );
+        assert_eq!(pc_of("IN: profile_mark"), None);
+        assert_eq!(pc_of("Trace 0: 0x7eff [00800400/zz/0] f"), None);
+    }
+
+    #[test]
+    fn symbols_are_demangled_and_cover_their_size_only() {
+        let s = symbols();
+        assert_eq!(s.at(0x0800_0200), Some("compensator::mathf::exp10"));
+        assert_eq!(s.at(0x0800_023f), Some("compensator::mathf::exp10"));
+        assert_eq!(s.at(0x0800_0240), None);
+        assert_eq!(s.at(0x0800_00ff), None);
+        assert_eq!(s.address("profile_mark"), Some(0x0800_0100));
+    }
+
+    #[test]
+    fn instructions_between_marks_go_to_their_section_and_function() {
+        let s = symbols();
+        let mut trace = String::new();
+        trace += &line(0x0800_0300); // before the first section: not counted
+        trace += &line(0x0800_0100); // mark: opens the twin section
+        trace += &line(0x0800_0102); // the marker's own body: not counted
+        for _ in 0..3 {
+            trace += &line(0x0800_0300);
+        }
+        trace += &line(0x0800_0100); // closes it
+        trace += &line(0x0800_0204); // between sections: not counted
+        trace += &line(0x0800_0100); // opens the estimator section
+        trace += &line(0x0800_0204);
+        trace += &line(0x0800_0206);
+        trace += &line(0x0900_0000); // no symbol
+        trace += &line(0x0800_0100);
+        let out = attribute(trace.as_bytes(), &s, 0x0800_0100, 2).unwrap();
+        assert_eq!(out[0].total, 3);
+        assert_eq!(out[0].functions["tick"], 3);
+        assert_eq!(out[1].total, 3);
+        assert_eq!(out[1].functions["compensator::mathf::exp10"], 2);
+        assert_eq!(out[1].functions["?"], 1);
+        let r = report(&[("Cortex-M4F", out)], 1);
+        assert!(r.contains("| `compensator::mathf::exp10` | 0.0 | 66.7 % |"), "{r}");
+        assert!(r.contains("| 1 other functions | 0.0 | 33.3 % |"), "{r}");
+    }
+
+    #[test]
+    fn a_run_that_stops_early_is_an_error() {
+        let s = symbols();
+        let trace = format!("{}{}", line(0x0800_0100), line(0x0800_0300));
+        let e = attribute(trace.as_bytes(), &s, 0x0800_0100, 2).unwrap_err();
+        assert!(e.contains("1 section marks, expected 4"), "{e}");
+    }
+}
