@@ -71,9 +71,14 @@ impl Symbols {
 
     /// The function holding `pc`, if a symbol covers it.
     pub fn at(&self, pc: u64) -> Option<&str> {
+        self.covering(pc).map(|(_, name)| name)
+    }
+
+    /// The start and name of the function holding `pc`.
+    pub fn covering(&self, pc: u64) -> Option<(u64, &str)> {
         let i = self.ranges.partition_point(|r| r.0 <= pc);
         let r = self.ranges.get(i.checked_sub(1)?)?;
-        (pc < r.1).then_some(r.2.as_str())
+        (pc < r.1).then_some((r.0, r.2.as_str()))
     }
 
     /// The start address of the function named `name` (demangled).
@@ -89,6 +94,10 @@ pub struct Section {
     pub total: u64,
     /// Per function (`?` for an address no symbol covers).
     pub functions: HashMap<String, u64>,
+    /// Per function and call site: the instructions of each call of the
+    /// function charged to the address of the instruction that entered it
+    /// (its `bl`; 0 where the section began inside the function).
+    pub sites: HashMap<String, HashMap<u64, u64>>,
 }
 
 /// The guest program counter of a QEMU `-d exec` line (`Trace 0: 0x... [flags/PC/...] name`).
@@ -110,26 +119,43 @@ pub fn pc_of(line: &str) -> Option<u64> {
 pub fn attribute(trace: impl BufRead, symbols: &Symbols, mark: u64, sections: usize) -> Result<Vec<Section>, String> {
     let mut out = vec![Section::default(); sections];
     let mut marks = 0usize;
-    let mut names: HashMap<u64, &str> = HashMap::new();
+    let mut names: HashMap<u64, (u64, &str)> = HashMap::new();
+    // The call site each function was last entered from.
+    let mut entered: HashMap<&str, u64> = HashMap::new();
+    let mut previous: Option<(u64, &str)> = None;
     for line in trace.lines() {
         let line = line.map_err(|e| format!("trace: {e}"))?;
         let Some(pc) = pc_of(&line) else { continue };
         if pc == mark {
             marks += 1;
+            previous = None;
             continue;
         }
-        if marks.is_multiple_of(2) {
+        let (start, name) = *names
+            .entry(pc)
+            .or_insert_with(|| symbols.covering(pc).unwrap_or((u64::MAX, "?")));
+        if pc == start
+            && let Some((site, from)) = previous
+            && from != name
+        {
+            entered.insert(name, site);
+        }
+        previous = Some((pc, name));
+        if marks.is_multiple_of(2) || name == "profile_mark" {
             continue;
         }
         let Some(section) = out.get_mut(marks / 2) else {
             continue;
         };
-        let name = *names.entry(pc).or_insert_with(|| symbols.at(pc).unwrap_or("?"));
-        if name == "profile_mark" {
-            continue;
-        }
         section.total += 1;
         *section.functions.entry(name.to_string()).or_insert(0) += 1;
+        let site = entered.get(name).copied().unwrap_or(0);
+        *section
+            .sites
+            .entry(name.to_string())
+            .or_default()
+            .entry(site)
+            .or_insert(0) += 1;
     }
     if marks != 2 * sections {
         return Err(format!(
@@ -138,6 +164,43 @@ pub fn attribute(trace: impl BufRead, symbols: &Symbols, mark: u64, sections: us
         ));
     }
     Ok(out)
+}
+
+/// Source lines of addresses, from the ELF's DWARF: the innermost inlined
+/// frame in the workspace's own code (`src/...`, `model/src/...`), else the
+/// innermost frame; `None` without debug information.
+pub struct Lines {
+    loader: Option<addr2line::Loader>,
+    root: String,
+}
+
+impl Lines {
+    /// The lines of `elf`, paths shown relative to `root`.
+    pub fn new(elf: &Path, root: &Path) -> Self {
+        Lines {
+            loader: addr2line::Loader::new(elf).ok(),
+            root: format!("{}/", root.display()),
+        }
+    }
+
+    /// `file:line` of `address`.
+    pub fn at(&self, address: u64) -> Option<String> {
+        let loader = self.loader.as_ref()?;
+        let mut frames = loader.find_frames(address).ok()?;
+        let mut first = None;
+        while let Ok(Some(frame)) = frames.next() {
+            let Some(loc) = frame.location else { continue };
+            let (Some(file), Some(line)) = (loc.file, loc.line) else {
+                continue;
+            };
+            let shown = format!("{}:{line}", file.strip_prefix(self.root.as_str()).unwrap_or(file));
+            if file.starts_with(self.root.as_str()) {
+                return Some(shown);
+            }
+            first.get_or_insert(shown);
+        }
+        first
+    }
 }
 
 /// Runs the profile image `elf` on `machine` and charges its instructions.
@@ -191,25 +254,46 @@ pub fn run(elf: &Path, machine: Machine, timeout: Duration) -> Result<Vec<Sectio
 }
 
 /// The report: per core and section, instructions per tick and the `top`
-/// functions.
-pub fn report(results: &[(&str, Vec<Section>)], top: usize) -> String {
+/// functions, each with its two costliest call sites (`lines` of the
+/// core's image).
+pub fn report(results: &[(&str, Vec<Section>, Lines)], top: usize) -> String {
     let mut s = String::new();
-    for (core, sections) in results {
+    for (core, sections, lines) in results {
         for (name, section) in SECTIONS.iter().zip(sections) {
             s += &format!(
-                "\n### {core}: {name} ({} instructions per tick, mean over {TICKS})\n\n| function | per tick | share |\n| --- | ---: | ---: |\n",
+                "\n### {core}: {name} ({} instructions per tick, mean over {TICKS})\n\n| function | per tick | share | called from (per tick) |\n| --- | ---: | ---: | --- |\n",
                 per_tick(section.total)
             );
             let mut rows: Vec<(&String, &u64)> = section.functions.iter().collect();
             rows.sort_by(|a, b| b.1.cmp(a.1).then(a.0.cmp(b.0)));
             let shown: u64 = rows.iter().take(top).map(|r| *r.1).sum();
             for (f, n) in rows.iter().take(top) {
-                s += &format!("| `{f}` | {} | {:.1} % |\n", per_tick(**n), share(**n, section.total));
+                let mut sites: Vec<(u64, u64)> = section
+                    .sites
+                    .get(*f)
+                    .map(|m| m.iter().map(|(a, n)| (*a, *n)).collect())
+                    .unwrap_or_default();
+                sites.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+                let called: Vec<String> = sites
+                    .iter()
+                    .filter(|(a, _)| *a != 0)
+                    .take(2)
+                    .map(|(a, n)| {
+                        let at = lines.at(*a).unwrap_or_else(|| format!("{a:#010x}"));
+                        format!("`{at}` {}", per_tick(*n))
+                    })
+                    .collect();
+                s += &format!(
+                    "| `{f}` | {} | {:.1} % | {} |\n",
+                    per_tick(**n),
+                    share(**n, section.total),
+                    called.join(", ")
+                );
             }
             if rows.len() > top {
                 let rest = section.total - shown;
                 s += &format!(
-                    "| {} other functions | {} | {:.1} % |\n",
+                    "| {} other functions | {} | {:.1} % | |\n",
                     rows.len() - top,
                     per_tick(rest),
                     share(rest, section.total)
@@ -256,7 +340,8 @@ pub fn cmd(root: &Path, params: Option<&Path>, targets: &[&'static str], top: us
         let elf = firmware::build(&tc, root, &image, params)?;
         let core = core_name(target);
         eprintln!("xtask: profiling {core} ({target}, QEMU {})", image.machine().name);
-        results.push((core, run(&elf, image.machine(), Duration::from_secs(1800))?));
+        let sections = run(&elf, image.machine(), Duration::from_secs(1800))?;
+        results.push((core, sections, Lines::new(&elf, root)));
     }
     println!("{}", report(&results, top));
     Ok(())
@@ -324,19 +409,34 @@ mod tests {
         trace += &line(0x0800_0100); // closes it
         trace += &line(0x0800_0204); // between sections: not counted
         trace += &line(0x0800_0100); // opens the estimator section
-        trace += &line(0x0800_0204);
+        trace += &line(0x0800_0302); // tick's call
+        trace += &line(0x0800_0200); // exp10's entry, from 0x0800_0302
         trace += &line(0x0800_0206);
         trace += &line(0x0900_0000); // no symbol
         trace += &line(0x0800_0100);
         let out = attribute(trace.as_bytes(), &s, 0x0800_0100, 2).unwrap();
         assert_eq!(out[0].total, 3);
         assert_eq!(out[0].functions["tick"], 3);
-        assert_eq!(out[1].total, 3);
+        assert_eq!(out[1].total, 4);
         assert_eq!(out[1].functions["compensator::mathf::exp10"], 2);
         assert_eq!(out[1].functions["?"], 1);
-        let r = report(&[("Cortex-M4F", out)], 1);
-        assert!(r.contains("| `compensator::mathf::exp10` | 0.0 | 66.7 % |"), "{r}");
-        assert!(r.contains("| 1 other functions | 0.0 | 33.3 % |"), "{r}");
+        assert_eq!(
+            out[1].sites["compensator::mathf::exp10"],
+            HashMap::from([(0x0800_0302, 2)])
+        );
+        // tick was last entered at its start in the first section, from the
+        // marker's body.
+        assert_eq!(out[1].sites["tick"], HashMap::from([(0x0800_0102, 1)]));
+        let none = Lines {
+            loader: None,
+            root: String::new(),
+        };
+        let r = report(&[("Cortex-M4F", out, none)], 1);
+        assert!(
+            r.contains("| `compensator::mathf::exp10` | 0.0 | 50.0 % | `0x08000302` 0.0 |"),
+            "{r}"
+        );
+        assert!(r.contains("| 2 other functions | 0.0 | 50.0 % | |"), "{r}");
     }
 
     #[test]
