@@ -69,12 +69,7 @@ impl Symbols {
         Symbols { ranges }
     }
 
-    /// The function holding `pc`, if a symbol covers it.
-    pub fn at(&self, pc: u64) -> Option<&str> {
-        self.covering(pc).map(|(_, name)| name)
-    }
-
-    /// The start and name of the function holding `pc`.
+    /// The start and name of the function holding `pc`, if a symbol covers it.
     pub fn covering(&self, pc: u64) -> Option<(u64, &str)> {
         let i = self.ranges.partition_point(|r| r.0 <= pc);
         let r = self.ranges.get(i.checked_sub(1)?)?;
@@ -389,10 +384,16 @@ mod tests {
     #[test]
     fn symbols_are_demangled_and_cover_their_size_only() {
         let s = symbols();
-        assert_eq!(s.at(0x0800_0200), Some("compensator::mathf::exp10"));
-        assert_eq!(s.at(0x0800_023f), Some("compensator::mathf::exp10"));
-        assert_eq!(s.at(0x0800_0240), None);
-        assert_eq!(s.at(0x0800_00ff), None);
+        assert_eq!(
+            s.covering(0x0800_0200),
+            Some((0x0800_0200, "compensator::mathf::exp10"))
+        );
+        assert_eq!(
+            s.covering(0x0800_023f),
+            Some((0x0800_0200, "compensator::mathf::exp10"))
+        );
+        assert_eq!(s.covering(0x0800_0240), None);
+        assert_eq!(s.covering(0x0800_00ff), None);
         assert_eq!(s.address("profile_mark"), Some(0x0800_0100));
     }
 
