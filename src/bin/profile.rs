@@ -38,6 +38,14 @@ pub extern "C" fn profile_mark(section: u32) {
     core::hint::black_box(section);
 }
 
+/// The start of a tick inside a section (the runner's per-tick counts and
+/// worst tick).
+#[inline(never)]
+#[unsafe(no_mangle)]
+pub extern "C" fn profile_tick() {
+    core::hint::black_box(());
+}
+
 fn run() -> Result<(), &'static str> {
     let params = Params::<f32>::new(&RAW_PARAMS).map_err(|_| "parameters")?;
     let scheme = Scheme::from_name(TWIN_SCHEME).ok_or("scheme")?;
@@ -51,6 +59,7 @@ fn run() -> Result<(), &'static str> {
     twin.tick().map_err(|_| "graded tick")?;
     profile_mark(1);
     for _ in 0..200 {
+        profile_tick();
         twin.tick().map_err(|_| "tick")?;
     }
     profile_mark(1);
@@ -62,6 +71,7 @@ fn run() -> Result<(), &'static str> {
     let mut est = Estimator::<Scalar, _, _>::with_scalar(&params, config, 30.0).map_err(|_| "estimator")?;
     profile_mark(2);
     for k in 0..200u32 {
+        profile_tick();
         let sample = if k % 20 == 0 { Ok(Some(40.0)) } else { Ok(None) };
         let e = est.tick(core::hint::black_box(sample));
         if est.telemetry_due() {

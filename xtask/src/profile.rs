@@ -93,6 +93,17 @@ pub struct Section {
     /// function charged to the address of the instruction that entered it
     /// (its `bl`; 0 where the section began inside the function).
     pub sites: HashMap<String, HashMap<u64, u64>>,
+    /// The costliest tick (between two entries of the tick marker, the
+    /// section's last tick ending at its closing mark): its index from 0,
+    /// and its instructions per function.
+    pub worst: Option<(usize, HashMap<String, u64>)>,
+}
+
+impl Section {
+    /// Instructions of the worst tick.
+    pub fn worst_total(&self) -> u64 {
+        self.worst.as_ref().map_or(0, |(_, f)| f.values().sum())
+    }
 }
 
 /// The guest program counter of a QEMU `-d exec` line (`Trace 0: 0x... [flags/PC/...] name`).
@@ -105,26 +116,51 @@ pub fn pc_of(line: &str) -> Option<u64> {
 
 /// Charges the trace's instructions to the sections between the entries
 /// of the function at `mark` (an entry opens a section, the next closes
-/// it; the marker's own instructions are not counted).
+/// it), and to ticks between the entries of the function at `tick` (when
+/// the image has one); the markers' own instructions are not counted.
 ///
 /// # Errors
 ///
 /// Fewer marks than two per section, or an odd number (the image did not
 /// run to its end).
-pub fn attribute(trace: impl BufRead, symbols: &Symbols, mark: u64, sections: usize) -> Result<Vec<Section>, String> {
+pub fn attribute(
+    trace: impl BufRead,
+    symbols: &Symbols,
+    mark: u64,
+    tick: Option<u64>,
+    sections: usize,
+) -> Result<Vec<Section>, String> {
     let mut out = vec![Section::default(); sections];
     let mut marks = 0usize;
     let mut names: HashMap<u64, (u64, &str)> = HashMap::new();
     // The call site each function was last entered from.
     let mut entered: HashMap<&str, u64> = HashMap::new();
     let mut previous: Option<(u64, &str)> = None;
+    // The current tick of the open section: its index and its counts.
+    let mut current: Option<(usize, HashMap<String, u64>)> = None;
+    let close = |current: &mut Option<(usize, HashMap<String, u64>)>, section: Option<&mut Section>| {
+        if let (Some(done), Some(section)) = (current.take(), section) {
+            let total: u64 = done.1.values().sum();
+            if total > section.worst_total() {
+                section.worst = Some(done);
+            }
+        }
+    };
     for line in trace.lines() {
         let line = line.map_err(|e| format!("trace: {e}"))?;
         let Some(pc) = pc_of(&line) else { continue };
         if pc == mark {
+            if !marks.is_multiple_of(2) {
+                close(&mut current, out.get_mut(marks / 2));
+            }
             marks += 1;
             previous = None;
             continue;
+        }
+        if Some(pc) == tick && !marks.is_multiple_of(2) {
+            let next = current.as_ref().map_or(0, |c| c.0 + 1);
+            close(&mut current, out.get_mut(marks / 2));
+            current = Some((next, HashMap::new()));
         }
         let (start, name) = *names
             .entry(pc)
@@ -136,7 +172,7 @@ pub fn attribute(trace: impl BufRead, symbols: &Symbols, mark: u64, sections: us
             entered.insert(name, site);
         }
         previous = Some((pc, name));
-        if marks.is_multiple_of(2) || name == "profile_mark" {
+        if marks.is_multiple_of(2) || name == "profile_mark" || name == "profile_tick" {
             continue;
         }
         let Some(section) = out.get_mut(marks / 2) else {
@@ -151,6 +187,9 @@ pub fn attribute(trace: impl BufRead, symbols: &Symbols, mark: u64, sections: us
             .or_default()
             .entry(site)
             .or_insert(0) += 1;
+        if let Some((_, counts)) = current.as_mut() {
+            *counts.entry(name.to_string()).or_insert(0) += 1;
+        }
     }
     if marks != 2 * sections {
         return Err(format!(
@@ -188,8 +227,16 @@ impl Lines {
             let (Some(file), Some(line)) = (loc.file, loc.line) else {
                 continue;
             };
-            let shown = format!("{}:{line}", file.strip_prefix(self.root.as_str()).unwrap_or(file));
-            if file.starts_with(self.root.as_str()) {
+            let own = file.starts_with(self.root.as_str());
+            // The standard library's sources as `library/...` (without the
+            // compiler's `/rustc/<commit>/` prefix).
+            let file = file.strip_prefix(self.root.as_str()).unwrap_or(file);
+            let file = match file.strip_prefix("/rustc/").and_then(|f| f.split_once('/')) {
+                Some((_, rest)) => rest,
+                None => file,
+            };
+            let shown = format!("{file}:{line}");
+            if own {
                 return Some(shown);
             }
             first.get_or_insert(shown);
@@ -210,6 +257,7 @@ pub fn run(elf: &Path, machine: Machine, timeout: Duration) -> Result<Vec<Sectio
     let mark = symbols
         .address("profile_mark")
         .ok_or_else(|| format!("{}: no profile_mark symbol", elf.display()))?;
+    let tick = symbols.address("profile_tick");
     let mut child = Command::new("qemu-system-arm")
         .args(["-machine", machine.name, "-cpu", machine.cpu])
         .args(["-nographic", "-monitor", "none", "-serial", "none"])
@@ -234,7 +282,7 @@ pub fn run(elf: &Path, machine: Machine, timeout: Duration) -> Result<Vec<Sectio
         let _ = Command::new("kill").arg(pid.to_string()).status();
     });
     let stderr = BufReader::with_capacity(1 << 20, child.stderr.take().expect("piped"));
-    let sections = attribute(stderr, &symbols, mark, SECTIONS.len());
+    let sections = attribute(stderr, &symbols, mark, tick, SECTIONS.len());
     let status = child.wait().map_err(|e| format!("qemu-system-arm: {e}"))?;
     let _ = drain.join();
     drop(watchdog);
@@ -263,20 +311,20 @@ pub fn report(results: &[(&str, Vec<Section>, Lines)], top: usize) -> String {
             rows.sort_by(|a, b| b.1.cmp(a.1).then(a.0.cmp(b.0)));
             let shown: u64 = rows.iter().take(top).map(|r| *r.1).sum();
             for (f, n) in rows.iter().take(top) {
-                let mut sites: Vec<(u64, u64)> = section
-                    .sites
-                    .get(*f)
-                    .map(|m| m.iter().map(|(a, n)| (*a, *n)).collect())
-                    .unwrap_or_default();
+                // Call sites by source line (one line may hold several calls).
+                let mut by_line: HashMap<String, u64> = HashMap::new();
+                for (a, n) in section.sites.get(*f).into_iter().flatten() {
+                    if *a != 0 {
+                        let at = lines.at(*a).unwrap_or_else(|| format!("{a:#010x}"));
+                        *by_line.entry(at).or_insert(0) += n;
+                    }
+                }
+                let mut sites: Vec<(String, u64)> = by_line.into_iter().collect();
                 sites.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
                 let called: Vec<String> = sites
                     .iter()
-                    .filter(|(a, _)| *a != 0)
                     .take(2)
-                    .map(|(a, n)| {
-                        let at = lines.at(*a).unwrap_or_else(|| format!("{a:#010x}"));
-                        format!("`{at}` {}", per_tick(*n))
-                    })
+                    .map(|(at, n)| format!("`{at}` {}", per_tick(*n)))
                     .collect();
                 s += &format!(
                     "| `{f}` | {} | {:.1} % | {} |\n",
@@ -292,6 +340,16 @@ pub fn report(results: &[(&str, Vec<Section>, Lines)], top: usize) -> String {
                     rows.len() - top,
                     per_tick(rest),
                     share(rest, section.total)
+                );
+            }
+            if let Some((k, counts)) = &section.worst {
+                let mut rows: Vec<(&String, &u64)> = counts.iter().collect();
+                rows.sort_by(|a, b| b.1.cmp(a.1).then(a.0.cmp(b.0)));
+                let parts: Vec<String> = rows.iter().take(top).map(|(f, n)| format!("`{f}` {n}")).collect();
+                s += &format!(
+                    "\nWorst tick: tick {k}, {} instructions: {}.\n",
+                    section.worst_total(),
+                    parts.join(", ")
                 );
             }
         }
@@ -415,7 +473,7 @@ mod tests {
         trace += &line(0x0800_0206);
         trace += &line(0x0900_0000); // no symbol
         trace += &line(0x0800_0100);
-        let out = attribute(trace.as_bytes(), &s, 0x0800_0100, 2).unwrap();
+        let out = attribute(trace.as_bytes(), &s, 0x0800_0100, None, 2).unwrap();
         assert_eq!(out[0].total, 3);
         assert_eq!(out[0].functions["tick"], 3);
         assert_eq!(out[1].total, 4);
@@ -441,10 +499,36 @@ mod tests {
     }
 
     #[test]
+    fn the_worst_tick_is_the_costliest_between_tick_marks() {
+        let s = Symbols::new([
+            (0x0800_0100, 0x20, "profile_mark".to_string()),
+            (0x0800_0400, 0x10, "profile_tick".to_string()),
+            (0x0800_0300, 0x10, "tick".to_string()),
+        ]);
+        let mut trace = String::new();
+        for section in [[2, 3, 1], [4, 1, 1]] {
+            trace += &line(0x0800_0100);
+            for n in section {
+                trace += &line(0x0800_0400);
+                trace += &line(0x0800_0402); // the marker's body: not counted
+                for _ in 0..n {
+                    trace += &line(0x0800_0304);
+                }
+            }
+            trace += &line(0x0800_0100);
+        }
+        let out = attribute(trace.as_bytes(), &s, 0x0800_0100, Some(0x0800_0400), 2).unwrap();
+        assert_eq!(out[0].total, 6);
+        assert_eq!(out[0].worst, Some((1, HashMap::from([("tick".to_string(), 3)]))));
+        assert_eq!(out[1].worst_total(), 4);
+        assert_eq!(out[1].worst.as_ref().map(|w| w.0), Some(0));
+    }
+
+    #[test]
     fn a_run_that_stops_early_is_an_error() {
         let s = symbols();
         let trace = format!("{}{}", line(0x0800_0100), line(0x0800_0300));
-        let e = attribute(trace.as_bytes(), &s, 0x0800_0100, 2).unwrap_err();
+        let e = attribute(trace.as_bytes(), &s, 0x0800_0100, None, 2).unwrap_err();
         assert!(e.contains("1 section marks, expected 4"), "{e}");
     }
 }
