@@ -277,15 +277,31 @@ pub fn run(elf: &Path, machine: Machine, timeout: Duration) -> Result<Vec<Sectio
         let mut sink = Vec::new();
         let _ = stdout.read_to_end(&mut sink);
     });
+    // Kills QEMU if it has not finished within `timeout` (and only then:
+    // the pid is not reused while the child is not yet waited for).
+    let (finished, wait_for_it) = std::sync::mpsc::channel::<()>();
     let watchdog = std::thread::spawn(move || {
-        std::thread::sleep(timeout);
-        let _ = Command::new("kill").arg(pid.to_string()).status();
+        let late = wait_for_it.recv_timeout(timeout).is_err();
+        if late {
+            let _ = Command::new("kill").arg(pid.to_string()).status();
+        }
+        late
     });
     let stderr = BufReader::with_capacity(1 << 20, child.stderr.take().expect("piped"));
     let sections = attribute(stderr, &symbols, mark, tick, SECTIONS.len());
+    // The trace ended (QEMU closed its log) or could not be read: the
+    // watchdog is told before `wait`, so that it never kills a reused pid,
+    // and QEMU is stopped if its log was abandoned.
+    let _ = finished.send(());
+    let timed_out = watchdog.join().unwrap_or(false);
+    if sections.is_err() {
+        let _ = child.kill();
+    }
     let status = child.wait().map_err(|e| format!("qemu-system-arm: {e}"))?;
     let _ = drain.join();
-    drop(watchdog);
+    if timed_out {
+        return Err(format!("{}: no end within {} s", elf.display(), timeout.as_secs()));
+    }
     if !status.success() {
         return Err(format!(
             "{}: the profile image exited with {status} (run it with `cargo xtask qemu-runner {}` to see its log)",
