@@ -192,9 +192,9 @@ enum Command {
         /// Cores to profile (repeatable) [default: all three]
         #[arg(long = "core", value_name = "C", value_parser = ["m4f", "m3", "m0"])]
         cores: Vec<String>,
-        /// Functions listed per section
-        #[arg(long, value_name = "N", default_value_t = 15)]
-        top: usize,
+        /// Functions listed per section and in its worst tick (at least 1)
+        #[arg(long, value_name = "N", default_value_t = 15, value_parser = clap::value_parser!(u16).range(1..))]
+        top: u16,
     },
     /// Host instruction counts (valgrind) against the baseline
     Callgrind {
@@ -272,7 +272,7 @@ fn main() -> ExitCode {
             })
             .map_err(Failure::from),
         Command::QemuRunner { elf, args: _ } => cmd_qemu_runner(&elf),
-        Command::Profile { params, cores, top } => cmd_profile(&params, &cores, top),
+        Command::Profile { params, cores, top } => cmd_profile(&params, &cores, usize::from(top)),
         Command::Callgrind { bless } => callgrind::check(&root(), bless).map(|_| 0).map_err(Failure::from),
         Command::Fuzz {
             seconds,
@@ -350,18 +350,21 @@ fn cmd_run(params: &ParamsArg, csv_path: Option<&Path>) -> Outcome {
 /// `cargo xtask profile [--params F] [--core C]... [--top N]`.
 fn cmd_profile(params: &ParamsArg, cores: &[String], top: usize) -> Outcome {
     let params = params_file(params)?;
-    let targets: Vec<&'static str> = if cores.is_empty() {
-        firmware::TARGETS.to_vec()
-    } else {
-        cores
-            .iter()
-            .map(|c| match c.as_str() {
-                "m3" => firmware::M3,
-                "m0" => firmware::M0,
-                _ => firmware::M4,
-            })
-            .collect()
-    };
+    let mut targets: Vec<&'static str> = Vec::new();
+    for c in cores {
+        let t = match c.as_str() {
+            "m3" => firmware::M3,
+            "m0" => firmware::M0,
+            _ => firmware::M4,
+        };
+        // A core named twice is profiled once.
+        if !targets.contains(&t) {
+            targets.push(t);
+        }
+    }
+    if targets.is_empty() {
+        targets = firmware::TARGETS.to_vec();
+    }
     profile::cmd(&root(), params.as_deref(), &targets, top)?;
     Ok(0)
 }
@@ -771,6 +774,7 @@ mod tests {
             })
         );
         assert_eq!(parse(&["profile", "--core", "m7"]), Err(ErrorKind::InvalidValue));
+        assert_eq!(parse(&["profile", "--top", "0"]), Err(ErrorKind::ValueValidation));
         assert_eq!(
             parse(&["fmu"]),
             Ok(Command::Fmu {

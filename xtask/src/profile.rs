@@ -25,6 +25,13 @@ use std::time::Duration;
 /// Ticks in each section of the profile image (`src/bin/profile.rs`).
 pub const TICKS: u64 = 200;
 
+/// QEMU messages (non-trace lines of its log) kept for an error.
+const MESSAGES: usize = 6;
+
+/// Longest run of the profile image before it is stopped (the Cortex-M0's
+/// takes about 30 s).
+const TIMEOUT: Duration = Duration::from_secs(300);
+
 /// The sections, in the order the image runs them.
 pub const SECTIONS: [&str; 2] = ["twin tick", "estimator tick"];
 
@@ -65,8 +72,22 @@ impl Symbols {
                 )
             })
             .collect();
-        ranges.sort_by_key(|r| r.0);
-        Symbols { ranges }
+        ranges.sort_by(|a, b| a.0.cmp(&b.0).then(a.2.cmp(&b.2)));
+        // Aliases (two names at one address: `DefaultPreInit` and a defmt
+        // timestamp, say) become one range named by both.
+        let mut merged: Vec<(u64, u64, String)> = Vec::with_capacity(ranges.len());
+        for r in ranges {
+            match merged.last_mut() {
+                Some(last) if last.0 == r.0 => {
+                    last.1 = last.1.max(r.1);
+                    if last.2 != r.2 {
+                        last.2 = format!("{} = {}", last.2, r.2);
+                    }
+                }
+                _ => merged.push(r),
+            }
+        }
+        Symbols { ranges: merged }
     }
 
     /// The start and name of the function holding `pc`, if a symbol covers it.
@@ -76,9 +97,21 @@ impl Symbols {
         (pc < r.1).then_some((r.0, r.2.as_str()))
     }
 
-    /// The start address of the function named `name` (demangled).
+    /// The start address of the function named `name` (demangled; one of
+    /// an alias's names).
     pub fn address(&self, name: &str) -> Option<u64> {
-        self.ranges.iter().find(|r| r.2 == name).map(|r| r.0)
+        self.ranges
+            .iter()
+            .find(|r| r.2.split(" = ").any(|n| n == name))
+            .map(|r| r.0)
+    }
+
+    /// `function+0xoffset` of `pc` (a call site without line information).
+    pub fn describe(&self, pc: u64) -> String {
+        match self.covering(pc) {
+            Some((start, name)) => format!("{name}+{:#x}", pc - start),
+            None => format!("{pc:#010x}"),
+        }
     }
 }
 
@@ -97,9 +130,18 @@ pub struct Section {
     /// section's last tick ending at its closing mark): its index from 0,
     /// and its instructions per function.
     pub worst: Option<(usize, HashMap<String, u64>)>,
+    /// Ticks marked in the section (0: the image marks none).
+    pub ticks: u64,
 }
 
 impl Section {
+    /// `n` instructions per tick of the section ([`TICKS`] when the image
+    /// marks no ticks).
+    pub fn per_tick(&self, n: u64) -> String {
+        let ticks = if self.ticks > 0 { self.ticks } else { TICKS };
+        format!("{:.1}", n as f64 / ticks as f64)
+    }
+
     /// Instructions of the worst tick.
     pub fn worst_total(&self) -> u64 {
         self.worst.as_ref().map_or(0, |(_, f)| f.values().sum())
@@ -129,6 +171,7 @@ pub fn attribute(
     mark: u64,
     tick: Option<u64>,
     sections: usize,
+    messages: &mut Vec<String>,
 ) -> Result<Vec<Section>, String> {
     let mut out = vec![Section::default(); sections];
     let mut marks = 0usize;
@@ -148,19 +191,33 @@ pub fn attribute(
     };
     for line in trace.lines() {
         let line = line.map_err(|e| format!("trace: {e}"))?;
-        let Some(pc) = pc_of(&line) else { continue };
+        let Some(pc) = pc_of(&line) else {
+            // QEMU's own messages share the log: the last few are kept for
+            // the error a failed run reports.
+            if !line.trim().is_empty() {
+                if messages.len() == MESSAGES {
+                    messages.remove(0);
+                }
+                messages.push(line);
+            }
+            continue;
+        };
         if pc == mark {
             if !marks.is_multiple_of(2) {
                 close(&mut current, out.get_mut(marks / 2));
             }
             marks += 1;
             previous = None;
+            entered.clear();
             continue;
         }
         if Some(pc) == tick && !marks.is_multiple_of(2) {
             let next = current.as_ref().map_or(0, |c| c.0 + 1);
             close(&mut current, out.get_mut(marks / 2));
             current = Some((next, HashMap::new()));
+            if let Some(section) = out.get_mut(marks / 2) {
+                section.ticks += 1;
+            }
         }
         let (start, name) = *names
             .entry(pc)
@@ -206,6 +263,8 @@ pub fn attribute(
 pub struct Lines {
     loader: Option<addr2line::Loader>,
     root: String,
+    /// The image's symbols: `function+offset` where a line is unknown.
+    pub symbols: Symbols,
 }
 
 impl Lines {
@@ -214,6 +273,10 @@ impl Lines {
         Lines {
             loader: addr2line::Loader::new(elf).ok(),
             root: format!("{}/", root.display()),
+            symbols: std::fs::read(elf)
+                .ok()
+                .and_then(|b| Symbols::of_elf(&b).ok())
+                .unwrap_or_default(),
         }
     }
 
@@ -232,6 +295,12 @@ impl Lines {
             // compiler's `/rustc/<commit>/` prefix).
             let file = file.strip_prefix(self.root.as_str()).unwrap_or(file);
             let file = match file.strip_prefix("/rustc/").and_then(|f| f.split_once('/')) {
+                Some((_, rest)) => rest,
+                None => file,
+            };
+            // A dependency's sources as `crate-version/...` (without the
+            // registry's directory).
+            let file = match file.split_once("/registry/src/").and_then(|(_, f)| f.split_once('/')) {
                 Some((_, rest)) => rest,
                 None => file,
             };
@@ -288,7 +357,8 @@ pub fn run(elf: &Path, machine: Machine, timeout: Duration) -> Result<Vec<Sectio
         late
     });
     let stderr = BufReader::with_capacity(1 << 20, child.stderr.take().expect("piped"));
-    let sections = attribute(stderr, &symbols, mark, tick, SECTIONS.len());
+    let mut messages = Vec::new();
+    let sections = attribute(stderr, &symbols, mark, tick, SECTIONS.len(), &mut messages);
     // The trace ended (QEMU closed its log) or could not be read: the
     // watchdog is told before `wait`, so that it never kills a reused pid,
     // and QEMU is stopped if its log was abandoned.
@@ -299,17 +369,26 @@ pub fn run(elf: &Path, machine: Machine, timeout: Duration) -> Result<Vec<Sectio
     }
     let status = child.wait().map_err(|e| format!("qemu-system-arm: {e}"))?;
     let _ = drain.join();
+    let said = if messages.is_empty() {
+        String::new()
+    } else {
+        format!("; QEMU said: {}", messages.join(" | "))
+    };
     if timed_out {
-        return Err(format!("{}: no end within {} s", elf.display(), timeout.as_secs()));
+        return Err(format!(
+            "{}: QEMU did not finish within {} s and was stopped{said}",
+            elf.display(),
+            timeout.as_secs()
+        ));
     }
     if !status.success() {
         return Err(format!(
-            "{}: the profile image exited with {status} (run it with `cargo xtask qemu-runner {}` to see its log)",
+            "{}: QEMU exited with {status}{said} (`cargo xtask qemu-runner {}` shows the image's own log)",
             elf.display(),
             elf.display()
         ));
     }
-    sections
+    sections.map_err(|e| format!("{}: {e}{said}", elf.display()))
 }
 
 /// The report: per core and section, instructions per tick and the `top`
@@ -320,8 +399,9 @@ pub fn report(results: &[(&str, Vec<Section>, Lines)], top: usize) -> String {
     for (core, sections, lines) in results {
         for (name, section) in SECTIONS.iter().zip(sections) {
             s += &format!(
-                "\n### {core}: {name} ({} instructions per tick, mean over {TICKS})\n\n| function | per tick | share | called from (per tick) |\n| --- | ---: | ---: | --- |\n",
-                per_tick(section.total)
+                "\n### {core}: {name} ({} instructions per tick, mean over {} ticks)\n\n| function | per tick | share | called from (per tick) |\n| --- | ---: | ---: | --- |\n",
+                section.per_tick(section.total),
+                if section.ticks > 0 { section.ticks } else { TICKS }
             );
             let mut rows: Vec<(&String, &u64)> = section.functions.iter().collect();
             rows.sort_by(|a, b| b.1.cmp(a.1).then(a.0.cmp(b.0)));
@@ -331,7 +411,7 @@ pub fn report(results: &[(&str, Vec<Section>, Lines)], top: usize) -> String {
                 let mut by_line: HashMap<String, u64> = HashMap::new();
                 for (a, n) in section.sites.get(*f).into_iter().flatten() {
                     if *a != 0 {
-                        let at = lines.at(*a).unwrap_or_else(|| format!("{a:#010x}"));
+                        let at = lines.at(*a).unwrap_or_else(|| lines.symbols.describe(*a));
                         *by_line.entry(at).or_insert(0) += n;
                     }
                 }
@@ -340,11 +420,11 @@ pub fn report(results: &[(&str, Vec<Section>, Lines)], top: usize) -> String {
                 let called: Vec<String> = sites
                     .iter()
                     .take(2)
-                    .map(|(at, n)| format!("`{at}` {}", per_tick(*n)))
+                    .map(|(at, n)| format!("`{at}` {}", section.per_tick(*n)))
                     .collect();
                 s += &format!(
                     "| `{f}` | {} | {:.1} % | {} |\n",
-                    per_tick(**n),
+                    section.per_tick(**n),
                     share(**n, section.total),
                     called.join(", ")
                 );
@@ -354,7 +434,7 @@ pub fn report(results: &[(&str, Vec<Section>, Lines)], top: usize) -> String {
                 s += &format!(
                     "| {} other functions | {} | {:.1} % | |\n",
                     rows.len() - top,
-                    per_tick(rest),
+                    section.per_tick(rest),
                     share(rest, section.total)
                 );
             }
@@ -371,10 +451,6 @@ pub fn report(results: &[(&str, Vec<Section>, Lines)], top: usize) -> String {
         }
     }
     s
-}
-
-fn per_tick(n: u64) -> String {
-    format!("{:.1}", n as f64 / TICKS as f64)
 }
 
 fn share(n: u64, total: u64) -> f64 {
@@ -409,10 +485,14 @@ pub fn cmd(root: &Path, params: Option<&Path>, targets: &[&'static str], top: us
         let elf = firmware::build(&tc, root, &image, params)?;
         let core = core_name(target);
         eprintln!("xtask: profiling {core} ({target}, QEMU {})", image.machine().name);
-        let sections = run(&elf, image.machine(), Duration::from_secs(1800))?;
+        let sections = run(&elf, image.machine(), TIMEOUT)?;
         results.push((core, sections, Lines::new(&elf, root)));
     }
-    println!("{}", report(&results, top));
+    let file = params.map_or_else(|| "presets/paper.toml".to_string(), |p| p.display().to_string());
+    println!(
+        "Profile of {file} (the twin as its build chose it)\n{}",
+        report(&results, top)
+    );
     Ok(())
 }
 
@@ -489,7 +569,7 @@ mod tests {
         trace += &line(0x0800_0206);
         trace += &line(0x0900_0000); // no symbol
         trace += &line(0x0800_0100);
-        let out = attribute(trace.as_bytes(), &s, 0x0800_0100, None, 2).unwrap();
+        let out = attribute(trace.as_bytes(), &s, 0x0800_0100, None, 2, &mut Vec::new()).unwrap();
         assert_eq!(out[0].total, 3);
         assert_eq!(out[0].functions["tick"], 3);
         assert_eq!(out[1].total, 4);
@@ -499,12 +579,12 @@ mod tests {
             out[1].sites["compensator::mathf::exp10"],
             HashMap::from([(0x0800_0302, 2)])
         );
-        // tick was last entered at its start in the first section, from the
-        // marker's body.
-        assert_eq!(out[1].sites["tick"], HashMap::from([(0x0800_0102, 1)]));
+        // tick was entered before the section opened: no call site.
+        assert_eq!(out[1].sites["tick"], HashMap::from([(0, 1)]));
         let none = Lines {
             loader: None,
             root: String::new(),
+            symbols: Symbols::default(),
         };
         let r = report(&[("Cortex-M4F", out, none)], 1);
         assert!(
@@ -533,7 +613,7 @@ mod tests {
             }
             trace += &line(0x0800_0100);
         }
-        let out = attribute(trace.as_bytes(), &s, 0x0800_0100, Some(0x0800_0400), 2).unwrap();
+        let out = attribute(trace.as_bytes(), &s, 0x0800_0100, Some(0x0800_0400), 2, &mut Vec::new()).unwrap();
         assert_eq!(out[0].total, 6);
         assert_eq!(out[0].worst, Some((1, HashMap::from([("tick".to_string(), 3)]))));
         assert_eq!(out[1].worst_total(), 4);
@@ -541,10 +621,75 @@ mod tests {
     }
 
     #[test]
+    fn a_return_keeps_the_call_site_and_two_callers_are_told_apart() {
+        let s = Symbols::new([
+            (0x0800_0100, 0x20, "profile_mark".to_string()),
+            (0x0800_0200, 0x10, "leaf".to_string()),
+            (0x0800_0300, 0x40, "caller".to_string()),
+        ]);
+        let mut trace = line(0x0800_0100);
+        trace += &line(0x0800_0300); // caller's entry, from the marker
+        trace += &line(0x0800_0304); // bl leaf
+        trace += &line(0x0800_0200);
+        trace += &line(0x0800_0202);
+        trace += &line(0x0800_0206);
+        trace += &line(0x0800_0308); // returns into caller, not at its start
+        trace += &line(0x0800_0310); // bl leaf again, from elsewhere
+        trace += &line(0x0800_0200);
+        trace += &line(0x0800_0312);
+        trace += &line(0x0800_0100);
+        trace += &line(0x0800_0100);
+        trace += &line(0x0800_0100);
+        let out = attribute(trace.as_bytes(), &s, 0x0800_0100, None, 2, &mut Vec::new()).unwrap();
+        assert_eq!(
+            out[0].sites["leaf"],
+            HashMap::from([(0x0800_0304, 3), (0x0800_0310, 1)])
+        );
+        // The return did not make leaf the caller's call site.
+        assert_eq!(out[0].sites["caller"], HashMap::from([(0, 5)]));
+        assert_eq!(out[0].total, 9);
+        let lines = Lines {
+            loader: None,
+            root: String::new(),
+            symbols: Symbols::new([(0x0800_0300, 0x40, "caller".to_string())]),
+        };
+        let r = report(&[("Cortex-M0", out, lines)], 2);
+        assert!(
+            r.contains("| `leaf` | 0.0 | 44.4 % | `caller+0x4` 0.0, `caller+0x10` 0.0 |"),
+            "{r}"
+        );
+        // Every function shown: no "other functions" row.
+        assert!(!r.contains("other functions"), "{r}");
+    }
+
+    #[test]
+    fn aliases_are_one_range_named_by_both() {
+        let s = Symbols::new([
+            (0x0800_0500, 0x8, "DefaultPreInit".to_string()),
+            (0x0800_0500, 0x8, "__defmt_default_timestamp".to_string()),
+        ]);
+        assert_eq!(
+            s.covering(0x0800_0504),
+            Some((0x0800_0500, "DefaultPreInit = __defmt_default_timestamp"))
+        );
+        assert_eq!(s.address("__defmt_default_timestamp"), Some(0x0800_0500));
+    }
+
+    #[test]
+    fn qemu_messages_are_kept_for_the_error() {
+        let s = symbols();
+        let trace = "qemu-system-arm: -singlestep: invalid option\n\n";
+        let mut messages = Vec::new();
+        let e = attribute(trace.as_bytes(), &s, 0x0800_0100, None, 2, &mut messages).unwrap_err();
+        assert!(e.contains("0 section marks"), "{e}");
+        assert_eq!(messages, ["qemu-system-arm: -singlestep: invalid option"]);
+    }
+
+    #[test]
     fn a_run_that_stops_early_is_an_error() {
         let s = symbols();
         let trace = format!("{}{}", line(0x0800_0100), line(0x0800_0300));
-        let e = attribute(trace.as_bytes(), &s, 0x0800_0100, None, 2).unwrap_err();
+        let e = attribute(trace.as_bytes(), &s, 0x0800_0100, None, 2, &mut Vec::new()).unwrap_err();
         assert!(e.contains("1 section marks, expected 4"), "{e}");
     }
 }
