@@ -346,7 +346,6 @@ fn cmd_run(params: &ParamsArg, csv_path: Option<&Path>) -> Outcome {
     Ok(run.code)
 }
 
-/// `cargo xtask build [--params F]`.
 /// `cargo xtask profile [--params F] [--core C]... [--top N]`.
 fn cmd_profile(params: &ParamsArg, cores: &[String], top: usize) -> Outcome {
     let params = params_file(params)?;
@@ -369,6 +368,7 @@ fn cmd_profile(params: &ParamsArg, cores: &[String], top: usize) -> Outcome {
     Ok(0)
 }
 
+/// `cargo xtask build [--params F]`.
 fn cmd_build(params: &ParamsArg) -> Outcome {
     let params = params_file(params)?;
     firmware::build_all(&root(), params.as_deref())?;
