@@ -291,19 +291,7 @@ impl Lines {
                 continue;
             };
             let own = file.starts_with(self.root.as_str());
-            // The standard library's sources as `library/...` (without the
-            // compiler's `/rustc/<commit>/` prefix).
-            let file = file.strip_prefix(self.root.as_str()).unwrap_or(file);
-            let file = match file.strip_prefix("/rustc/").and_then(|f| f.split_once('/')) {
-                Some((_, rest)) => rest,
-                None => file,
-            };
-            // A dependency's sources as `crate-version/...` (without the
-            // registry's directory).
-            let file = match file.split_once("/registry/src/").and_then(|(_, f)| f.split_once('/')) {
-                Some((_, rest)) => rest,
-                None => file,
-            };
+            let file = shorten(file, &self.root);
             let shown = format!("{file}:{line}");
             if own {
                 return Some(shown);
@@ -311,6 +299,22 @@ impl Lines {
             first.get_or_insert(shown);
         }
         first
+    }
+}
+
+/// A source path as the report shows it: relative to the workspace `root`
+/// (with its trailing `/`), the standard library's as `library/...`
+/// (without the compiler's `/rustc/<commit>/`), a dependency's as
+/// `crate-version/...` (without the registry's directory).
+pub fn shorten<'a>(file: &'a str, root: &str) -> &'a str {
+    let file = file.strip_prefix(root).unwrap_or(file);
+    let file = match file.strip_prefix("/rustc/").and_then(|f| f.split_once('/')) {
+        Some((_, rest)) => rest,
+        None => file,
+    };
+    match file.split_once("/registry/src/").and_then(|(_, f)| f.split_once('/')) {
+        Some((_, rest)) => rest,
+        None => file,
     }
 }
 
@@ -660,6 +664,30 @@ mod tests {
         );
         // Every function shown: no "other functions" row.
         assert!(!r.contains("other functions"), "{r}");
+    }
+
+    #[test]
+    fn source_paths_are_shown_short() {
+        let root = "/work/main/";
+        assert_eq!(
+            shorten("/work/main/model/src/estimator/mod.rs", root),
+            "model/src/estimator/mod.rs"
+        );
+        assert_eq!(
+            shorten(
+                "/rustc/59807616e1fa2540724bfbac14d7976d7e4a3860/library/core/src/result.rs",
+                root
+            ),
+            "library/core/src/result.rs"
+        );
+        assert_eq!(
+            shorten(
+                "/root/.cargo/registry/src/index.crates.io-1949cf8c6b5b557f/defmt-1.2.0/src/lib.rs",
+                root
+            ),
+            "defmt-1.2.0/src/lib.rs"
+        );
+        assert_eq!(shorten("/elsewhere/x.rs", root), "/elsewhere/x.rs");
     }
 
     #[test]
