@@ -254,29 +254,46 @@ fn model<const N: usize>(s: &ObserverSettings) -> Mat<N> {
     a
 }
 
-/// Steady state of one mode of the `N`-state model (`M = 2 N`).
-fn mode<const N: usize, const M: usize>(s: &ObserverSettings, q: f64) -> Result<([f64; N], f64, Mat<N>), DesignError> {
-    let a = model::<N>(s);
+/// Variance of one reading [C^2]: the probe's noise and the converter's
+/// quantization (uniform over one step of `resolution`).
+fn reading_variance(s: &ObserverSettings) -> f64 {
+    s.noise * s.noise + s.resolution * s.resolution / 12.0
+}
+
+/// The `N`-state model (`M = 2 N`) over one reading period with the rate
+/// driven by white noise of intensity `q`: `(Phi, Q_d)`.
+fn discrete<const N: usize, const M: usize>(s: &ObserverSettings, q: f64) -> Result<(Mat<N>, Mat<N>), DesignError> {
     let mut g = [0.0; N];
     g[1] = 1.0;
-    let (phi, qd) = van_loan::<N, M>(&a, &g, q, s.sample_period).ok_or(DesignError::Numerics)?;
-    let r = s.noise * s.noise + s.resolution * s.resolution / 12.0;
+    van_loan::<N, M>(&model::<N>(s), &g, q, s.sample_period).ok_or(DesignError::Numerics)
+}
+
+/// The measurement update of the probe reading (the last state) with
+/// variance `r`, from the prior covariance: the gain, the innovation's
+/// variance and the posterior covariance `(I - k h) P`.
+fn update<const N: usize>(prior: &Mat<N>, r: f64) -> ([f64; N], f64, Mat<N>) {
+    let innovation = prior[N - 1][N - 1] + r;
+    let mut k = [0.0; N];
+    for i in 0..N {
+        k[i] = prior[i][N - 1] / innovation;
+    }
+    let mut post = *prior;
+    for i in 0..N {
+        for j in 0..N {
+            post[i][j] = prior[i][j] - k[i] * prior[N - 1][j];
+        }
+    }
+    (k, innovation, post)
+}
+
+/// Steady state of one mode of the `N`-state model (`M = 2 N`).
+fn mode<const N: usize, const M: usize>(s: &ObserverSettings, q: f64) -> Result<([f64; N], f64, Mat<N>), DesignError> {
+    let (phi, qd) = discrete::<N, M>(s, q)?;
+    let r = reading_variance(s);
     let mut h = [0.0; N];
     h[N - 1] = 1.0;
     let p = dare_filter(&phi, &qd, &h, r).ok_or(DesignError::Numerics)?;
-    let innovation = p[N - 1][N - 1] + r;
-    let mut k = [0.0; N];
-    for i in 0..N {
-        k[i] = p[i][N - 1] / innovation;
-    }
-    // Posterior covariance (I - k h) P.
-    let mut post = p;
-    for i in 0..N {
-        for j in 0..N {
-            post[i][j] = p[i][j] - k[i] * p[N - 1][j];
-        }
-    }
-    Ok((k, innovation, post))
+    Ok(update(&p, r))
 }
 
 /// A mode's gains on the runtime's four slots.
@@ -311,11 +328,9 @@ fn schedule<const N: usize, const M: usize>(
     hold: &ModeGains,
     fast: &ModeGains,
 ) -> Result<([ModeGains; SCHEDULE], f64), DesignError> {
-    let mut g = [0.0; N];
-    g[1] = 1.0;
-    let (phi, qd) = van_loan::<N, M>(&model::<N>(s), &g, q_hold, s.sample_period).ok_or(DesignError::Numerics)?;
+    let (phi, qd) = discrete::<N, M>(s, q_hold)?;
     let phi_t = transpose(&phi);
-    let r = s.noise * s.noise + s.resolution * s.resolution / 12.0;
+    let r = reading_variance(s);
     // One reading: the prior from the last posterior, the gain, the
     // posterior.
     let step = |post: &Mat<N>| -> ([f64; N], f64, Mat<N>) {
@@ -325,18 +340,7 @@ fn schedule<const N: usize, const M: usize>(
                 prior[i][j] += qd[i][j];
             }
         }
-        let innovation = prior[N - 1][N - 1] + r;
-        let mut k = [0.0; N];
-        for i in 0..N {
-            k[i] = prior[i][N - 1] / innovation;
-        }
-        let mut next = prior;
-        for i in 0..N {
-            for j in 0..N {
-                next[i][j] = prior[i][j] - k[i] * prior[N - 1][j];
-            }
-        }
-        (k, innovation, next)
+        update(&prior, r)
     };
     let slots: &[(usize, usize)] = if N == 4 {
         &[(0, 0), (1, 1), (2, 2), (3, 3)]
@@ -411,16 +415,22 @@ impl ObserverDesign {
         let accel = s.max_rate / lag;
         let q_fast = (accel / 2.0) * (accel / 2.0) * s.sample_period;
         let q_hold = HOLD_RATIO * q_fast;
-        let (hold, fast) = if well {
+        // Each mode's steady state; the schedule starts from the fast
+        // mode's posterior covariance.
+        let (hold, fast, schedule, readings_per) = if well {
             let (k, i, p) = mode::<4, 8>(s, q_hold)?;
             let hold = gains(k, i, &p, q_hold);
             let (k, i, p) = mode::<4, 8>(s, q_fast)?;
-            (hold, gains(k, i, &p, q_fast))
+            let fast = gains(k, i, &p, q_fast);
+            let (schedule, c) = schedule::<4, 8>(s, q_hold, &p, &hold, &fast)?;
+            (hold, fast, schedule, c)
         } else {
             let (k, i, p) = mode::<3, 6>(s, q_hold)?;
             let hold = gains(k, i, &p, q_hold);
             let (k, i, p) = mode::<3, 6>(s, q_fast)?;
-            (hold, gains(k, i, &p, q_fast))
+            let fast = gains(k, i, &p, q_fast);
+            let (schedule, c) = schedule::<3, 6>(s, q_hold, &p, &hold, &fast)?;
+            (hold, fast, schedule, c)
         };
         // The per-tick transition (noise-free), as increments.
         let (well_oil, well_rate, probe_oil, probe_well, probe_rate) = if well {
@@ -429,13 +439,6 @@ impl ObserverDesign {
         } else {
             let (phi, _) = van_loan::<3, 6>(&model::<3>(s), &[0.0; 3], 0.0, s.tick).ok_or(DesignError::Numerics)?;
             (0.0, 0.0, phi[2][0], 0.0, phi[2][1])
-        };
-        let (schedule, readings_per) = if well {
-            let (_, _, p) = mode::<4, 8>(s, q_fast)?;
-            schedule::<4, 8>(s, q_hold, &p, &hold, &fast)?
-        } else {
-            let (_, _, p) = mode::<3, 6>(s, q_fast)?;
-            schedule::<3, 6>(s, q_hold, &p, &hold, &fast)?
         };
         let design = ObserverDesign {
             tick: s.tick as f32,
@@ -453,7 +456,7 @@ impl ObserverDesign {
             gate_rate: (s.span / s.time_constant) as f32,
             rate_limit: (RATE_LIMIT * s.max_rate) as f32,
             innovation_weight: -libm::expm1(-s.sample_period / lag) as f32,
-            gate_noise: (6.0 * libm::sqrt(2.0 * (s.noise * s.noise + s.resolution * s.resolution / 12.0))) as f32,
+            gate_noise: (6.0 * libm::sqrt(2.0 * reading_variance(s))) as f32,
         };
         let finite = [
             design.well_oil,
