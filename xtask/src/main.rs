@@ -364,7 +364,10 @@ fn cmd_profile(params: &ParamsArg, cores: &[String], top: usize) -> Outcome {
     if targets.is_empty() {
         targets = firmware::TARGETS.to_vec();
     }
-    profile::cmd(&root(), params.as_deref(), &targets, top)?;
+    let root = root();
+    qemu::ensure()?;
+    let tc = toolchain::get(&root, &targets)?;
+    profile::cmd(&tc, &root, params.as_deref(), &targets, top)?;
     Ok(0)
 }
 
@@ -712,7 +715,7 @@ fn cmd_test(bless: bool) -> Outcome {
     step("QEMU: cost, footprint and stack budgets");
     bench::check(&elfs, &twin_runs)?;
     step("QEMU: the profile runner on the Cortex-M4F (instructions per function, docs/profile.md)");
-    profile::cmd(&root, None, &[firmware::M4], 5)?;
+    profile::cmd(&tc, &root, None, &[firmware::M4], 5)?;
     eprintln!("\nxtask: all checks passed");
     Ok(0)
 }

@@ -15,6 +15,7 @@
 
 use crate::firmware::{self, Image};
 use crate::qemu::Machine;
+use crate::toolchain::Toolchain;
 use object::{Object, ObjectSymbol, SymbolKind};
 use std::collections::HashMap;
 use std::io::{BufRead, BufReader, Read};
@@ -135,11 +136,15 @@ pub struct Section {
 }
 
 impl Section {
-    /// `n` instructions per tick of the section ([`TICKS`] when the image
-    /// marks no ticks).
+    /// The ticks the section's means are over ([`TICKS`] when the image
+    /// marks none).
+    pub fn tick_count(&self) -> u64 {
+        if self.ticks > 0 { self.ticks } else { TICKS }
+    }
+
+    /// `n` instructions per tick of the section.
     pub fn per_tick(&self, n: u64) -> String {
-        let ticks = if self.ticks > 0 { self.ticks } else { TICKS };
-        format!("{:.1}", n as f64 / ticks as f64)
+        format!("{:.1}", n as f64 / self.tick_count() as f64)
     }
 
     /// Instructions of the worst tick.
@@ -268,15 +273,13 @@ pub struct Lines {
 }
 
 impl Lines {
-    /// The lines of `elf`, paths shown relative to `root`.
-    pub fn new(elf: &Path, root: &Path) -> Self {
+    /// The lines of `elf` (its `symbols` already read), paths shown
+    /// relative to `root`.
+    pub fn new(elf: &Path, root: &Path, symbols: Symbols) -> Self {
         Lines {
             loader: addr2line::Loader::new(elf).ok(),
             root: format!("{}/", root.display()),
-            symbols: std::fs::read(elf)
-                .ok()
-                .and_then(|b| Symbols::of_elf(&b).ok())
-                .unwrap_or_default(),
+            symbols,
         }
     }
 
@@ -324,9 +327,7 @@ pub fn shorten<'a>(file: &'a str, root: &str) -> &'a str {
 ///
 /// QEMU cannot start, the image fails (non-zero exit: its defmt log says
 /// why under `cargo xtask qemu-runner`), or its marks are missing.
-pub fn run(elf: &Path, machine: Machine, timeout: Duration) -> Result<Vec<Section>, String> {
-    let bytes = std::fs::read(elf).map_err(|e| format!("{}: {e}", elf.display()))?;
-    let symbols = Symbols::of_elf(&bytes)?;
+pub fn run(elf: &Path, symbols: &Symbols, machine: Machine, timeout: Duration) -> Result<Vec<Section>, String> {
     let mark = symbols
         .address("profile_mark")
         .ok_or_else(|| format!("{}: no profile_mark symbol", elf.display()))?;
@@ -362,7 +363,7 @@ pub fn run(elf: &Path, machine: Machine, timeout: Duration) -> Result<Vec<Sectio
     });
     let stderr = BufReader::with_capacity(1 << 20, child.stderr.take().expect("piped"));
     let mut messages = Vec::new();
-    let sections = attribute(stderr, &symbols, mark, tick, SECTIONS.len(), &mut messages);
+    let sections = attribute(stderr, symbols, mark, tick, SECTIONS.len(), &mut messages);
     // The trace ended (QEMU closed its log) or could not be read: the
     // watchdog is told before `wait`, so that it never kills a reused pid,
     // and QEMU is stopped if its log was abandoned.
@@ -405,7 +406,7 @@ pub fn report(results: &[(&str, Vec<Section>, Lines)], top: usize) -> String {
             s += &format!(
                 "\n### {core}: {name} ({} instructions per tick, mean over {} ticks)\n\n| function | per tick | share | called from (per tick) |\n| --- | ---: | ---: | --- |\n",
                 section.per_tick(section.total),
-                if section.ticks > 0 { section.ticks } else { TICKS }
+                section.tick_count()
             );
             let mut rows: Vec<(&String, &u64)> = section.functions.iter().collect();
             rows.sort_by(|a, b| b.1.cmp(a.1).then(a.0.cmp(b.0)));
@@ -474,23 +475,30 @@ pub fn image(target: &'static str) -> Image {
     }
 }
 
-/// `cargo xtask profile`: builds the profile image for each of `targets`,
-/// runs it and prints the report.
+/// `cargo xtask profile`: builds the profile image for each of `targets`
+/// with `tc` (which covers them; QEMU installed), runs it and prints the
+/// report.
 ///
 /// # Errors
 ///
-/// No toolchain, a build fails, or a run fails ([`run`]).
-pub fn cmd(root: &Path, params: Option<&Path>, targets: &[&'static str], top: usize) -> Result<(), String> {
-    crate::qemu::ensure()?;
-    let tc = crate::toolchain::get(root, targets)?;
+/// A build fails, the ELF cannot be read, or a run fails ([`run`]).
+pub fn cmd(
+    tc: &Toolchain,
+    root: &Path,
+    params: Option<&Path>,
+    targets: &[&'static str],
+    top: usize,
+) -> Result<(), String> {
     let mut results = Vec::new();
     for &target in targets {
         let image = image(target);
-        let elf = firmware::build(&tc, root, &image, params)?;
+        let elf = firmware::build(tc, root, &image, params)?;
         let core = core_name(target);
         eprintln!("xtask: profiling {core} ({target}, QEMU {})", image.machine().name);
-        let sections = run(&elf, image.machine(), TIMEOUT)?;
-        results.push((core, sections, Lines::new(&elf, root)));
+        let bytes = std::fs::read(&elf).map_err(|e| format!("{}: {e}", elf.display()))?;
+        let symbols = Symbols::of_elf(&bytes).map_err(|e| format!("{}: {e}", elf.display()))?;
+        let sections = run(&elf, &symbols, image.machine(), TIMEOUT)?;
+        results.push((core, sections, Lines::new(&elf, root, symbols)));
     }
     let file = params.map_or_else(|| "presets/paper.toml".to_string(), |p| p.display().to_string());
     println!(
