@@ -7,27 +7,24 @@
 //! configuration the core's chooser picks for the parameter file
 //! (`compensator::dynamics::config::choose` at the estimator's tick over
 //! its validated range: what `build.rs` ships and `compensator step
-//! --precision f32` runs), driven with the input temperature directly. The
-//! estimator itself is not ticked: its temperature filter, spike rejection
-//! and slew limit would put the sensor's dynamics between the oil
-//! temperature and the twin, and its API takes sensor samples only. Its
-//! flags are computed with the same functions as its jobs (fluid point,
-//! flow laws, closed-form equilibrium, Routh-Hurwitz stability of the
-//! linearisation, machine losses: `compensator::estimator` module docs).
+//! --precision f32` runs), inside the estimator's own plant observer
+//! (`compensator::estimator::Plant`: the twin, the jobs and the
+//! publication of an estimate), driven with the input temperature and
+//! port pressures directly. The estimator's sensor side is not used: its
+//! temperature filter, spike rejection and slew limit would put the
+//! sensor's dynamics between the oil temperature and the twin. Where the
+//! estimator runs its jobs in rotation, an input change runs them all at
+//! once (`Plant::refresh`); the flags, flows and compensation error are
+//! the estimator's publication (`Plant::estimate`).
 
 use crate::variables::{
     FIELD_COUNT, FLAGS_OUTPUT, INPUTS, OUTPUTS, VR_FIRST_OUTPUT, VR_MACHINE_PRESENT, VR_P_OUTLET, VR_P_SUPPLY, VR_TIME,
     field_of, fields, input_of,
 };
 use compensator::dynamics::config::choose;
-use compensator::dynamics::fsi::{Contact, Fsi};
-use compensator::dynamics::linear::characteristic_polynomial;
-use compensator::dynamics::schemes::OdeSystem;
-use compensator::dynamics::{DynamicState, Twin, TwinConfig, TwinMemory};
-use compensator::equilibrium::{a_parameter, equilibrium, equilibrium_for};
-use compensator::estimator::{EstimatorConfig, Flags, quartic_hurwitz};
-use compensator::throttle::FlowLaws;
-use compensator::{ModelError, Params, RawParams, asymptotic, compensation};
+use compensator::dynamics::{TwinConfig, TwinMemory};
+use compensator::estimator::{EstimatorConfig, Flags, Plant};
+use compensator::{ModelError, Params, RawParams};
 use compensator_params::{MACHINE_FIELDS, RawTolerances};
 
 /// Where an instance is in the FMI state machine.
@@ -191,16 +188,6 @@ pub fn pressures_start(raw: &RawParams) -> (f64, f64) {
     (c.outlet_pressure + c.pressure_drop, c.outlet_pressure)
 }
 
-/// Results that depend on the temperature and the port pressures only
-/// (what the estimator's jobs keep).
-#[derive(Clone, Copy, Debug)]
-struct Statics {
-    flows: FlowLaws<f32>,
-    stable: bool,
-    /// The machine's losses [m^3/s] (NaN without a machine).
-    losses: f32,
-}
-
 /// What the twin's coefficients were last set from: the oil temperature
 /// [C] and the port pressures `(p_supply, p_outlet)` [Pa].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -209,23 +196,21 @@ struct Applied {
     pressures: (f32, f32),
 }
 
-/// An initialised instance: the twin and what it needs.
+/// An initialised instance: the plant observer and what drives it.
 #[derive(Clone, Copy, Debug)]
 struct Sim {
     raw: RawParams,
-    params: Params<f32>,
     estimator: EstimatorConfig,
-    twin: Twin<f32, f32>,
+    /// The twin, its jobs and the publication of an estimate: the
+    /// estimator's own ([`Plant`]), driven by the inputs.
+    plant: Plant<f32>,
     /// The configured tick [s] (the chooser's; a communication step that
     /// is not whole ticks runs shorter ones, `Twin::set_tick`).
     tick: f64,
-    monotonic: bool,
-    machine_mu_ref: f32,
     /// Temperature the twin was built at [C].
     t_init: f32,
     /// Temperature and pressures of the twin's coefficients.
     applied: Applied,
-    statics: Statics,
     /// The last results could not be computed at `applied` (the previous
     /// ones stand, flagged `DEGRADED`, until they can).
     stale: bool,
@@ -298,154 +283,54 @@ impl Sim {
                 inputs.p_supply, inputs.p_outlet
             ));
         }
-        let mut twin = Twin::new(&params, config, t).map_err(|e| model_error(&format!("T_oil = {t_oil} degC"), e))?;
+        let at_t = |e| model_error(&format!("T_oil = {t_oil} degC"), e);
+        // The twin at rest at the oil temperature, the input's uncertainty
+        // none (the temperature is given, not measured).
+        let mut plant = Plant::new(&params, &EstimatorConfig { twin: config, ..estimator }, t, 0.0).map_err(at_t)?;
         let designed = (params.pressure_drop + params.outlet_pressure, params.outlet_pressure);
         if pressures != designed {
-            let at = pressures_of(&params, pressures);
-            let eq = equilibrium(&at, t).map_err(|e| model_error("the equilibrium at p_supply, p_outlet", e))?;
-            twin.set_pressures(pressures.0, pressures.1)
+            plant
+                .set_ports(pressures.0, pressures.1)
                 .map_err(|e| model_error("p_supply, p_outlet", e))?;
-            twin.set_state(&DynamicState {
-                x: eq.x,
-                v: 0.0,
-                p_a: eq.p_a,
-                p_b: eq.p_b,
-            });
-            // At rest: no transient to grade.
-            let memory = twin.memory();
-            twin.restore(&TwinMemory {
-                abrupt: false,
-                ..memory
-            });
+            plant
+                .rest()
+                .map_err(|e| model_error("the equilibrium at p_supply, p_outlet", e))?;
+            plant.refresh(&estimator, t, 0.0).map_err(at_t)?;
         }
-        let monotonic = asymptotic::monotonicity(&params, estimator.valid.min, estimator.valid.max, 201)
-            .map(|m| m.monotonic)
-            .unwrap_or(false);
-        let machine_mu_ref = match &params.machine {
-            Some(m) => {
-                params
-                    .oil
-                    .state(m.leakage_temperature)
-                    .map_err(|e| model_error("machine.leakage_temperature", e))?
-                    .dynamic_viscosity
-            }
-            None => f32::NAN,
-        };
         let applied = Applied { t, pressures };
         let mut sim = Sim {
             raw,
-            params,
             estimator,
-            twin,
+            plant,
             tick: config.tick,
-            monotonic,
-            machine_mu_ref,
             t_init: t,
             applied,
-            statics: Statics {
-                flows: FlowLaws {
-                    capillary_conductance: 0.0,
-                    orifice_factor: 0.0,
-                    window_factor: 0.0,
-                },
-                stable: true,
-                losses: f32::NAN,
-            },
             stale: false,
             time: start_time,
             flags: Flags::empty(),
             outputs: [f64::NAN; 10],
         };
-        sim.statics = sim
-            .statics_at(applied)
-            .map_err(|e| model_error(&format!("T_oil = {t_oil} degC"), e))?;
-        let flags = sim.base_flags();
-        sim.publish(flags);
+        sim.publish(Flags::empty());
         Ok(sim)
     }
 
-    /// The estimator's jobs at `at` (Fluid, Equilibrium, Stability,
-    /// Losses: `compensator::estimator`), with the twin's current
-    /// coefficients; the flow laws at the port pressures. Stability needs
-    /// an equilibrium, which a drop that is not positive has not: it keeps
-    /// its last verdict then.
-    fn statics_at(&self, at: Applied) -> Result<Statics, ModelError> {
-        let p = &pressures_of(&self.params, at.pressures);
-        let point = p.oil.point(at.t)?;
-        let flows = FlowLaws::new(
-            &p.capillary,
-            &p.orifice,
-            p.slot.window_factor(p.pressure_drop),
-            point.state.density,
-            point.state.dynamic_viscosity,
-        );
-        let stable = if p.pressure_drop > 0.0 {
-            let eq = equilibrium_for(p, point.state, a_parameter(p, &point.state))?;
-            let y_equilibrium: [f32; 4] = self.twin.model().equilibrium_state(&eq);
-            let sys = Fsi {
-                coefficients: self.twin.coefficients(),
-                contact: Contact::Free,
-            };
-            quartic_hurwitz(&characteristic_polynomial(&sys.jacobian(&y_equilibrium)))
-        } else {
-            self.statics.stable
-        };
-        let losses = match &p.machine {
-            Some(m) => compensation::losses_for(m, self.machine_mu_ref, point.state.dynamic_viscosity)?,
-            None => f32::NAN,
-        };
-        Ok(Statics { flows, stable, losses })
-    }
-
-    /// Flags that follow from the design, the applied temperature and the
-    /// applied drop (outside `operating.pressure_drop`'s plausible range:
-    /// out of the model's range, as a temperature outside the validated one).
-    fn base_flags(&self) -> Flags {
-        let mut flags = Flags::empty();
-        if !self.monotonic {
-            flags.insert(Flags::NOT_UNIQUE);
-        }
-        let drop = (self.applied.pressures.0 - self.applied.pressures.1) as f64;
-        let drop_in_range = (DROP_FIELD.min..=DROP_FIELD.max).contains(&drop);
-        if !(self.estimator.valid.contains(self.applied.t) && drop_in_range) {
-            flags.insert(Flags::OUT_OF_RANGE);
-        }
-        if !self.statics.stable {
-            flags.insert(Flags::UNSTABLE);
-        }
-        flags
-    }
-
-    /// Computes the outputs from the twin's state (as the estimator's step 5).
+    /// Computes the outputs from the plant's estimate (the estimator's
+    /// publication) with `flags` and the design's and inputs' own.
     fn publish(&mut self, mut flags: Flags) {
-        let [xi, ..] = self.twin.raw_state();
-        if xi <= 0.0 || xi >= 1.0 {
-            flags.insert(Flags::AT_STOP);
-        }
-        let p = &self.params;
-        let st = &self.statics;
-        let s = self.twin.state();
-        let outlet = self.applied.pressures.1;
-        let q_a = st.flows.capillary_flow(s.p_a - outlet);
-        let q_b = st.flows.orifice_flow(s.p_b - outlet);
-        let q_throt = st.flows.window_flow(s.x);
-        let q_total = q_a + q_b + q_throt;
-        let error = match &p.machine {
-            Some(m) => q_total - (m.working_flow + st.losses),
-            None => f32::NAN,
-        };
-        self.flags = flags;
+        flags.insert(self.plant.flags_at(&self.estimator, self.applied.t));
+        let e = self.plant.estimate(self.applied.t, flags);
+        self.flags = e.flags;
         self.outputs = [
-            s.x as f64,
-            s.v as f64,
-            s.p_a as f64,
-            s.p_b as f64,
-            q_a as f64,
-            q_b as f64,
-            q_throt as f64,
-            q_total as f64,
-            error as f64,
-            flags.0 as f64,
+            e.x as f64,
+            e.v as f64,
+            e.p_a as f64,
+            e.p_b as f64,
+            e.q_a as f64,
+            e.q_b as f64,
+            e.q_throt as f64,
+            e.q_total as f64,
+            e.compensation_error as f64,
+            e.flags.0 as f64,
         ];
     }
 
@@ -457,10 +342,7 @@ impl Sim {
         let mut next = self.applied;
         let t = inputs.t_oil as f32;
         if t.is_finite() && self.estimator.oil.contains(t) {
-            match self.twin.set_temperature(t) {
-                Ok(()) => next.t = t,
-                Err(_) => flags.insert(Flags::DEGRADED),
-            }
+            next.t = t;
         } else {
             // Not an oil temperature: the twin keeps the last one, flagged
             // as the estimator flags an unusable sample.
@@ -469,7 +351,7 @@ impl Sim {
         let pressures = (inputs.p_supply as f32, inputs.p_outlet as f32);
         if pressures.0.is_finite() && pressures.1.is_finite() {
             if pressures != self.applied.pressures {
-                match self.twin.set_pressures(pressures.0, pressures.1) {
+                match self.plant.set_ports(pressures.0, pressures.1) {
                     Ok(()) => next.pressures = pressures,
                     Err(_) => flags.insert(Flags::DEGRADED),
                 }
@@ -478,13 +360,10 @@ impl Sim {
             flags.insert(Flags::SENSOR_FAULT);
         }
         if next != self.applied || self.stale {
-            match self.statics_at(next) {
-                Ok(s) => {
-                    self.statics = s;
-                    self.stale = false;
-                }
-                Err(_) => self.stale = true,
-            }
+            // Every job at once at the inputs (the estimator runs them in
+            // rotation); a refusal leaves the twin's last oil and the last
+            // results, flagged, until the inputs are usable.
+            self.stale = self.plant.refresh(&self.estimator, next.t, 0.0).is_err();
             self.applied = next;
         }
         flags
@@ -493,67 +372,23 @@ impl Sim {
     /// `n` ticks of `tick` [s] with the inputs held.
     fn step(&mut self, inputs: Inputs, n: u64, tick: f64) -> Result<(), String> {
         let mut flags = self.apply(inputs);
-        if self.twin.config().tick != tick {
-            self.twin
-                .set_tick(tick)
+        let twin = self.plant.twin_mut();
+        if twin.config().tick != tick {
+            twin.set_tick(tick)
                 .map_err(|e| model_error(&format!("a tick of {tick} s"), e))?;
         }
         for _ in 0..n {
-            if self.twin.tick().is_err() {
-                // As the estimator: a failed tick (never seen with valid
-                // parameters) restarts the twin at rest in the equilibrium.
-                self.restart()?;
-                flags.insert(Flags::DEGRADED);
-            }
+            // As the estimator: a failed tick (never seen with valid
+            // parameters) restarts the twin at rest in the equilibrium.
+            self.plant.advance(&mut flags).map_err(|e| {
+                model_error(&format!("restarting the twin at {} degC", self.applied.t), e)
+            })?;
         }
-        if self.stale {
-            flags.insert(Flags::DEGRADED);
-        }
-        let mut all = self.base_flags();
-        all.insert(flags);
-        self.publish(all);
-        Ok(())
-    }
-
-    /// A new twin at rest in the equilibrium of the applied temperature and
-    /// the design's drop, given the applied pressures and the current tick.
-    fn restart(&mut self) -> Result<(), String> {
-        let what = || format!("restarting the twin at {} degC", self.applied.t);
-        let tick = self.twin.config().tick;
-        let mut twin = Twin::new(
-            &self.params,
-            TwinConfig {
-                tick: self.tick,
-                ..self.twin.config()
-            },
-            self.applied.t,
-        )
-        .map_err(|e| model_error(&what(), e))?;
-        let (ps, po) = self.applied.pressures;
-        twin.set_pressures(ps, po).map_err(|e| model_error(&what(), e))?;
-        twin.set_tick(tick).map_err(|e| model_error(&what(), e))?;
-        self.twin = twin;
+        self.publish(flags);
         Ok(())
     }
 }
 
-/// The parameters with the port pressures `(p_supply, p_outlet)` [Pa] as
-/// the design's operating point (for the closed forms at the current drop).
-fn pressures_of(params: &Params<f32>, (supply, outlet): (f32, f32)) -> Params<f32> {
-    Params {
-        pressure_drop: supply - outlet,
-        outlet_pressure: outlet,
-        ..*params
-    }
-}
-
-/// The schema's `operating.pressure_drop` (its plausible range bounds the
-/// drops the flags call in range).
-static DROP_FIELD: std::sync::LazyLock<&'static compensator_params::Field> = std::sync::LazyLock::new(|| {
-    fields()
-        .find(|f| f.path == "operating.pressure_drop")
-        .expect("the schema has operating.pressure_drop")
-});
 
 /// One FMU instance.
 #[derive(Clone, Debug)]
@@ -632,7 +467,7 @@ impl Instance {
 
     /// The twin's configuration (once initialised).
     pub fn twin_config(&self) -> Option<TwinConfig> {
-        self.sim.as_ref().map(|s| s.twin.config())
+        self.sim.as_ref().map(|s| s.plant.twin().config())
     }
 
     /// The inputs as they stand: `p_supply`, `p_outlet` at their start
@@ -939,8 +774,8 @@ impl Instance {
                 b.extend_from_slice(&s.applied.pressures.0.to_le_bytes());
                 b.extend_from_slice(&s.applied.pressures.1.to_le_bytes());
                 b.extend_from_slice(&s.time.to_le_bytes());
-                b.extend_from_slice(&s.twin.config().tick.to_le_bytes());
-                let m = s.twin.memory();
+                b.extend_from_slice(&s.plant.twin().config().tick.to_le_bytes());
+                let m = s.plant.twin().memory();
                 for v in m.state {
                     b.extend_from_slice(&v.to_le_bytes());
                 }
@@ -1012,7 +847,7 @@ impl Instance {
                 // The twin rebuilt along the same path (built at t_init at
                 // the design's pressures, then given the last temperature
                 // and pressures and the last tick), then its memory.
-                let chosen = self.sim.as_ref().map(|s| (&s.raw, s.twin.config()));
+                let chosen = self.sim.as_ref().map(|s| (&s.raw, s.plant.twin().config()));
                 let raw = setup.to_raw().map_err(Failure::Refused)?;
                 let (ps, po) = pressures_start(&raw);
                 let designed = Inputs {
@@ -1031,10 +866,11 @@ impl Instance {
                         "FMU state: its temperature or pressures no longer apply".into(),
                     ));
                 }
-                sim.twin
+                sim.plant
+                    .twin_mut()
                     .set_tick(tick)
                     .map_err(|e| Failure::Refused(model_error("FMU state: tick", e)))?;
-                sim.twin.restore(&TwinMemory {
+                sim.plant.twin_mut().restore(&TwinMemory {
                     state,
                     xi_carry,
                     abrupt,

@@ -42,9 +42,7 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
             let caught = missed.min(MAX_CATCH_UP);
             self.lost_ticks = self.lost_ticks.saturating_add(missed - caught);
             for _ in 0..caught {
-                // A failed step is the next tick's to handle (it restarts
-                // the twin, flagged): nothing to add here.
-                let _ = self.twin.tick();
+                self.plant.coast();
                 self.observer.predict(self.config.observer_design());
             }
             // The tick counter (telemetry's cadence, staleness) follows real

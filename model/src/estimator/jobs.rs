@@ -17,9 +17,6 @@ use crate::params::Params;
 use crate::scalar::Real;
 use crate::throttle::FlowLaws;
 use crate::uncertainty::{Uncertainty, UncertaintyTable};
-use core::borrow::Borrow;
-
-use super::{EstimatorConfig, ObserverDesign, OilObserver};
 
 /// The temperature-only jobs, one per tick in turn (the uncertainty's
 /// depends on the observer's variance too).
@@ -97,6 +94,12 @@ impl Design {
             machine_mu_ref,
         }
     }
+
+    /// The oil's dynamic viscosity at the machine's reference temperature
+    /// \[Pa s\] (NaN without a `[machine]`).
+    pub(super) fn machine_mu_ref(self) -> f32 {
+        self.machine_mu_ref
+    }
 }
 
 /// Results that depend on the temperature only. Each tick that is not a
@@ -170,17 +173,76 @@ impl Statics {
     }
 }
 
-/// Runs `job` at the estimated oil temperature `t` [C], updating
-/// `statics`. On an error the job's previous results stay in force.
+/// Moves the twin's oil and the flow laws towards `target` \[C\], at most
+/// by what changes the capillary conductance (~ 1 / mu) by `slew`
+/// (relative); `statics.slewing` says whether the limit held it short.
+fn move_oil<T: Real>(
+    p: &Params<f32>,
+    twin: &mut Twin<f32, T>,
+    design: Design,
+    statics: &mut Statics,
+    target: f32,
+    slew: f32,
+) -> Result<(), ModelError> {
+    let prev = &statics.point;
+    let now = prev.state.temperature;
+    let dln_mu = libm::fabsf(prev.viscosity.d1 / prev.viscosity.value + prev.density.d1 / prev.density.value);
+    let max_step = if dln_mu > 0.0 { slew / dln_mu } else { f32::INFINITY };
+    // max/min, not `f32::clamp`: its assertion formats f32 with
+    // core::fmt, 17 KiB of flash on the controller.
+    let step = (target - now).max(-max_step).min(max_step);
+    let point = p.oil.point(now + step)?;
+    statics.slewing = step != target - now;
+    apply(p, twin, design, statics, point)
+}
+
+/// The twin's oil and the flow laws at `t` \[C\] at once (the Fluid job's
+/// last step; a co-simulation's input, which the twin grades itself when
+/// the change is abrupt).
+pub(super) fn set_oil<T: Real>(
+    p: &Params<f32>,
+    twin: &mut Twin<f32, T>,
+    design: Design,
+    statics: &mut Statics,
+    t: f32,
+) -> Result<(), ModelError> {
+    let point = p.oil.point(t)?;
+    apply(p, twin, design, statics, point)
+}
+
+/// The twin's oil and the flow laws at `point`.
+fn apply<T: Real>(
+    p: &Params<f32>,
+    twin: &mut Twin<f32, T>,
+    design: Design,
+    statics: &mut Statics,
+    point: FluidPoint<f32>,
+) -> Result<(), ModelError> {
+    twin.set_fluid(&point.state)?;
+    statics.point = point;
+    statics.flows = FlowLaws::new(
+        &p.capillary,
+        &p.orifice,
+        design.slot_window_factor,
+        point.state.density,
+        point.state.dynamic_viscosity,
+    );
+    Ok(())
+}
+
+/// Runs `job` at the estimated oil temperature `t` \[C\], updating
+/// `statics`; `variance` gives the oil temperature's variance \[C^2\] for
+/// the Uncertainty job (the table's input). On an error the job's previous
+/// results stay in force.
 #[allow(clippy::too_many_arguments, reason = "the tick's state, borrowed apart")]
-pub(super) fn run<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Copy>(
+pub(super) fn run<T: Real>(
     job: Job,
     p: &Params<f32>,
-    config: &EstimatorConfig<U, O>,
+    table: &UncertaintyTable,
     twin: &mut Twin<f32, T>,
     design: Design,
     t: f32,
-    observer: &OilObserver,
+    variance: impl FnOnce() -> f32,
     statics: &mut Statics,
 ) -> Result<(), ModelError> {
     match job {
@@ -190,28 +252,7 @@ pub(super) fn run<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<Observe
             // the spike filter takes as real reaches the twin as a
             // fast ramp, never as an abrupt change (which the twin
             // would grade, at several substeps' cost: `Twin::tick`).
-            let prev = &statics.point;
-            let now = prev.state.temperature;
-            let dln_mu = libm::fabsf(prev.viscosity.d1 / prev.viscosity.value + prev.density.d1 / prev.density.value);
-            let max_step = if dln_mu > 0.0 {
-                TWIN_SLEW / dln_mu
-            } else {
-                f32::INFINITY
-            };
-            // max/min, not `f32::clamp`: its assertion formats f32 with
-            // core::fmt, 17 KiB of flash on the controller.
-            let step = (t - now).max(-max_step).min(max_step);
-            let point = p.oil.point(now + step)?;
-            statics.slewing = step != t - now;
-            twin.set_fluid(&point.state)?;
-            statics.point = point;
-            statics.flows = FlowLaws::new(
-                &p.capillary,
-                &p.orifice,
-                design.slot_window_factor,
-                point.state.density,
-                point.state.dynamic_viscosity,
-            );
+            move_oil(p, twin, design, statics, t, TWIN_SLEW)?;
         }
         Job::Equilibrium => {
             let point = &statics.point;
@@ -269,7 +310,7 @@ pub(super) fn run<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<Observe
             };
         }
         Job::Uncertainty => {
-            statics.uncertainty = config.table().at(t, observer.variance(config.observer_design()));
+            statics.uncertainty = table.at(t, variance());
         }
     }
     Ok(())

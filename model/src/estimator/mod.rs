@@ -36,14 +36,17 @@
 //! The pieces, one concept per file: [`EstimatorConfig`] and its
 //! [`TemperatureRange`]s (`config`); the oil-temperature observer
 //! ([`OilObserver`], [`ObserverDesign`], `observer`) and its spike gate
-//! ([`SpikeGate`], `spike`); the jobs of step 4 and the results they keep
-//! (`jobs`); the stability test and decay-rate bound of the Stability job
+//! ([`SpikeGate`], `spike`); the plant observer of steps 3-5, driven by a
+//! temperature rather than samples (the twin, the rotation of the jobs,
+//! the consistency check, the publication: [`Plant`], `plant`, which the
+//! FMU drives with its inputs); the jobs of step 4 and the results they
+//! keep (`jobs`); the stability test and decay-rate bound of the Stability job
 //! ([`quartic_hurwitz`], [`slowest_decay_rate`], `stability`); the flags
 //! ([`Flags`], `flags`); the estimate ([`StateEstimate`], `estimate`) and
 //! its telemetry record, declared once as a table ([`telemetry`]). The
 //! flows of step 5 are the throttle laws'
 //! ([`FlowLaws`](crate::throttle::FlowLaws)). This module runs the tick:
-//! the sequence above, the rotation of the jobs and the consistency check.
+//! the sequence above, when a job runs and when an estimate is published.
 //!
 //! A consistency check catches a twin that settled where the physics does
 //! not: once the twin's temperature has stayed within [`STEADY_BAND`] for
@@ -68,6 +71,7 @@ mod estimate;
 mod flags;
 mod jobs;
 mod observer;
+mod plant;
 mod spike;
 mod stability;
 pub mod telemetry;
@@ -80,10 +84,10 @@ pub use observer::{
     CUSUM_DRIFT, CUSUM_THRESHOLD, DesignError, HOLD_RATIO, ModeGains, NO_LAG, ObserverDesign, ObserverSettings,
     OilObserver,
 };
+pub use plant::Plant;
 pub use spike::{SpikeGate, SpikeSettings, Verdict};
 pub use stability::{quartic_hurwitz, slowest_decay_rate};
 
-use crate::asymptotic;
 use crate::dynamics::Twin;
 use crate::error::ModelError;
 use crate::params::Params;
@@ -91,7 +95,6 @@ use crate::scalar::Real;
 use crate::sensor::SensorFault;
 use crate::uncertainty::{Uncertainty, UncertaintyTable};
 use core::borrow::Borrow;
-use jobs::{Design, Job, Statics};
 
 /// Largest relative change of the twin's capillary conductance (~ 1 / mu)
 /// per Fluid job: below the twin's `ABRUPT_CHANGE` (1 %), so that the twin
@@ -158,38 +161,16 @@ pub const P_TOLERANCE: f32 = 1e-2;
 /// else (observer, jobs, flows) is `f32`.
 #[derive(Clone, Copy, Debug)]
 pub struct Estimator<T = f32, U = UncertaintyTable, O = ObserverDesign> {
-    params: Params<f32>,
     config: EstimatorConfig<U, O>,
-    twin: Twin<f32, T>,
+    /// The twin, its jobs and the consistency check (steps 3-5 of the
+    /// tick), driven by the observer's temperature.
+    plant: Plant<T>,
     /// The oil-temperature observer (steps 1-2 of the tick).
     observer: OilObserver,
-    /// Jobs whose last run failed, one bit per [`Job`] (the oil model
-    /// refused the temperature: the previous results stay in force). The
-    /// estimate is degraded until each of them succeeds again.
-    failed_jobs: u8,
     /// Ticks since the last accepted sample.
     since_sample: u32,
     tick: u32,
-    monotonic: bool,
-    /// Constants of the design the jobs need.
-    design: Design,
-    /// Temperature-only results, refreshed in rotation (see [`Job`]).
-    statics: Statics,
-    /// The job of the next tick that is not a telemetry tick.
-    next_job: Job,
     last: Option<StateEstimate>,
-    /// Filtered temperature at the start of the current steady stretch [C].
-    steady_anchor: f32,
-    /// Ticks that ran a job while the filtered temperature stayed within
-    /// [`STEADY_BAND`] of `steady_anchor` (or since the last re-seat).
-    steady_ticks: u32,
-    /// Re-seats of the twin so far (saturating).
-    reseats: u32,
-    /// Consistency checks run so far (saturating).
-    checks: u32,
-    /// The last check re-seated the twin (raises `TWIN_RESEATED` until a
-    /// check finds it in agreement).
-    reseated: bool,
     /// This tick's estimate is to be published ([`Estimator::telemetry_due`]).
     publish: bool,
     /// A publication was due on a tick the twin spent on an event: the
@@ -233,49 +214,16 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
     /// * a temperature-only job fails at `initial` (the equilibrium, its
     ///   sensitivity or the machine's losses not finite).
     pub fn with_scalar(params: &Params<f32>, config: EstimatorConfig<U, O>, initial: f32) -> Result<Self, ModelError> {
-        let monotonic = asymptotic::monotonicity(params, config.valid.min, config.valid.max, 201)
-            .map(|m| m.monotonic)
-            .unwrap_or(false);
-        let twin = Twin::new(params, config.twin, initial)?;
-        let machine_mu_ref = match &params.machine {
-            Some(m) => params.oil.state(m.leakage_temperature)?.dynamic_viscosity,
-            None => f32::NAN,
-        };
-        let point = params.oil.point(initial)?;
-        let design = Design::new(params, machine_mu_ref);
-        let mut statics = Statics::new(point, config.tick());
-        let mut twin = twin;
         let observer = OilObserver::new(initial);
-        for job in Job::ALL {
-            jobs::run(
-                job,
-                params,
-                &config,
-                &mut twin,
-                design,
-                initial,
-                &observer,
-                &mut statics,
-            )?;
-        }
+        let variance = observer.variance(config.observer_design());
+        let plant = Plant::new(params, &config, initial, variance)?;
         Ok(Estimator {
-            params: *params,
             config,
-            twin,
+            plant,
             observer,
-            failed_jobs: 0,
             since_sample: 0,
             tick: 0,
-            monotonic,
-            design,
-            statics,
-            next_job: Job::Fluid,
             last: None,
-            steady_anchor: initial,
-            steady_ticks: 0,
-            reseats: 0,
-            checks: 0,
-            reseated: false,
             publish: false,
             telemetry_pending: false,
             deadline_misses: 0,
@@ -286,23 +234,21 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
     }
 
     /// The time constant of the twin's slowest mode at the last Stability
-    /// job \[s\]: `1 / sigma`, with `sigma` a lower bound (within 25 %) of the
-    /// smallest decay rate `-Re(lambda)` of the linearisation at the
-    /// equilibrium. Infinite while the linearisation is not stable.
+    /// job \[s\] ([`Plant::slowest_time_constant`]).
     pub fn slowest_time_constant(&self) -> f32 {
-        self.statics.slowest_time_constant
+        self.plant.slowest_time_constant()
     }
 
     /// Consistency checks run since start (saturating): each compared the
     /// settled twin with the closed form, and re-seated it or not.
     pub fn consistency_checks(&self) -> u32 {
-        self.checks
+        self.plant.consistency_checks()
     }
 
     /// Steady ticks the consistency check waits for at the last Stability
     /// job (`u32::MAX`: it does not run, the linearisation is not stable).
     pub fn settle_ticks(&self) -> u32 {
-        self.statics.settle_ticks
+        self.plant.settle_ticks()
     }
 
     /// The oil-temperature observer.
@@ -326,21 +272,23 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
 
     /// The twin.
     pub fn twin(&self) -> &Twin<f32, T> {
-        &self.twin
+        self.plant.twin()
     }
 
     /// The twin, mutable: to inject a fault (a wrong state, with
     /// [`Twin::set_state`]) and watch the consistency check undo it.
     pub fn twin_mut(&mut self) -> &mut Twin<f32, T> {
-        &mut self.twin
+        self.plant.twin_mut()
+    }
+
+    /// The plant observer: the twin, its jobs and the consistency check.
+    pub fn plant(&self) -> &Plant<T> {
+        &self.plant
     }
 
     /// One tick with this tick's sample (see the module docs).
     pub fn tick(&mut self, sample: Result<Option<f32>, SensorFault>) -> StateEstimate {
         let mut flags = Flags::empty();
-        if !self.monotonic {
-            flags.insert(Flags::NOT_UNIQUE);
-        }
         if core::mem::take(&mut self.late) {
             flags.insert(Flags::DEADLINE_MISSED);
         }
@@ -364,9 +312,7 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
         // The estimated oil temperature, inside the range the oil model is
         // used in (the observer may overshoot it for a moment).
         let t = self.observer.oil().max(self.config.oil.min).min(self.config.oil.max);
-        if !self.config.valid.contains(t) {
-            flags.insert(Flags::OUT_OF_RANGE);
-        }
+        flags.insert(self.plant.flags_at(&self.config, t));
         match self.update(t, &mut flags) {
             Ok(e) => {
                 self.last = Some(e);
@@ -376,17 +322,18 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
                 // The model cannot evaluate this temperature: keep the last
                 // estimate's physics, flagged.
                 flags.insert(Flags::DEGRADED);
+                let reseats = self.plant.reseats();
                 let mut e = self.last.unwrap_or(StateEstimate::without_physics(
                     0,
                     t,
                     self.observer.last_reading(),
-                    self.reseats,
+                    reseats,
                     flags,
                 ));
                 e.tick = self.tick;
                 e.temperature = t;
                 e.t_probe = self.observer.last_reading();
-                e.reseats = self.reseats;
+                e.reseats = reseats;
                 e.deadline_misses = self.deadline_misses;
                 e.flags = flags;
                 e
@@ -399,17 +346,7 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
         // steps more, and the tick then runs neither a job nor telemetry
         // (both wait for the next tick), so that the worst tick stays the
         // twin's plain tick plus the larger of one job or the telemetry.
-        let p = &self.params;
-        let event = match self.twin.tick() {
-            Ok(report) => report.eventful(),
-            Err(_) => {
-                // A failed step (never seen with valid parameters): restart
-                // from the equilibrium rather than continue from garbage.
-                self.twin = Twin::new(p, self.twin.config(), self.statics.point.state.temperature)?;
-                flags.insert(Flags::DEGRADED);
-                true
-            }
-        };
+        let event = self.plant.advance(flags)?;
         // A plunger resting on a stop where the force is nearly zero can
         // have an event every tick (released and stopped again, within the
         // tick), while the oil that would move it on is the Fluid job's to
@@ -424,127 +361,17 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
         self.publish = due && !eventful;
         self.telemetry_pending = due && eventful;
         if !due && !eventful {
-            // The steady stretch, counted in ticks that run a job (a
-            // telemetry tick only publishes): the window in time is at
-            // least as long, and the telemetry tick, the costliest, is
-            // spared. A drift out of the band shows at the next job tick.
-            // The twin's temperature (it follows the filter at most at
-            // its slew rate): steady once it has arrived and stays.
-            let tw = self.statics.point.state.temperature;
-            if libm::fabsf(tw - self.steady_anchor) <= STEADY_BAND {
-                self.steady_ticks = self.steady_ticks.saturating_add(1);
-            } else {
-                self.steady_anchor = tw;
-                self.steady_ticks = 0;
-            }
-            // While the twin's oil is on its way to a new temperature, every
-            // job tick moves it on (the other jobs' results wait: the
-            // temperature they belong to is moving).
-            let job = if self.statics.slewing {
-                Job::Fluid
-            } else {
-                let job = self.next_job;
-                self.next_job = job.next();
-                job
-            };
-            // A temperature the model refuses leaves the job's previous
-            // results in force; the estimate goes on, flagged, until the
-            // job succeeds again.
-            match jobs::run(
-                job,
-                &self.params,
-                &self.config,
-                &mut self.twin,
-                self.design,
-                t,
-                &self.observer,
-                &mut self.statics,
-            ) {
-                Ok(()) => {
-                    self.failed_jobs &= !job.bit();
-                    if job == Job::Equilibrium {
-                        self.check_twin();
-                    }
-                }
-                Err(_) => self.failed_jobs |= job.bit(),
-            }
+            // A job tick (a telemetry tick only publishes: the costliest
+            // tick is spared).
+            let (observer, design) = (&self.observer, self.config.observer_design());
+            self.plant.run_job(self.config.table(), t, || observer.variance(design));
         }
-        if self.failed_jobs != 0 {
-            flags.insert(Flags::DEGRADED);
-        }
-        if self.reseated {
-            flags.insert(Flags::TWIN_RESEATED);
-        }
-        let p = &self.params;
-        if !self.statics.stable {
-            flags.insert(Flags::UNSTABLE);
-        }
-        let s = self.twin.state();
-        let [xi, ..] = self.twin.raw_state();
-        if xi <= T::ZERO || xi >= T::ONE {
-            flags.insert(Flags::AT_STOP);
-        }
-        let st = &self.statics;
-        let q_a = st.flows.capillary_flow(s.p_a - p.outlet_pressure);
-        let q_b = st.flows.orifice_flow(s.p_b - p.outlet_pressure);
-        let q_throt = st.flows.window_flow(s.x);
-        let q_total = q_a + q_b + q_throt;
-        let compensation_error = match &p.machine {
-            Some(m) => q_total - (m.working_flow + st.losses),
-            None => f32::NAN,
-        };
-        Ok(StateEstimate {
-            tick: self.tick,
-            temperature: t,
-            t_probe: self.observer.last_reading(),
-            x: s.x,
-            v: s.v,
-            p_a: s.p_a,
-            p_b: s.p_b,
-            q_a,
-            q_b,
-            q_throt,
-            q_total,
-            compensation_error,
-            x_equilibrium: st.x_equilibrium,
-            dx_dt: st.dx_dt,
-            reseats: self.reseats,
-            deadline_misses: self.deadline_misses,
-            uncertainty: st.uncertainty,
-            flags: *flags,
-        })
-    }
-
-    /// The consistency check, right after a successful Equilibrium job:
-    /// once the temperature has been steady for the settling window, the
-    /// twin must sit within [`X_TOLERANCE`] of the stroke and
-    /// [`P_TOLERANCE`] of `dp` of the closed-form equilibrium (clamped to
-    /// the stops, in the twin's model units, where both are fractions
-    /// already). Otherwise it is put there at rest, counted, flagged, and
-    /// given a new window before the next check. Skipped while any job's
-    /// results are stale (the equilibrium may not be the twin's) or the
-    /// linearisation is unstable (no attracting equilibrium to agree with).
-    fn check_twin(&mut self) {
-        let st = &self.statics;
-        if self.failed_jobs != 0 || !st.stable || self.steady_ticks < st.settle_ticks {
-            return;
-        }
-        self.checks = self.checks.saturating_add(1);
-        let [xi, _, pi_a, pi_b] = self.twin.raw_state().map(Real::to_f32);
-        let [xi_eq, _, pi_a_eq, pi_b_eq] = st.y_equilibrium;
-        // Written so that a NaN state fails the check too.
-        let agrees = libm::fabsf(xi - xi_eq) <= X_TOLERANCE
-            && libm::fabsf(pi_a - pi_a_eq) <= P_TOLERANCE
-            && libm::fabsf(pi_b - pi_b_eq) <= P_TOLERANCE;
-        if agrees {
-            self.reseated = false;
-        } else {
-            let at_rest = self.twin.model().scales.to_si(&st.y_equilibrium);
-            self.twin.set_state(&at_rest);
-            self.reseats = self.reseats.saturating_add(1);
-            self.reseated = true;
-            self.steady_ticks = 0;
-        }
+        let mut e = self.plant.estimate(t, *flags);
+        e.tick = self.tick;
+        e.t_probe = self.observer.last_reading();
+        e.deadline_misses = self.deadline_misses;
+        *flags = e.flags;
+        Ok(e)
     }
 
     /// `true` when this tick's estimate should be published: every
