@@ -92,11 +92,13 @@ fn a_tick_later_than_the_catch_up_loses_the_rest_counted() {
     let e = est.tick_after(Ok(None), gap);
     assert_eq!(e.deadline_misses, gap - 1);
     assert_eq!(est.lost_ticks(), 5);
+    // The estimate (and so its telemetry record) carries the count.
+    assert_eq!(e.lost_ticks, 5);
     assert_eq!(e.tick, gap);
     assert!(e.flags.contains(Flags::DEADLINE_MISSED));
     // No elapsed time at all is taken as one tick.
     let e = est.tick_after(Ok(None), 0);
-    assert_eq!((e.tick, e.deadline_misses), (gap + 1, gap - 1));
+    assert_eq!((e.tick, e.deadline_misses, e.lost_ticks), (gap + 1, gap - 1, 5));
 }
 
 #[test]

@@ -95,6 +95,7 @@ fn the_estimator_publishes_its_plants_estimate() {
     from_plant.tick = e.tick;
     from_plant.t_probe = e.t_probe;
     from_plant.deadline_misses = e.deadline_misses;
+    from_plant.lost_ticks = e.lost_ticks;
     assert_eq!(from_plant, e);
     assert!(e.x.is_finite() && e.q_total > 0.0, "{e:?}");
 }

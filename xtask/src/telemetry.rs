@@ -272,6 +272,7 @@ mod tests {
             dx_dt: 3.7e-5,
             reseats: 2,
             deadline_misses: 0,
+            lost_ticks: 0,
             uncertainty: compensator::uncertainty::Uncertainty {
                 t_oil: 0.31,
                 x: 7.8e-6,
@@ -338,7 +339,7 @@ mod tests {
     fn the_readable_line_is_rounded_to_what_the_sensor_resolves() {
         assert_eq!(
             humanize(&line("INFO  ", 12999, &estimate(Flags::empty()))),
-            "INFO  12999 ms t_probe=35.31 t=35.79 u_t=0.310 C x=12.9 u_x=7.80 um v=0.038 mm/s p_a=196.2 u_p_a=1.28 p_b=203.8 u_p_b=1.28 kPa Q_a=0.307 Q_b=0.307 Q_throt=0.092 Q0=0.706 u_Q0=0.0582 err=-1.028 u_err=0.0126 l/min reseats=2 missed=0 [-]"
+            "INFO  12999 ms t_probe=35.31 t=35.79 u_t=0.310 C x=12.9 u_x=7.80 um v=0.038 mm/s p_a=196.2 u_p_a=1.28 p_b=203.8 u_p_b=1.28 kPa Q_a=0.307 Q_b=0.307 Q_throt=0.092 Q0=0.706 u_Q0=0.0582 err=-1.028 u_err=0.0126 l/min reseats=2 missed=0 lost=0 [-]"
         );
         assert_eq!(fixed(-0.0001, 3), "0.000");
         assert_eq!(fixed(-0.0006, 3), "-0.001");
@@ -360,7 +361,7 @@ mod tests {
         let text = std::fs::read_to_string(&path).unwrap();
         assert_eq!(
             text.lines().next().unwrap(),
-            "time_s,t_probe_c,t_oil_c,t_oil_sd_c,x_m,x_sd_m,v_m_s,p_a_pa,p_a_sd_pa,p_b_pa,p_b_sd_pa,q_a_m3s,q_b_m3s,q_throt_m3s,q_total_m3s,q_total_sd_m3s,compensation_error_m3s,compensation_error_sd_m3s,reseats,deadline_misses,flags"
+            "time_s,t_probe_c,t_oil_c,t_oil_sd_c,x_m,x_sd_m,v_m_s,p_a_pa,p_a_sd_pa,p_b_pa,p_b_sd_pa,q_a_m3s,q_b_m3s,q_throt_m3s,q_total_m3s,q_total_sd_m3s,compensation_error_m3s,compensation_error_sd_m3s,reseats,deadline_misses,lost_ticks,flags"
         );
         assert!(
             text.lines()

@@ -43,6 +43,11 @@ pub struct StateEstimate {
     /// elapsed while the controller was still busy with an earlier one
     /// ([`Estimator::tick_after`](super::Estimator::tick_after)).
     pub deadline_misses: u32,
+    /// Ticks of real time the twin did not advance through since start
+    /// (saturating): late ticks beyond the catch-up bound
+    /// ([`MAX_CATCH_UP`](super::MAX_CATCH_UP)) each; 0 while the twin's
+    /// simulated time is the real time.
+    pub lost_ticks: u32,
     /// Standard uncertainties of the estimate (`k = 1`), refreshed in the
     /// job rotation.
     pub uncertainty: Uncertainty,
@@ -72,6 +77,7 @@ impl StateEstimate {
             dx_dt: f32::NAN,
             reseats,
             deadline_misses: 0,
+            lost_ticks: 0,
             uncertainty: Uncertainty::UNKNOWN,
             flags,
         }

@@ -335,6 +335,7 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
                 e.t_probe = self.observer.last_reading();
                 e.reseats = reseats;
                 e.deadline_misses = self.deadline_misses;
+                e.lost_ticks = self.lost_ticks;
                 e.flags = flags;
                 e
             }
@@ -370,6 +371,7 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
         e.tick = self.tick;
         e.t_probe = self.observer.last_reading();
         e.deadline_misses = self.deadline_misses;
+        e.lost_ticks = self.lost_ticks;
         *flags = e.flags;
         Ok(e)
     }

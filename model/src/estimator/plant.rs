@@ -353,7 +353,7 @@ impl<T: Real> Plant<T> {
     /// on a stop: `AT_STOP`): the state, the flows at the applied outlet
     /// pressure, the compensation error, the last equilibrium and
     /// uncertainty. The fields that are the caller's (`tick`, `t_probe`,
-    /// `deadline_misses`) are 0 and NaN.
+    /// `deadline_misses`, `lost_ticks`) are 0 and NaN.
     pub fn estimate(&self, t: f32, mut flags: Flags) -> StateEstimate {
         if self.failed_jobs != 0 {
             flags.insert(Flags::DEGRADED);
@@ -396,6 +396,7 @@ impl<T: Real> Plant<T> {
             dx_dt: st.dx_dt,
             reseats: self.reseats,
             deadline_misses: 0,
+            lost_ticks: 0,
             uncertainty: st.uncertainty,
             flags,
         }

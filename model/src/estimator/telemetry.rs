@@ -567,6 +567,8 @@ telemetry_table! {
     reseats ["-", u32] shown ["reseats", "", 1.0, 0] = |e| e.reseats;
     /// Tick deadlines the controller missed since start.
     deadline_misses ["-", u32] shown ["missed", "", 1.0, 0] = |e| e.deadline_misses;
+    /// Ticks of real time the twin did not advance through since start.
+    lost_ticks ["-", u32] shown ["lost", "", 1.0, 0] = |e| e.lost_ticks;
 }
 
 #[cfg(test)]
