@@ -38,6 +38,7 @@
 
 mod bench;
 mod callgrind;
+mod cycles;
 mod firmware;
 mod flash;
 mod fmu;

@@ -13,6 +13,7 @@
 //! function it was inlined into). The counts are exact instruction counts,
 //! the same measure as `cargo xtask bench` (`-icount shift=0`), not samples.
 
+use crate::cycles::{Core, Timing};
 use crate::firmware::{self, Image};
 use crate::qemu::Machine;
 use crate::toolchain::Toolchain;
@@ -133,6 +134,11 @@ pub struct Section {
     pub worst: Option<(usize, HashMap<String, u64>)>,
     /// Ticks marked in the section (0: the image marks none).
     pub ticks: u64,
+    /// Core cycles of the section's instructions, lower and upper
+    /// ([`crate::cycles`]; 0 without a timing).
+    pub cycles: (u64, u64),
+    /// Core cycles of the worst tick, lower and upper.
+    pub worst_cycles: (u64, u64),
 }
 
 impl Section {
@@ -151,7 +157,20 @@ impl Section {
     pub fn worst_total(&self) -> u64 {
         self.worst.as_ref().map_or(0, |(_, f)| f.values().sum())
     }
+
+    /// Core cycles per instruction over the section, lower and upper
+    /// (NaN without a timing).
+    pub fn cycles_per_instruction(&self) -> (f64, f64) {
+        if self.total == 0 || self.cycles.1 == 0 {
+            return (f64::NAN, f64::NAN);
+        }
+        let t = self.total as f64;
+        (self.cycles.0 as f64 / t, self.cycles.1 as f64 / t)
+    }
 }
+
+/// The tick being counted: its index, instructions per function, cycles.
+type Tick = (usize, HashMap<String, u64>, (u64, u64));
 
 /// The guest program counter of a QEMU `-d exec` line (`Trace 0: 0x... [flags/PC/...] name`).
 pub fn pc_of(line: &str) -> Option<u64> {
@@ -165,6 +184,8 @@ pub fn pc_of(line: &str) -> Option<u64> {
 /// of the function at `mark` (an entry opens a section, the next closes
 /// it), and to ticks between the entries of the function at `tick` (when
 /// the image has one); the markers' own instructions are not counted.
+/// With a `timing`, each instruction's cycles are counted too, a branch as
+/// taken when the next executed instruction is not the one after it.
 ///
 /// # Errors
 ///
@@ -176,6 +197,7 @@ pub fn attribute(
     mark: u64,
     tick: Option<u64>,
     sections: usize,
+    timing: Option<&Timing>,
     messages: &mut Vec<String>,
 ) -> Result<Vec<Section>, String> {
     let mut out = vec![Section::default(); sections];
@@ -185,12 +207,16 @@ pub fn attribute(
     let mut entered: HashMap<&str, u64> = HashMap::new();
     let mut previous: Option<(u64, &str)> = None;
     // The current tick of the open section: its index and its counts.
-    let mut current: Option<(usize, HashMap<String, u64>)> = None;
-    let close = |current: &mut Option<(usize, HashMap<String, u64>)>, section: Option<&mut Section>| {
-        if let (Some(done), Some(section)) = (current.take(), section) {
-            let total: u64 = done.1.values().sum();
+    let mut current: Option<Tick> = None;
+    // The last counted instruction, whose cycles wait for the next
+    // executed address (taken or not).
+    let mut pending: Option<u64> = None;
+    let close = |current: &mut Option<Tick>, section: Option<&mut Section>| {
+        if let (Some((index, counts, cycles)), Some(section)) = (current.take(), section) {
+            let total: u64 = counts.values().sum();
             if total > section.worst_total() {
-                section.worst = Some(done);
+                section.worst = Some((index, counts));
+                section.worst_cycles = cycles;
             }
         }
     };
@@ -207,6 +233,17 @@ pub fn attribute(
             }
             continue;
         };
+        if let Some((from, cost)) = pending.take().and_then(|from| Some((from, timing?.at(from)?))) {
+            let (lo, hi) = cost.cycles(pc != from + u64::from(cost.size));
+            if let Some(section) = out.get_mut(marks / 2) {
+                section.cycles.0 += lo;
+                section.cycles.1 += hi;
+            }
+            if let Some((_, _, c)) = current.as_mut() {
+                c.0 += lo;
+                c.1 += hi;
+            }
+        }
         if pc == mark {
             if !marks.is_multiple_of(2) {
                 close(&mut current, out.get_mut(marks / 2));
@@ -219,7 +256,7 @@ pub fn attribute(
         if Some(pc) == tick && !marks.is_multiple_of(2) {
             let next = current.as_ref().map_or(0, |c| c.0 + 1);
             close(&mut current, out.get_mut(marks / 2));
-            current = Some((next, HashMap::new()));
+            current = Some((next, HashMap::new(), (0, 0)));
             if let Some(section) = out.get_mut(marks / 2) {
                 section.ticks += 1;
             }
@@ -241,6 +278,7 @@ pub fn attribute(
             continue;
         };
         section.total += 1;
+        pending = Some(pc);
         *section.functions.entry(name.to_string()).or_insert(0) += 1;
         let site = entered.get(name).copied().unwrap_or(0);
         *section
@@ -249,7 +287,7 @@ pub fn attribute(
             .or_default()
             .entry(site)
             .or_insert(0) += 1;
-        if let Some((_, counts)) = current.as_mut() {
+        if let Some((_, counts, _)) = current.as_mut() {
             *counts.entry(name.to_string()).or_insert(0) += 1;
         }
     }
@@ -327,7 +365,13 @@ pub fn shorten<'a>(file: &'a str, root: &str) -> &'a str {
 ///
 /// QEMU cannot start, the image fails (non-zero exit: its defmt log says
 /// why under `cargo xtask qemu-runner`), or its marks are missing.
-pub fn run(elf: &Path, symbols: &Symbols, machine: Machine, timeout: Duration) -> Result<Vec<Section>, String> {
+pub fn run(
+    elf: &Path,
+    symbols: &Symbols,
+    timing: Option<&Timing>,
+    machine: Machine,
+    timeout: Duration,
+) -> Result<Vec<Section>, String> {
     let mark = symbols
         .address("profile_mark")
         .ok_or_else(|| format!("{}: no profile_mark symbol", elf.display()))?;
@@ -363,7 +407,7 @@ pub fn run(elf: &Path, symbols: &Symbols, machine: Machine, timeout: Duration) -
     });
     let stderr = BufReader::with_capacity(1 << 20, child.stderr.take().expect("piped"));
     let mut messages = Vec::new();
-    let sections = attribute(stderr, symbols, mark, tick, SECTIONS.len(), &mut messages);
+    let sections = attribute(stderr, symbols, mark, tick, SECTIONS.len(), timing, &mut messages);
     // The trace ended (QEMU closed its log) or could not be read: the
     // watchdog is told before `wait`, so that it never kills a reused pid,
     // and QEMU is stopped if its log was abandoned.
@@ -403,10 +447,13 @@ pub fn report(results: &[(&str, Vec<Section>, Lines)], top: usize) -> String {
     let mut s = String::new();
     for (core, sections, lines) in results {
         for (name, section) in SECTIONS.iter().zip(sections) {
+            let (lo, hi) = section.cycles_per_instruction();
             s += &format!(
-                "\n### {core}: {name} ({} instructions per tick, mean over {} ticks)\n\n| function | per tick | share | called from (per tick) |\n| --- | ---: | ---: | --- |\n",
+                "\n### {core}: {name} ({} instructions per tick, mean over {} ticks; {}-{} cycles per tick, {lo:.2}-{hi:.2} per instruction)\n\n| function | per tick | share | called from (per tick) |\n| --- | ---: | ---: | --- |\n",
                 section.per_tick(section.total),
-                section.tick_count()
+                section.tick_count(),
+                section.per_tick(section.cycles.0),
+                section.per_tick(section.cycles.1),
             );
             let mut rows: Vec<(&String, &u64)> = section.functions.iter().collect();
             rows.sort_by(|a, b| b.1.cmp(a.1).then(a.0.cmp(b.0)));
@@ -448,8 +495,10 @@ pub fn report(results: &[(&str, Vec<Section>, Lines)], top: usize) -> String {
                 rows.sort_by(|a, b| b.1.cmp(a.1).then(a.0.cmp(b.0)));
                 let parts: Vec<String> = rows.iter().take(top).map(|(f, n)| format!("`{f}` {n}")).collect();
                 s += &format!(
-                    "\nWorst tick: tick {k}, {} instructions: {}.\n",
+                    "\nWorst tick: tick {k}, {} instructions ({}-{} cycles): {}.\n",
                     section.worst_total(),
+                    section.worst_cycles.0,
+                    section.worst_cycles.1,
                     parts.join(", ")
                 );
             }
@@ -497,7 +546,8 @@ pub fn cmd(
         eprintln!("xtask: profiling {core} ({target}, QEMU {})", image.machine().name);
         let bytes = std::fs::read(&elf).map_err(|e| format!("{}: {e}", elf.display()))?;
         let symbols = Symbols::of_elf(&bytes).map_err(|e| format!("{}: {e}", elf.display()))?;
-        let sections = run(&elf, &symbols, image.machine(), TIMEOUT)?;
+        let timing = Timing::of_elf(&elf, Core::of_target(target))?;
+        let sections = run(&elf, &symbols, Some(&timing), image.machine(), TIMEOUT)?;
         results.push((core, sections, Lines::new(&elf, root, symbols)));
     }
     let file = params.map_or_else(|| "presets/paper.toml".to_string(), |p| p.display().to_string());
@@ -506,6 +556,31 @@ pub fn cmd(
         report(&results, top)
     );
     Ok(())
+}
+
+/// The estimator section's cycles per instruction on `target`'s core,
+/// lower and upper ([`Section::cycles_per_instruction`]): the profile image
+/// built with `tc` for `params`, traced on QEMU and timed by
+/// [`crate::cycles`]. What `cargo xtask bench` turns instructions into
+/// cycles with.
+///
+/// # Errors
+///
+/// As [`cmd`]; `llvm-objdump` missing.
+pub fn cycles_per_instruction(
+    tc: &Toolchain,
+    root: &Path,
+    params: Option<&Path>,
+    target: &'static str,
+) -> Result<(f64, f64), String> {
+    let image = image(target);
+    let elf = firmware::build(tc, root, &image, params)?;
+    let bytes = std::fs::read(&elf).map_err(|e| format!("{}: {e}", elf.display()))?;
+    let symbols = Symbols::of_elf(&bytes).map_err(|e| format!("{}: {e}", elf.display()))?;
+    let timing = Timing::of_elf(&elf, Core::of_target(target))?;
+    let sections = run(&elf, &symbols, Some(&timing), image.machine(), TIMEOUT)?;
+    let estimator = sections.get(1).ok_or("the profile has no estimator section")?;
+    Ok(estimator.cycles_per_instruction())
 }
 
 /// The core a target is profiled on.
@@ -535,6 +610,34 @@ mod tests {
 
     fn line(pc: u64) -> String {
         format!("Trace 0: 0x7eff7c197200 [00800400/{pc:08x}/00000010/ff000201] whatever\n")
+    }
+
+    #[test]
+    fn cycles_follow_each_instruction_and_whether_its_branch_was_taken() {
+        // tick: a load, a conditional branch taken once and not once, a
+        // return (taken), on the Cortex-M4F.
+        let timing = Timing::of_disassembly(
+            " 8000300: 12 48        \tldr\tr0, [pc, #72]\n 8000302: 01 d0        \tbeq\t0x8000306\n 8000304: 00 bf        \tnop\n 8000306: 70 47        \tbx\tlr\n",
+            Core::M4F,
+        );
+        let mut trace = line(0x0800_0100);
+        for pc in [0x0800_0300, 0x0800_0302, 0x0800_0306, 0x0800_0300, 0x0800_0302, 0x0800_0304, 0x0800_0306] {
+            trace += &line(pc);
+        }
+        // The return's target: back in the (uncounted) caller.
+        trace += &line(0x0800_0100);
+        trace += &line(0x0800_0100);
+        trace += &line(0x0800_0100);
+        let s = symbols();
+        let out = attribute(trace.as_bytes(), &s, 0x0800_0100, None, 2, Some(&timing), &mut Vec::new()).unwrap();
+        // ldr 1-2 twice, beq taken 2-4 and untaken 1, nop 1, bx taken
+        // twice (the second time into the mark) 2-4 each.
+        assert_eq!(out[0].total, 7);
+        assert_eq!(out[0].cycles, (2 + 2 + 1 + 1 + 4, 4 + 4 + 1 + 1 + 8));
+        let (lo, hi) = out[0].cycles_per_instruction();
+        assert!((lo - 10.0 / 7.0).abs() < 1e-12 && (hi - 18.0 / 7.0).abs() < 1e-12);
+        assert_eq!(out[1].cycles, (0, 0));
+        assert!(out[1].cycles_per_instruction().0.is_nan());
     }
 
     #[test]
@@ -581,7 +684,7 @@ mod tests {
         trace += &line(0x0800_0206);
         trace += &line(0x0900_0000); // no symbol
         trace += &line(0x0800_0100);
-        let out = attribute(trace.as_bytes(), &s, 0x0800_0100, None, 2, &mut Vec::new()).unwrap();
+        let out = attribute(trace.as_bytes(), &s, 0x0800_0100, None, 2, None, &mut Vec::new()).unwrap();
         assert_eq!(out[0].total, 3);
         assert_eq!(out[0].functions["tick"], 3);
         assert_eq!(out[1].total, 4);
@@ -625,7 +728,7 @@ mod tests {
             }
             trace += &line(0x0800_0100);
         }
-        let out = attribute(trace.as_bytes(), &s, 0x0800_0100, Some(0x0800_0400), 2, &mut Vec::new()).unwrap();
+        let out = attribute(trace.as_bytes(), &s, 0x0800_0100, Some(0x0800_0400), 2, None, &mut Vec::new()).unwrap();
         assert_eq!(out[0].total, 6);
         assert_eq!(out[0].worst, Some((1, HashMap::from([("tick".to_string(), 3)]))));
         assert_eq!(out[1].worst_total(), 4);
@@ -652,7 +755,7 @@ mod tests {
         trace += &line(0x0800_0100);
         trace += &line(0x0800_0100);
         trace += &line(0x0800_0100);
-        let out = attribute(trace.as_bytes(), &s, 0x0800_0100, None, 2, &mut Vec::new()).unwrap();
+        let out = attribute(trace.as_bytes(), &s, 0x0800_0100, None, 2, None, &mut Vec::new()).unwrap();
         assert_eq!(
             out[0].sites["leaf"],
             HashMap::from([(0x0800_0304, 3), (0x0800_0310, 1)])
@@ -716,7 +819,7 @@ mod tests {
         let s = symbols();
         let trace = "qemu-system-arm: -singlestep: invalid option\n\n";
         let mut messages = Vec::new();
-        let e = attribute(trace.as_bytes(), &s, 0x0800_0100, None, 2, &mut messages).unwrap_err();
+        let e = attribute(trace.as_bytes(), &s, 0x0800_0100, None, 2, None, &mut messages).unwrap_err();
         assert!(e.contains("0 section marks"), "{e}");
         assert_eq!(messages, ["qemu-system-arm: -singlestep: invalid option"]);
     }
@@ -725,7 +828,7 @@ mod tests {
     fn a_run_that_stops_early_is_an_error() {
         let s = symbols();
         let trace = format!("{}{}", line(0x0800_0100), line(0x0800_0300));
-        let e = attribute(trace.as_bytes(), &s, 0x0800_0100, None, 2, &mut Vec::new()).unwrap_err();
+        let e = attribute(trace.as_bytes(), &s, 0x0800_0100, None, 2, None, &mut Vec::new()).unwrap_err();
         assert!(e.contains("1 section marks, expected 4"), "{e}");
     }
 }

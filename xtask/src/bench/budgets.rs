@@ -255,6 +255,7 @@ mod tests {
                     ram: 300,
                 },
             ],
+            cpi: None,
         }
     }
 

@@ -57,6 +57,10 @@ pub struct Firmware {
     /// The board image's, the QEMU twin image's, then the Cortex-M3 and
     /// Cortex-M0 twin images'.
     footprints: Vec<Footprint>,
+    /// Cycles per instruction of the estimator's tick on the Cortex-M4F,
+    /// M3 and M0, lower and upper (`profile::cycles_per_instruction`;
+    /// `None` where not measured).
+    cpi: Option<[(f64, f64); 3]>,
 }
 
 /// The footprint label of the Cortex-M3 twin image.
@@ -107,6 +111,7 @@ pub fn measure_firmware(elfs: &[(Image, PathBuf)], twin_runs: &[(Image, Vec<Stri
         stack,
         fixed_stacks,
         footprints,
+        cpi: None,
     })
 }
 
@@ -121,7 +126,12 @@ pub fn cmd(root: &Path, params: Option<&Path>, write: bool) -> Result<i32, Strin
     eprintln!("xtask: toolchain: {}", tc.description);
     qemu::ensure()?;
     let elfs = crate::firmware::build_all_params(&tc, root, params)?;
-    let fw = measure_firmware(&elfs, &[])?;
+    let mut fw = measure_firmware(&elfs, &[])?;
+    let mut cpi = [(f64::NAN, f64::NAN); 3];
+    for (c, target) in cpi.iter_mut().zip([crate::firmware::M4, crate::firmware::M3, crate::firmware::M0]) {
+        *c = crate::profile::cycles_per_instruction(&tc, root, params, target)?;
+    }
+    fw.cpi = Some(cpi);
     let budget = Budget::of(&fw)?;
     let accuracy = accuracy::points(&fw.m4.configs())?;
     let text = report::document(&fw, &budget, &accuracy);

@@ -108,15 +108,6 @@ pub fn budget_table(fw: &Firmware, budget: &Budget) -> String {
 }
 
 #[cfg(feature = "host")]
-/// Core cycles per executed instruction, per core, for the tick-rate
-/// table: the executed instruction mix of the estimator's tick (measured on
-/// `src/bin/profile.rs` by an earlier trace runner: carried over; `cargo xtask profile` counts per function, not cycles) weighted by each core's cycle counts
-/// (Arm's Technical Reference Manuals: Cortex-M0 DDI 0432C table 3-1,
-/// Cortex-M3 DDI 0337I table 18-1, Cortex-M4 DDI 0439B table 3-1),
-/// rounded up, with zero-wait-state memory.
-pub const CYCLES_PER_INSTRUCTION: [(&str, f64); 3] = [("Cortex-M4F", 1.5), ("Cortex-M3", 1.5), ("Cortex-M0", 1.6)];
-
-#[cfg(feature = "host")]
 /// Clock rates of the tick-rate table [MHz].
 pub const CLOCKS_MHZ: [f64; 3] = [48.0, 72.0, 168.0];
 
@@ -175,11 +166,13 @@ pub fn cores_section(fw: &Firmware) -> String {
         t,
         "\n### The highest tick rate each core sustains\n\nWith 50 % headroom: the worst estimator tick (telemetry included) in the core's arithmetic \
          (f32 with the FPU, Q12.20 without) may take half of the tick's period, at the core's cycles \
-         per instruction (the estimator tick's executed instruction mix weighted by the core's cycle \
-         counts from Arm's Technical Reference Manuals, zero-wait-state memory; the mix was measured on \
-         `src/bin/profile.rs` by an earlier trace runner; `cargo xtask profile`, docs/profile.md, traces \
-         the same image and charges each instruction to its function but does not weigh instructions \
-         by their cycles, so the factors are carried over, not re-measured by a command here): rate = clock / (2 x cycles per instruction x worst instructions).\n"
+         per instruction: the estimator tick of `src/bin/profile.rs` traced on QEMU instruction by \
+         instruction (`cargo xtask profile`, docs/profile.md), each executed instruction given its \
+         cycles from Arm's Technical Reference Manuals (`xtask/src/cycles.rs`: Cortex-M0 DDI 0432C \
+         table 3-1, Cortex-M3 DDI 0337I table 18-1, Cortex-M4 DDI 0439B table 3-1 and its FPU's; a \
+         taken branch as taken; zero-wait-state memory), the lower and upper ends of the manuals' \
+         ranges (branch refill 1-3 cycles, pipelined loads, division 2-12). The rate uses the upper \
+         end: rate = clock / (2 x cycles per instruction x worst instructions).\n"
     );
     let _ = write!(
         t,
@@ -194,12 +187,10 @@ pub fn cores_section(fw: &Firmware) -> String {
         ("Cortex-M3", &fw.m3, "q12.20"),
         ("Cortex-M0", &fw.m0, "q12.20"),
     ] {
-        let cpi = CYCLES_PER_INSTRUCTION
-            .iter()
-            .find(|(c, _)| *c == core)
-            .map_or(f64::NAN, |(_, k)| *k);
+        let i = ["Cortex-M4F", "Cortex-M3", "Cortex-M0"].iter().position(|c| *c == core).unwrap_or(0);
+        let (low, cpi) = fw.cpi.map_or((f64::NAN, f64::NAN), |c| c[i]);
         let worst = costs.estimator(scalar, true).map_or(f64::NAN, |(_, w)| w);
-        let _ = write!(t, "| {core} | {scalar} | {worst:.0} | {cpi} |");
+        let _ = write!(t, "| {core} | {scalar} | {worst:.0} | {low:.2}-{cpi:.2} |");
         for mhz in CLOCKS_MHZ {
             let _ = write!(t, " {:.0} Hz |", mhz * 1e6 / (2.0 * cpi * worst));
         }
