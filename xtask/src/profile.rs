@@ -567,6 +567,7 @@ pub fn cmd(
 /// # Errors
 ///
 /// As [`cmd`]; `llvm-objdump` missing.
+#[cfg_attr(not(feature = "host"), allow(dead_code, reason = "the bench's, a host-only command"))]
 pub fn cycles_per_instruction(
     tc: &Toolchain,
     root: &Path,

@@ -588,13 +588,19 @@ impl<F: Float, T: Real> Twin<F, T> {
             return Ok((end, e | RELEASE));
         }
         // Released where the held force, interpolated linearly over the
-        // step, crosses zero.
+        // step, crosses zero. The pressures there: interpolated over the
+        // held step (as at an impact) in a plain substep, where they drift
+        // slowly; a step to the release in a graded piece, whose transient
+        // the interpolation would cut short.
         let theta = f0 / (f0 - f1);
-        let at = if theta > T::ZERO {
+        let at = if fine && theta > T::ZERO {
             let mut no_carry = T::ZERO;
             self.step(&y0, frac * theta, held, &mut no_carry, fine)?
         } else {
-            y0
+            let mut at = y0;
+            at[2] += theta * (end[2] - y0[2]);
+            at[3] += theta * (end[3] - y0[3]);
+            at
         };
         let rest = frac * (T::ONE - theta);
         if !(rest > T::ZERO) {

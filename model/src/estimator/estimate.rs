@@ -57,8 +57,8 @@ pub struct StateEstimate {
 
 impl StateEstimate {
     /// An estimate at `temperature` [C] without physics: every state, flow
-    /// and equilibrium field NaN (what the estimator reports, flagged, when
-    /// the model refuses a temperature before it has had an estimate).
+    /// and equilibrium field NaN (the telemetry's tests start from it).
+    #[cfg(test)]
     pub(super) const fn without_physics(tick: u32, temperature: f32, t_probe: f32, reseats: u32, flags: Flags) -> Self {
         StateEstimate {
             tick,

@@ -170,7 +170,6 @@ pub struct Estimator<T = f32, U = UncertaintyTable, O = ObserverDesign> {
     /// Ticks since the last accepted sample.
     since_sample: u32,
     tick: u32,
-    last: Option<StateEstimate>,
     /// This tick's estimate is to be published ([`Estimator::telemetry_due`]).
     publish: bool,
     /// A publication was due on a tick the twin spent on an event: the
@@ -223,7 +222,6 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
             observer,
             since_sample: 0,
             tick: 0,
-            last: None,
             publish: false,
             telemetry_pending: false,
             deadline_misses: 0,
@@ -313,41 +311,20 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
         // used in (the observer may overshoot it for a moment).
         let t = self.observer.oil().max(self.config.oil.min).min(self.config.oil.max);
         flags.insert(self.plant.flags_at(&self.config, t));
-        match self.update(t, &mut flags) {
-            Ok(e) => {
-                self.last = Some(e);
-                e
-            }
-            Err(_) => {
-                // The model cannot evaluate this temperature: keep the last
-                // estimate's physics, flagged.
-                flags.insert(Flags::DEGRADED);
-                let reseats = self.plant.reseats();
-                let mut e = self.last.unwrap_or(StateEstimate::without_physics(
-                    0,
-                    t,
-                    self.observer.last_reading(),
-                    reseats,
-                    flags,
-                ));
-                e.tick = self.tick;
-                e.temperature = t;
-                e.t_probe = self.observer.last_reading();
-                e.reseats = reseats;
-                e.deadline_misses = self.deadline_misses;
-                e.lost_ticks = self.lost_ticks;
-                e.flags = flags;
-                e
-            }
-        }
-    }
-
-    fn update(&mut self, t: f32, flags: &mut Flags) -> Result<StateEstimate, ModelError> {
         // The twin first: its events (an impact, a release) cost it a few
         // steps more, and the tick then runs neither a job nor telemetry
         // (both wait for the next tick), so that the worst tick stays the
         // twin's plain tick plus the larger of one job or the telemetry.
-        let event = self.plant.advance(flags)?;
+        let event = match self.plant.advance(&mut flags) {
+            Ok(event) => event,
+            Err(_) => {
+                // Not even a restart could be made (never seen with valid
+                // parameters): the twin's last good state is published,
+                // flagged, and the tick counts as eventful.
+                flags.insert(Flags::DEGRADED);
+                true
+            }
+        };
         // A plunger resting on a stop where the force is nearly zero can
         // have an event every tick (released and stopped again, within the
         // tick), while the oil that would move it on is the Fluid job's to
@@ -367,13 +344,12 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
             let (observer, design) = (&self.observer, self.config.observer_design());
             self.plant.run_job(self.config.table(), t, || observer.variance(design));
         }
-        let mut e = self.plant.estimate(t, *flags);
+        let mut e = self.plant.estimate(t, flags);
         e.tick = self.tick;
         e.t_probe = self.observer.last_reading();
         e.deadline_misses = self.deadline_misses;
         e.lost_ticks = self.lost_ticks;
-        *flags = e.flags;
-        Ok(e)
+        e
     }
 
     /// `true` when this tick's estimate should be published: every

@@ -60,6 +60,7 @@ pub struct Firmware {
     /// Cycles per instruction of the estimator's tick on the Cortex-M4F,
     /// M3 and M0, lower and upper (`profile::cycles_per_instruction`;
     /// `None` where not measured).
+    #[cfg_attr(not(feature = "host"), allow(dead_code, reason = "read by the host-only report"))]
     cpi: Option<[(f64, f64); 3]>,
 }
 
