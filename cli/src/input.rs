@@ -119,6 +119,23 @@ pub fn load_params<T: Float>(path: &Path) -> Result<(RawParams, Params<T>), CliE
     Ok((raw, params))
 }
 
+/// [`load_params`] in `f64` of the file `path`, or without one of the
+/// built-in [`PAPER_PRESET`] (`paper` and `report`).
+///
+/// # Errors
+///
+/// As [`load_params`].
+pub fn load_or_paper(path: Option<&Path>) -> Result<(RawParams, Params<f64>), CliError> {
+    match path {
+        Some(path) => load_params::<f64>(path),
+        None => {
+            let raw = params_file::parse(PAPER_PRESET)?;
+            let p = Params::<f64>::new(&raw).map_err(|e| CliError::Input(e.to_string()))?;
+            Ok((raw, p))
+        }
+    }
+}
+
 /// [`load_params`] in `f64` with the file's temperature envelope.
 ///
 /// # Errors

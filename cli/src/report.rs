@@ -13,7 +13,7 @@
 use crate::csv::{self, Table};
 use crate::dynamics::{Precision, eigen_table, simulate, step_indicators};
 use crate::error::CliError;
-use crate::input::load_params;
+use crate::input::load_or_paper;
 use crate::paper::tables::{BAR, load_tables, table1_residuals, table2_residuals};
 use crate::paper::{self, asymptotic_search};
 use crate::plot::{self, Figure, Series, panel};
@@ -23,7 +23,7 @@ use crate::units::Units;
 use compensator::asymptotic::{Expansion, Reading};
 use compensator::dynamics::TwinConfig;
 use compensator::equilibrium::{a_parameter, equilibrium, pressure_difference};
-use compensator::{Params, RawParams};
+use compensator::RawParams;
 use compensator_reference::dynamics::Profile;
 use rayon::prelude::*;
 use std::fmt::Write as _;
@@ -110,17 +110,6 @@ const STEP_T_END: f64 = 0.1;
 const INDICATOR_DT: f64 = 1.0e-4;
 const INDICATOR_T_END: f64 = 1.0;
 
-fn load(path: Option<&Path>) -> Result<(RawParams, Params<f64>), CliError> {
-    match path {
-        Some(path) => load_params::<f64>(path),
-        None => {
-            let raw = crate::params_file::parse(crate::input::PAPER_PRESET)?;
-            let p = Params::<f64>::new(&raw).map_err(|e| CliError::Input(e.to_string()))?;
-            Ok((raw, p))
-        }
-    }
-}
-
 /// A number for a markdown table: four significant digits.
 fn sig(v: f64) -> String {
     if !v.is_finite() {
@@ -179,7 +168,7 @@ fn responses(raw: &RawParams, steps: &[(f64, f64)]) -> Result<Vec<Run>, CliError
 /// (one per line).
 pub fn report(opts: &Options) -> Result<String, CliError> {
     let u = opts.units;
-    let (raw, p) = load(opts.params)?;
+    let (raw, p) = load_or_paper(opts.params)?;
     let (t1, t2) = load_tables(opts.data).map_err(CliError::Input)?;
     let t3 = Table3::load(opts.data).map_err(CliError::Input)?;
     std::fs::create_dir_all(opts.out).map_err(|e| CliError::Input(format!("--dir: {}: {e}", opts.out.display())))?;

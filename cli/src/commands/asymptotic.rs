@@ -1,6 +1,6 @@
 //! `asymptotic`: the asymptotic displacement (Eqs. 16-21) beside the quasi-static one.
 
-use crate::args::{Every10, Output, ParamsArg, PlotArg, TableArgs, Temps};
+use crate::args::{Every10, Output, ParamsArg, PlottedTable, Temps};
 use crate::error::CliError;
 use crate::{plot, statics};
 use compensator::asymptotic::Reading;
@@ -41,9 +41,7 @@ pub struct Args {
     #[command(flatten)]
     temps: Temps<Every10>,
     #[command(flatten)]
-    plot: PlotArg,
-    #[command(flatten)]
-    table: TableArgs,
+    output: PlottedTable,
 }
 
 impl Args {
@@ -59,8 +57,6 @@ impl Args {
         };
         let order = usize::from(self.order);
         let csv = statics::asymptotic(&self.params.params, order, reading, &self.t0, &self.temps.temps)?;
-        let units = self.table.units.units;
-        self.plot.draw(&csv, |csv| plot::asymptotic(csv, order, units))?;
-        Ok(Output::table(csv, &self.table))
+        self.output.output(csv, |csv, units| plot::asymptotic(csv, order, units))
     }
 }

@@ -1,6 +1,6 @@
 //! `calibrate`: the static parameters fitted to measured data.
 
-use crate::args::{FormatArg, Output, PlotArg};
+use crate::args::{FitTable, Output};
 use crate::calibration;
 use crate::error::CliError;
 use std::path::PathBuf;
@@ -59,9 +59,7 @@ pub struct Args {
     #[arg(long, value_name = "FILE")]
     write_preset: Option<PathBuf>,
     #[command(flatten)]
-    plot: PlotArg,
-    #[command(flatten)]
-    format: FormatArg,
+    output: FitTable,
 }
 
 impl Args {
@@ -76,11 +74,8 @@ impl Args {
             pressure: self.pressure_data,
             displacement: self.displacement_data,
             write_preset: self.write_preset,
-            plot: self.plot.plot,
+            plot: self.output.plot.plot.clone(),
         })?;
-        for line in &out.notes {
-            eprintln!("calibrate: {line}");
-        }
-        Ok(Output::si_table(out.table, &self.format))
+        Ok(self.output.output("calibrate", out.table, &out.notes))
     }
 }

@@ -1,6 +1,6 @@
 //! `compensation`: demand, supply and compensation error per temperature.
 
-use crate::args::{Every10, Output, ParamsArg, PlotArg, TableArgs, Temps};
+use crate::args::{Every10, OverTemps, Output, PlottedTable};
 use crate::error::CliError;
 use crate::{plot, sizing};
 
@@ -21,13 +21,9 @@ Example:
 #[command(after_long_help = HELP)]
 pub struct Args {
     #[command(flatten)]
-    params: ParamsArg,
+    over: OverTemps<Every10>,
     #[command(flatten)]
-    temps: Temps<Every10>,
-    #[command(flatten)]
-    plot: PlotArg,
-    #[command(flatten)]
-    table: TableArgs,
+    output: PlottedTable,
 }
 
 impl Args {
@@ -37,9 +33,7 @@ impl Args {
     ///
     /// Bad input (the file, the list, no `[machine]` section), naming it.
     pub fn run(self) -> Result<Output, CliError> {
-        let csv = sizing::compensation_table(&self.params.params, &self.temps.temps)?;
-        let units = self.table.units.units;
-        self.plot.draw(&csv, |csv| plot::compensation(csv, units))?;
-        Ok(Output::table(csv, &self.table))
+        let csv = self.over.table(sizing::compensation_table)?;
+        self.output.output(csv, plot::compensation)
     }
 }

@@ -1,6 +1,6 @@
 //! `eigen`: eigenvalues of the linearisation (Eq. 37) per temperature.
 
-use crate::args::{Every10, Output, ParamsArg, PlotArg, TableArgs, Temps};
+use crate::args::{Every10, OverTemps, Output, PlottedTable};
 use crate::error::CliError;
 use crate::plot;
 
@@ -22,13 +22,9 @@ Example:
 #[command(after_long_help = HELP)]
 pub struct Args {
     #[command(flatten)]
-    params: ParamsArg,
+    over: OverTemps<Every10>,
     #[command(flatten)]
-    temps: Temps<Every10>,
-    #[command(flatten)]
-    plot: PlotArg,
-    #[command(flatten)]
-    table: TableArgs,
+    output: PlottedTable,
 }
 
 impl Args {
@@ -38,8 +34,7 @@ impl Args {
     ///
     /// Bad input (the file, the list), naming it.
     pub fn run(self) -> Result<Output, CliError> {
-        let csv = crate::dynamics::eigen(&self.params.params, &self.temps.temps)?;
-        self.plot.draw(&csv, plot::eigen)?;
-        Ok(Output::table(csv, &self.table))
+        let csv = self.over.table(crate::dynamics::eigen)?;
+        self.output.output(csv, |csv, _| plot::eigen(csv))
     }
 }

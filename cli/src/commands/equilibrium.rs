@@ -1,6 +1,6 @@
 //! `equilibrium`: the quasi-static operating point per temperature (Eqs. 2-10).
 
-use crate::args::{Every10, Output, ParamsArg, PlotArg, TableArgs, Temps};
+use crate::args::{Every10, OverTemps, Output, PlottedTable};
 use crate::error::CliError;
 use crate::{plot, statics};
 
@@ -32,16 +32,12 @@ Example:
 #[command(after_long_help = HELP)]
 pub struct Args {
     #[command(flatten)]
-    params: ParamsArg,
-    #[command(flatten)]
-    temps: Temps<Every10>,
+    over: OverTemps<Every10>,
     /// Scalar type of the computation.
     #[arg(long, value_enum, default_value = "f64")]
     precision: StaticPrecision,
     #[command(flatten)]
-    plot: PlotArg,
-    #[command(flatten)]
-    table: TableArgs,
+    output: PlottedTable,
 }
 
 impl Args {
@@ -51,13 +47,8 @@ impl Args {
     ///
     /// Bad input (the file, the list), naming it.
     pub fn run(self) -> Result<Output, CliError> {
-        let csv = statics::equilibrium(
-            &self.params.params,
-            &self.temps.temps,
-            self.precision == StaticPrecision::F32,
-        )?;
-        let units = self.table.units.units;
-        self.plot.draw(&csv, |csv| plot::equilibrium(csv, units))?;
-        Ok(Output::table(csv, &self.table))
+        let single = self.precision == StaticPrecision::F32;
+        let csv = self.over.table(|path, temps| statics::equilibrium(path, temps, single))?;
+        self.output.output(csv, plot::equilibrium)
     }
 }

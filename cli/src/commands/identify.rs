@@ -1,6 +1,6 @@
 //! `identify`: the dynamic parameters fitted to a measured transient.
 
-use crate::args::{FormatArg, Output, ParamsArg, PlotArg};
+use crate::args::{FitTable, Output, ParamsArg};
 use crate::error::CliError;
 use crate::identify;
 use std::path::PathBuf;
@@ -46,9 +46,7 @@ pub struct Args {
     #[arg(long, value_name = "FILE")]
     write_preset: Option<PathBuf>,
     #[command(flatten)]
-    plot: PlotArg,
-    #[command(flatten)]
-    format: FormatArg,
+    output: FitTable,
 }
 
 impl Args {
@@ -63,11 +61,8 @@ impl Args {
             data: self.data,
             fit: Some(self.fit),
             write_preset: self.write_preset,
-            plot: self.plot.plot,
+            plot: self.output.plot.plot.clone(),
         })?;
-        for line in &notes {
-            eprintln!("identify: {line}");
-        }
-        Ok(Output::si_table(table, &self.format))
+        Ok(self.output.output("identify", table, &notes))
     }
 }

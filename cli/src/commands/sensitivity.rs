@@ -1,6 +1,6 @@
 //! `sensitivity`: the temperature sensitivities (Eqs. 30-31).
 
-use crate::args::{Every2, Output, ParamsArg, TableArgs, Temps};
+use crate::args::{Every2, OverTemps, Output, TableArgs};
 use crate::error::CliError;
 use crate::statics;
 
@@ -18,9 +18,7 @@ Example:
 #[command(after_long_help = HELP)]
 pub struct Args {
     #[command(flatten)]
-    params: ParamsArg,
-    #[command(flatten)]
-    temps: Temps<Every2>,
+    over: OverTemps<Every2>,
     #[command(flatten)]
     table: TableArgs,
 }
@@ -32,9 +30,6 @@ impl Args {
     ///
     /// Bad input (the file, the list), naming it.
     pub fn run(self) -> Result<Output, CliError> {
-        Ok(Output::table(
-            statics::sensitivity(&self.params.params, &self.temps.temps)?,
-            &self.table,
-        ))
+        Ok(Output::table(self.over.table(statics::sensitivity)?, &self.table))
     }
 }

@@ -11,7 +11,6 @@
 pub mod tables;
 
 use crate::error::CliError;
-use crate::input::load_params;
 use crate::lsq::{max_abs, rms};
 use crate::statics::find_balance;
 use compensator::Params;
@@ -116,14 +115,7 @@ pub fn chamber_gradient(params: &Params<f64>, dp: f64, lo: f64, hi: f64) -> Resu
 /// file `path` and the tables in `data` (without them: the built-in
 /// `presets/paper.toml` and `data/paper/`).
 pub fn report(path: Option<&Path>, data: Option<&Path>) -> Result<String, CliError> {
-    let (raw, p) = match path {
-        Some(path) => load_params::<f64>(path)?,
-        None => {
-            let raw = crate::params_file::parse(crate::input::PAPER_PRESET)?;
-            let p = Params::<f64>::new(&raw).map_err(|e| CliError::Input(e.to_string()))?;
-            (raw, p)
-        }
-    };
+    let (raw, p) = crate::input::load_or_paper(path)?;
     let (t1, t2) = load_tables(data).map_err(CliError::Input)?;
     let mut o = String::new();
     let shown = path.map_or("presets/paper.toml".into(), |p| p.display().to_string());
