@@ -89,6 +89,30 @@ temps_default! {
     Three = "30,50,80";
 }
 
+/// The long help (`after_long_help`) of a command whose CSV has a row per
+/// temperature or step: `Output: CSV, one row per <rows>:`, its `columns`
+/// (lines indented by two spaces; the first line's are the macro's, as a
+/// string continued after `\` starts without them), the two columns every such table ends with (the
+/// envelope's mark, [`crate::envelope::Envelope::mark`], and why a row
+/// could not be computed), then `notes` (lines, or empty) and the
+/// example.
+macro_rules! rows_help {
+    ($rows:literal, $columns:literal, $notes:literal, $example:literal) => {
+        concat!(
+            "Output: CSV, one row per ",
+            $rows,
+            ":\n  ",
+            $columns,
+            "\n  envelope (validated | oil_model: outside the validated range, extrapolated),",
+            "\n  error (why the row could not be computed; empty when it was)\n",
+            $notes,
+            "\nExample:\n  ",
+            $example
+        )
+    };
+}
+pub(crate) use rows_help;
+
 /// `--params` and `--temps`: a table of the file's model, one row per
 /// temperature of the list.
 #[derive(clap::Args, Debug, Clone)]

@@ -1,20 +1,19 @@
 //! `compensation`: demand, supply and compensation error per temperature.
 
 use crate::args::{Every10, OverTemps, Output, PlottedTable};
+use crate::args::rows_help;
 use crate::error::CliError;
 use crate::{plot, sizing};
 
-const HELP: &str = "\
-Output: CSV, one row per temperature:
+const HELP: &str = rows_help!(
+    "temperature",
+    "\
   t_c [C], losses_m3s [m^3/s], demand_m3s [m^3/s], supply_m3s [m^3/s],
   error_m3s [m^3/s] (supply - demand), required_area_m2 [m^2],
-  required_x_m [m], x_m [m],
-  envelope (validated | oil_model: outside the validated range, extrapolated),
-  error (why the row could not be computed; empty when it was)
-The file needs a [machine] section.
-
-Example:
-  compensator compensation --params presets/paper.toml --temps 30:80:10";
+  required_x_m [m], x_m [m],",
+    "The file needs a [machine] section.\n",
+    "compensator compensation --params presets/paper.toml --temps 30:80:10"
+);
 
 /// Demand, supply, compensation error and the Eq. (9) window per temperature.
 #[derive(clap::Args, Debug, Clone)]

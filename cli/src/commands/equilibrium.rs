@@ -1,6 +1,7 @@
 //! `equilibrium`: the quasi-static operating point per temperature (Eqs. 2-10).
 
 use crate::args::{Every10, OverTemps, Output, PlottedTable};
+use crate::args::rows_help;
 use crate::error::CliError;
 use crate::{plot, statics};
 
@@ -13,19 +14,19 @@ pub enum StaticPrecision {
     F32,
 }
 
-const HELP: &str = "\
-Output: CSV, one row per temperature:
+const HELP: &str = rows_help!(
+    "temperature",
+    "\
   t_c [C], a_sqrt_pa [sqrt(Pa)] (the property A), p_a_pa [Pa], p_b_pa [Pa],
   dp_ab_pa [Pa] (p_b - p_a), x_m [m] (plunger displacement),
   q_branch_m3s [m^3/s], q_throt_m3s [m^3/s], q_total_m3s [m^3/s],
-  nu_m2s [m^2/s] (kinematic viscosity; cSt with --units eng),
-  envelope (validated | oil_model: outside the validated range, extrapolated),
-  error (why the row could not be computed; empty when it was)
+  nu_m2s [m^2/s] (kinematic viscosity; cSt with --units eng),",
+    "\
 A temperature outside the file's oil-model range is refused (exit 2,
 naming the limit and why): docs/parameters.md, the temperature envelope.
-
-Example:
-  compensator equilibrium --params presets/paper.toml --temps 30:80:10";
+",
+    "compensator equilibrium --params presets/paper.toml --temps 30:80:10"
+);
 
 /// Quasi-static equilibrium (Eqs. 2-10) per temperature.
 #[derive(clap::Args, Debug, Clone)]
