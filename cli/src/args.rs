@@ -205,25 +205,57 @@ impl PlottedTable {
     }
 }
 
-/// `--plot` with `--format`: the table of a fit's parameters (in their
-/// file's SI units) and a figure of the fit, for `calibrate` and
+/// A command that fits parameters and reports them with [`FitTable`]
+/// (`calibrate`, `identify`).
+pub trait Fit: Clone + Debug + Send + Sync + 'static {
+    /// The command's name, before each of its lines on standard error.
+    const COMMAND: &'static str;
+    /// The help of `--write-preset` (without the final period clap drops
+    /// from a doc comment's one line).
+    const WRITE_PRESET_HELP: &'static str;
+}
+
+/// `calibrate`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Calibrate;
+impl Fit for Calibrate {
+    const COMMAND: &'static str = "calibrate";
+    const WRITE_PRESET_HELP: &'static str = "Write the calibrated parameter file (TOML, the fit in comments, its \
+        standard errors and correlations in [tolerances] and [[correlation]]) to FILE";
+}
+
 /// `identify`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Identify;
+impl Fit for Identify {
+    const COMMAND: &'static str = "identify";
+    const WRITE_PRESET_HELP: &'static str = "Write the parameter file with the identified values (TOML) to FILE";
+}
+
+/// `--write-preset`, `--plot` and `--format` of a fit `F`: the fitted
+/// parameter file, a figure of the fit and the table of the parameters
+/// (in their file's SI units).
 #[derive(clap::Args, Debug, Clone)]
-pub struct FitTable {
+pub struct FitTable<F: Fit> {
+    #[arg(long, value_name = "FILE", help = F::WRITE_PRESET_HELP)]
+    #[allow(missing_docs)]
+    pub write_preset: Option<PathBuf>,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub plot: PlotArg,
     #[command(flatten)]
     #[allow(missing_docs)]
     pub format: FormatArg,
+    #[arg(skip)]
+    fit: PhantomData<F>,
 }
 
-impl FitTable {
+impl<F: Fit> FitTable<F> {
     /// The fit's output: its `notes` on standard error, each line after
-    /// `command: `, and its `table`.
-    pub fn output(&self, command: &str, table: String, notes: &[String]) -> Output {
+    /// the command's name, and its `table`.
+    pub fn output(&self, table: String, notes: &[String]) -> Output {
         for line in notes {
-            eprintln!("{command}: {line}");
+            eprintln!("{}: {line}", F::COMMAND);
         }
         Output::si_table(table, &self.format)
     }
