@@ -574,9 +574,7 @@ pub fn fit(
     let mut internal = oil.theta.to_vec();
     if let Some(data) = displacement {
         let (stage, spring_core) = fit_displacement(base, &oil, data)?;
-        warnings.extend(
-            (stage.uncertainty.warnings().into_iter()).map(|w| format!("displacement data: {w}")),
-        );
+        warnings.extend((stage.uncertainty.warnings().into_iter()).map(|w| format!("displacement data: {w}")));
         core = spring_core;
         cov = joint_covariance(&base.core, &oil, &stage, core, data)?;
         internal.extend_from_slice(&stage.fit.x);

@@ -600,7 +600,7 @@ impl<'a> Problem<'a> {
         }
         match self.profiles(order, &fit, &u) {
             Err((i, reason)) => drop(i, reason),
-            Ok(ci) => Step::Accept(self.with(&fit.x), (u, fit.x, self.coords.clone(), ci)),
+            Ok(ci) => Step::Accept(Box::new(self.with(&fit.x)), (u, fit.x, self.coords.clone(), ci)),
         }
     }
 
@@ -608,7 +608,12 @@ impl<'a> Problem<'a> {
     /// optimum `fit` with uncertainty `u`, in `order`: every parameter's
     /// 95 % profile-likelihood interval, or the first parameter that fails
     /// and why.
-    fn profiles(&self, order: &[usize], fit: &lsq::Fit, u: &lsq::Uncertainty) -> Result<Vec<(f64, f64)>, (usize, String)> {
+    fn profiles(
+        &self,
+        order: &[usize],
+        fit: &lsq::Fit,
+        u: &lsq::Uncertainty,
+    ) -> Result<Vec<(f64, f64)>, (usize, String)> {
         let f = |v: &[f64]| self.residuals(v);
         let se = u.std_errors();
         let rss0: f64 = fit.residuals.iter().map(|r| r * r).sum();
@@ -625,8 +630,17 @@ impl<'a> Problem<'a> {
                     ),
                 ));
             }
-            ci[i] = profile_interval(&f, &fit.x, i, self.coords[i], field(self.free[i]), rss0, u.s2, &self.step)
-                .map_err(|reason| (i, reason))?;
+            ci[i] = profile_interval(
+                &f,
+                &fit.x,
+                i,
+                self.coords[i],
+                field(self.free[i]),
+                rss0,
+                u.s2,
+                &self.step,
+            )
+            .map_err(|reason| (i, reason))?;
         }
         Ok(ci)
     }
@@ -650,7 +664,7 @@ enum Step {
         reason: String,
     },
     /// Every free parameter determined: the fitted set and the fit.
-    Accept(RawParams, Accepted),
+    Accept(Box<RawParams>, Accepted),
 }
 
 /// The joint fit: the identified parameters of `results` and the
@@ -1041,7 +1055,7 @@ pub fn identify_params(base: &RawParams, data: &Transient, fit: &[&'static str])
             Step::Pin { path, value, reason } => held.pin(path, value, reason),
             Step::Accept(raw, accepted) => {
                 warnings.extend(accepted.0.warnings());
-                break (raw, Some(accepted));
+                break (*raw, Some(accepted));
             }
         }
     };
@@ -1426,11 +1440,17 @@ mod tests {
         };
         for (path, says) in [
             ("plunger.bogus", "unknown parameter 'plunger.bogus'"),
-            ("machine.working_flow", "machine.working_flow: the parameter file has no [machine] section"),
+            (
+                "machine.working_flow",
+                "machine.working_flow: the parameter file has no [machine] section",
+            ),
         ] {
             let e = identify_params(&base, &data, &["plunger.mass", path]).unwrap_err();
             assert_eq!(e.exit_code(), 2, "{e}");
-            assert!(e.to_string().starts_with("--fit: ") && e.to_string().contains(says), "{e}");
+            assert!(
+                e.to_string().starts_with("--fit: ") && e.to_string().contains(says),
+                "{e}"
+            );
         }
     }
 

@@ -1,7 +1,6 @@
 //! `asymptotic`: the asymptotic displacement (Eqs. 16-21) beside the quasi-static one.
 
-use crate::args::{Every10, Output, ParamsArg, PlottedTable, Temps};
-use crate::args::rows_help;
+use crate::args::{Every10, Output, ParamsArg, PlottedTable, Temps, rows_help};
 use crate::error::CliError;
 use crate::{plot, statics};
 use compensator::asymptotic::Reading;
@@ -57,6 +56,7 @@ impl Args {
         };
         let order = usize::from(self.order);
         let csv = statics::asymptotic(&self.params.params, order, reading, &self.t0, &self.temps.temps)?;
-        self.output.output(csv, |csv, units| plot::asymptotic(csv, order, units))
+        self.output
+            .output(csv, |csv, units| plot::asymptotic(csv, order, units))
     }
 }

@@ -1,7 +1,6 @@
 //! `eigen`: eigenvalues of the linearisation (Eq. 37) per temperature.
 
-use crate::args::{Every10, OverTemps, Output, PlottedTable};
-use crate::args::rows_help;
+use crate::args::{Every10, Output, OverTemps, PlottedTable, rows_help};
 use crate::error::CliError;
 use crate::plot;
 

@@ -1,7 +1,6 @@
 //! `equilibrium`: the quasi-static operating point per temperature (Eqs. 2-10).
 
-use crate::args::{Every10, OverTemps, Output, PlottedTable};
-use crate::args::rows_help;
+use crate::args::{Every10, Output, OverTemps, PlottedTable, rows_help};
 use crate::error::CliError;
 use crate::{plot, statics};
 
@@ -49,7 +48,9 @@ impl Args {
     /// Bad input (the file, the list), naming it.
     pub fn run(self) -> Result<Output, CliError> {
         let single = self.precision == StaticPrecision::F32;
-        let csv = self.over.table(|path, temps| statics::equilibrium(path, temps, single))?;
+        let csv = self
+            .over
+            .table(|path, temps| statics::equilibrium(path, temps, single))?;
         self.output.output(csv, plot::equilibrium)
     }
 }

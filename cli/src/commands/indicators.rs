@@ -1,7 +1,6 @@
 //! `indicators`: the step-response indicators of the paper's Table 3.
 
-use crate::args::{Output, ParamsArg, TableArgs};
-use crate::args::rows_help;
+use crate::args::{Output, ParamsArg, TableArgs, rows_help};
 use crate::error::CliError;
 
 const HELP: &str = rows_help!(

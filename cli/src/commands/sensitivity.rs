@@ -1,7 +1,6 @@
 //! `sensitivity`: the temperature sensitivities (Eqs. 30-31).
 
-use crate::args::{Every2, OverTemps, Output, TableArgs};
-use crate::args::rows_help;
+use crate::args::{Every2, Output, OverTemps, TableArgs, rows_help};
 use crate::error::CliError;
 use crate::statics;
 
