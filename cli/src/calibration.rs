@@ -344,16 +344,7 @@ fn fit_pressure(base: &RawParams, pressure: &[PressurePoint]) -> Result<Pressure
         10f64.powf(log_t_ref) - 273.15
     );
     let names1 = [level.as_str(), f.walther_b.path, f.laminar_length.path];
-    if pressure.len() <= 3 {
-        return Err(undetermined(
-            "--pressure-data",
-            &names1,
-            lsq::Undetermined::NoDegreesOfFreedom {
-                points: pressure.len(),
-                parameters: 3,
-            },
-        ));
-    }
+    enough_points("--pressure-data", &names1, pressure.len())?;
     // Start from the oil through the data's extreme temperatures, or the
     // base file's oil where that one cannot be evaluated at every point.
     let r1 = |u: &[f64]| pressure_residuals(&oil.core(u), pressure);
@@ -453,16 +444,7 @@ fn fit_displacement(
 ) -> Result<(Stage, RawCore), CliError> {
     let f = &RawCore::FIELD;
     let names2 = [f.spring_rate.path, f.preload.path];
-    if data.len() <= 2 {
-        return Err(undetermined(
-            "--displacement-data",
-            &names2,
-            lsq::Undetermined::NoDegreesOfFreedom {
-                points: data.len(),
-                parameters: 2,
-            },
-        ));
-    }
+    enough_points("--displacement-data", &names2, data.len())?;
     check_travel(&base.core, data)?;
     let spring = Spring::of(&base.core);
     let fluid_core = oil.core;
@@ -551,6 +533,22 @@ fn joint_covariance(
     full.view_mut((3, 0), (2, 3)).copy_from(&cov21);
     full.view_mut((0, 3), (3, 2)).copy_from(&cov21.transpose());
     Ok(full)
+}
+
+/// Refuses `points` data points for the parameters `names` (of the data
+/// `which`) when they leave no degree of freedom.
+fn enough_points(which: &str, names: &[&str], points: usize) -> Result<(), CliError> {
+    if points <= names.len() {
+        return Err(undetermined(
+            which,
+            names,
+            lsq::Undetermined::NoDegreesOfFreedom {
+                points,
+                parameters: names.len(),
+            },
+        ));
+    }
+    Ok(())
 }
 
 /// Fits the base parameter set to the data (see the module docs).
