@@ -3,6 +3,13 @@
 //! parameter file, the temperature list, the figure, the output format
 //! and units. A command offers only the ones it accepts, so its `--help`
 //! lists what it really takes and clap refuses the rest by name.
+//!
+//! The groups that go together carry what the commands do with them:
+//! [`OverTemps`] (`--params` and `--temps`) hands them to a table's
+//! computation, [`PlottedTable`] (`--plot`, `--format`, `--units`) draws
+//! the figure and returns the table, [`FitTable`] writes a fit's notes
+//! and table, [`PaperInputs`] holds the paper's defaults; `rows_help!`
+//! writes the long help of a table with a row per temperature or step.
 
 use crate::csv::Format;
 use crate::error::CliError;
@@ -92,10 +99,10 @@ temps_default! {
 /// The long help (`after_long_help`) of a command whose CSV has a row per
 /// temperature or step: `Output: CSV, one row per <rows>:`, its `columns`
 /// (lines indented by two spaces; the first line's are the macro's, as a
-/// string continued after `\` starts without them), the two columns every such table ends with (the
-/// envelope's mark, [`crate::envelope::Envelope::mark`], and why a row
-/// could not be computed), then `notes` (lines, or empty) and the
-/// example.
+/// string continued after `\` starts without them), the two columns
+/// every such table ends with (the envelope's mark,
+/// [`crate::envelope::Envelope::mark`], and why a row could not be
+/// computed), then `notes` (lines, or empty) and the example.
 macro_rules! rows_help {
     ($rows:literal, $columns:literal, $notes:literal, $example:literal) => {
         concat!(
