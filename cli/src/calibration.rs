@@ -1206,25 +1206,9 @@ pub fn calibrate(opts: &Options) -> Result<Output, CliError> {
         }
         None => None,
     };
-    // Every temperature inside the base file's oil model (refused naming
-    // the row otherwise); rows outside the validated range are counted.
     let params = compensator::Params::<f64>::new(&base).map_err(|e| CliError::Input(format!("--params: {e}")))?;
     let env = crate::envelope::Envelope::of(&base, &params);
-    let mut outside = 0;
-    for (flag, temps) in [
-        ("--pressure-data", pressure.iter().map(|p| p.t_c).collect::<Vec<_>>()),
-        (
-            "--displacement-data",
-            displacement.iter().flatten().map(|p| p.t_c).collect::<Vec<_>>(),
-        ),
-    ] {
-        for (i, &t) in temps.iter().enumerate() {
-            let at = format!("{flag}: data row {}, column t_c", i + 1);
-            if env.check(t, &at)? == crate::envelope::Zone::OilModel {
-                outside += 1;
-            }
-        }
-    }
+    let outside = outside_validated(&env, &pressure, displacement.as_deref())?;
     let cal = fit(&base, &pressure, displacement.as_deref())?;
     let mut held = Vec::new();
     let mut command = format!(
@@ -1255,22 +1239,59 @@ pub fn calibrate(opts: &Options) -> Result<Output, CliError> {
         ));
     }
     notes.extend(cal.warnings.iter().map(|w| format!("WARNING: {w}")));
-    for h in &held {
-        notes.push(format!(
-            "--write-preset: {}: its tolerance is the base file's, {:.3e} {} (the fit's standard error, {:.3e} {}, \
-             is above a third of the value); the other fitted fields' covariance is conditioned on it",
-            h.path, h.tolerance, h.unit, h.std_error, h.unit
-        ));
-        if h.shift > HELD_SHIFT_WARN {
-            notes.push(format!(
-                "WARNING: {}: the fitted value {} lies {:.2} standard errors from the base file's {}: the written \
-                 band assumes a value the base file does not support",
-                h.path, h.value, h.shift, h.base_value
-            ));
-        }
-    }
+    notes.extend(held.iter().flat_map(held_notes));
     Ok(Output {
         table: cal.table(),
         notes,
     })
+}
+
+/// The data rows outside the validated range of `env`; every temperature
+/// must be inside its oil model (refused naming the data and the row
+/// otherwise).
+fn outside_validated(
+    env: &crate::envelope::Envelope,
+    pressure: &[PressurePoint],
+    displacement: Option<&[DisplacementPoint]>,
+) -> Result<usize, CliError> {
+    let mut outside = 0;
+    for (flag, temps) in [
+        ("--pressure-data", pressure.iter().map(|p| p.t_c).collect::<Vec<_>>()),
+        (
+            "--displacement-data",
+            displacement
+                .iter()
+                .copied()
+                .flatten()
+                .map(|p| p.t_c)
+                .collect::<Vec<_>>(),
+        ),
+    ] {
+        for (i, &t) in temps.iter().enumerate() {
+            let at = format!("{flag}: data row {}, column t_c", i + 1);
+            if env.check(t, &at)? == crate::envelope::Zone::OilModel {
+                outside += 1;
+            }
+        }
+    }
+    Ok(outside)
+}
+
+/// The notes on a field written with the base file's tolerance
+/// ([`Written::held`]): that it is, and a warning when the fit lies far
+/// from the base file's value.
+fn held_notes(h: &Held) -> Vec<String> {
+    let mut notes = vec![format!(
+        "--write-preset: {}: its tolerance is the base file's, {:.3e} {} (the fit's standard error, {:.3e} {}, \
+         is above a third of the value); the other fitted fields' covariance is conditioned on it",
+        h.path, h.tolerance, h.unit, h.std_error, h.unit
+    )];
+    if h.shift > HELD_SHIFT_WARN {
+        notes.push(format!(
+            "WARNING: {}: the fitted value {} lies {:.2} standard errors from the base file's {}: the written \
+             band assumes a value the base file does not support",
+            h.path, h.value, h.shift, h.base_value
+        ));
+    }
+    notes
 }
