@@ -3,14 +3,22 @@
 //! parameter file, the temperature list, the figure, the output format
 //! and units. A command offers only the ones it accepts, so its `--help`
 //! lists what it really takes and clap refuses the rest by name.
+//!
+//! The groups that go together carry what the commands do with them:
+//! [`OverTemps`] (`--params` and `--temps`) hands them to a table's
+//! computation, [`PlottedTable`] (`--plot`, `--format`, `--units`) draws
+//! the figure and returns the table, [`FitTable`] writes a fit's notes
+//! and table, [`PaperInputs`] holds the paper's defaults; `rows_help!`
+//! writes the long help of a table with a row per temperature or step.
 
 use crate::csv::Format;
 use crate::error::CliError;
+use crate::plot::Figure;
 use crate::units::Units;
 use compensator::{Float, Params, RawParams};
 use std::fmt::Debug;
 use std::marker::PhantomData;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// `--params FILE`: the parameter file every computing command reads.
 #[derive(clap::Args, Debug, Clone)]
@@ -88,31 +96,61 @@ temps_default! {
     Three = "30,50,80";
 }
 
+/// The long help (`after_long_help`) of a command whose CSV has a row per
+/// temperature or step: `Output: CSV, one row per <rows>:`, its `columns`
+/// (lines indented by two spaces; the first line's are the macro's, as a
+/// string continued after `\` starts without them), the two columns
+/// every such table ends with (the envelope's mark,
+/// [`crate::envelope::Envelope::mark`], and why a row could not be
+/// computed), then `notes` (lines, or empty) and the example.
+macro_rules! rows_help {
+    ($rows:literal, $columns:literal, $notes:literal, $example:literal) => {
+        concat!(
+            "Output: CSV, one row per ",
+            $rows,
+            ":\n  ",
+            $columns,
+            "\n  envelope (validated | oil_model: outside the validated range, extrapolated),",
+            "\n  error (why the row could not be computed; empty when it was)\n",
+            $notes,
+            "\nExample:\n  ",
+            $example
+        )
+    };
+}
+pub(crate) use rows_help;
+
+/// `--params` and `--temps`: a table of the file's model, one row per
+/// temperature of the list.
+#[derive(clap::Args, Debug, Clone)]
+pub struct OverTemps<D: TempsDefault> {
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub params: ParamsArg,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub temps: Temps<D>,
+}
+
+impl<D: TempsDefault> OverTemps<D> {
+    /// The table `compute` makes of the file and the list (the library's
+    /// per-temperature functions take them as given: the path and the
+    /// list's text, and check one against the other).
+    ///
+    /// # Errors
+    ///
+    /// `compute`'s: bad input naming the file, the list or the field.
+    pub fn table(&self, compute: impl FnOnce(&Path, &str) -> Result<String, CliError>) -> Result<String, CliError> {
+        compute(&self.params.params, &self.temps.temps)
+    }
+}
+
 /// `--plot FILE.svg|FILE.png`: the output drawn as a figure too.
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct PlotArg {
     /// Also draw a figure, SVG or PNG by the file's extension (docs/plots.md).
     #[arg(long, value_name = "FILE.svg|FILE.png", value_parser = crate::plot::parse_path)]
     pub plot: Option<PathBuf>,
-}
-
-impl PlotArg {
-    /// Draws the figure `fig` builds from a command's CSV output `csv` to
-    /// the file of `--plot`, if one was given.
-    ///
-    /// # Errors
-    ///
-    /// The figure's or the file's error.
-    pub fn draw(
-        &self,
-        csv: &str,
-        fig: impl FnOnce(&str) -> Result<crate::plot::Figure, CliError>,
-    ) -> Result<(), CliError> {
-        match &self.plot {
-            Some(path) => crate::plot::write(path, &fig(csv)?),
-            None => Ok(()),
-        }
-    }
 }
 
 /// `--format csv|json|table`, for the commands that print a table.
@@ -140,6 +178,131 @@ pub struct TableArgs {
     #[command(flatten)]
     #[allow(missing_docs)]
     pub units: UnitsArg,
+}
+
+/// `--plot` with `--format` and `--units`: a table the command can also
+/// draw.
+#[derive(clap::Args, Debug, Clone)]
+pub struct PlottedTable {
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub plot: PlotArg,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub table: TableArgs,
+}
+
+impl PlottedTable {
+    /// The command's output, the table `csv`, after drawing the figure
+    /// `figure` builds from it (in the table's units) to the file of
+    /// `--plot`, if one was given.
+    ///
+    /// # Errors
+    ///
+    /// The figure's or the file's error.
+    pub fn output(
+        &self,
+        csv: String,
+        figure: impl FnOnce(&str, Units) -> Result<Figure, CliError>,
+    ) -> Result<Output, CliError> {
+        if let Some(path) = &self.plot.plot {
+            crate::plot::write(path, &figure(&csv, self.table.units.units)?)?;
+        }
+        Ok(Output::table(csv, &self.table))
+    }
+}
+
+/// A command that fits parameters and reports them with [`FitTable`]
+/// (`calibrate`, `identify`).
+pub trait Fit: Clone + Debug + Send + Sync + 'static {
+    /// The command's name, before each of its lines on standard error.
+    const COMMAND: &'static str;
+    /// The help of `--write-preset` (without the final period clap drops
+    /// from a doc comment's one line).
+    const WRITE_PRESET_HELP: &'static str;
+}
+
+/// `calibrate`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Calibrate;
+impl Fit for Calibrate {
+    const COMMAND: &'static str = "calibrate";
+    const WRITE_PRESET_HELP: &'static str = "Write the calibrated parameter file (TOML, the fit in comments, its \
+        standard errors and correlations in [tolerances] and [[correlation]]) to FILE";
+}
+
+/// `identify`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Identify;
+impl Fit for Identify {
+    const COMMAND: &'static str = "identify";
+    const WRITE_PRESET_HELP: &'static str = "Write the parameter file with the identified values (TOML) to FILE";
+}
+
+/// `--write-preset`, `--plot` and `--format` of a fit `F`: the fitted
+/// parameter file, a figure of the fit and the table of the parameters
+/// (in their file's SI units).
+#[derive(clap::Args, Debug, Clone)]
+pub struct FitTable<F: Fit> {
+    #[arg(long, value_name = "FILE", help = F::WRITE_PRESET_HELP)]
+    #[allow(missing_docs)]
+    pub write_preset: Option<PathBuf>,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub plot: PlotArg,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub format: FormatArg,
+    #[arg(skip)]
+    fit: PhantomData<F>,
+}
+
+impl<F: Fit> FitTable<F> {
+    /// The fit's output: its `notes` on standard error, each line after
+    /// the command's name, and its `table`.
+    pub fn output(&self, table: String, notes: &[String]) -> Output {
+        for line in notes {
+            eprintln!("{}: {line}", F::COMMAND);
+        }
+        Output::si_table(table, &self.format)
+    }
+}
+
+/// Which of the paper's tables a command reads from `--data` (the
+/// commands differ in it).
+pub trait PaperTables: Clone + Debug + Send + Sync + 'static {
+    /// The help of `--data` (without the final period clap drops from a
+    /// doc comment's one line).
+    const DATA_HELP: &'static str;
+}
+
+/// `paper`: Tables 1 and 2.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Tables12;
+impl PaperTables for Tables12 {
+    const DATA_HELP: &'static str = "Folder with table1.csv and table2.csv [default: the built-in data/paper]";
+}
+
+/// `report`: Tables 1 to 3.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Tables123;
+impl PaperTables for Tables123 {
+    const DATA_HELP: &'static str =
+        "Folder with table1.csv, table2.csv and table3.csv [default: the built-in data/paper]";
+}
+
+/// `--params` and `--data` of the commands that recompute the paper, with
+/// the paper's preset and tables built into the binary as defaults.
+#[derive(clap::Args, Debug, Clone)]
+pub struct PaperInputs<T: PaperTables> {
+    /// Parameter file (TOML) [default: the built-in presets/paper.toml].
+    #[arg(long, value_name = "FILE")]
+    pub params: Option<PathBuf>,
+    #[arg(long, value_name = "DIR", help = T::DATA_HELP)]
+    #[allow(missing_docs)]
+    pub data: Option<PathBuf>,
+    #[arg(skip)]
+    tables: PhantomData<T>,
 }
 
 /// What a command writes to standard output (or `-o FILE`).

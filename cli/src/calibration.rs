@@ -316,17 +316,21 @@ fn undetermined(which: &str, names: &[&str], e: lsq::Undetermined) -> CliError {
     CliError::Input(format!("{which}: cannot fit {}: {e}", names.join(", ")))
 }
 
-/// Fits the base parameter set to the data (see the module docs).
-///
-/// Errors: [`CliError::Input`] when the data cannot determine the
-/// parameters (no degree of freedom, a rank-deficient Jacobian: the message
-/// names the data and the parameters) or the base file is not valid;
-/// [`CliError::Failed`] when the minimiser does not converge.
-pub fn fit(
-    base: &RawParams,
-    pressure: &[PressurePoint],
-    displacement: Option<&[DisplacementPoint]>,
-) -> Result<Calibration, CliError> {
+/// The pressure stage's outcome: the fit in its own coordinates ([`Oil`])
+/// and the fitted oil in the parameter file's.
+struct PressureFit {
+    stage: Stage,
+    /// The base core with the fitted oil and capillary.
+    core: RawCore,
+    /// `(walther_a, walther_b, log10 G)` at the optimum.
+    theta: [f64; 3],
+    /// Their covariance.
+    cov: DMatrix<f64>,
+}
+
+/// Fits `fluid.walther_a`, `fluid.walther_b` and the capillary (through
+/// `log10 G`) of `base` to the pressure data (module docs).
+fn fit_pressure(base: &RawParams, pressure: &[PressurePoint]) -> Result<PressureFit, CliError> {
     let f = &RawCore::FIELD;
     let start = params_of(&base.core).ok_or_else(|| CliError::Input("--base: parameters are not valid".into()))?;
     let g0 = geometry_factor(&start);
@@ -340,16 +344,7 @@ pub fn fit(
         10f64.powf(log_t_ref) - 273.15
     );
     let names1 = [level.as_str(), f.walther_b.path, f.laminar_length.path];
-    if pressure.len() <= 3 {
-        return Err(undetermined(
-            "--pressure-data",
-            &names1,
-            lsq::Undetermined::NoDegreesOfFreedom {
-                points: pressure.len(),
-                parameters: 3,
-            },
-        ));
-    }
+    enough_points("--pressure-data", &names1, pressure.len())?;
     // Start from the oil through the data's extreme temperatures, or the
     // base file's oil where that one cannot be evaluated at every point.
     let r1 = |u: &[f64]| pressure_residuals(&oil.core(u), pressure);
@@ -379,168 +374,214 @@ pub fn fit(
     let fit1 = least_squares(r1, &u0, &steps(&u0)).map_err(|e| CliError::Failed(format!("--pressure-data: {e}")))?;
     let unc1 = lsq::analyse(&fit1.jacobian, &fit1.residuals, &names1)
         .map_err(|e| undetermined("--pressure-data", &names1, e))?;
-    let mut warnings: Vec<String> = unc1
-        .warnings()
-        .into_iter()
-        .map(|w| format!("pressure data: {w}"))
-        .collect();
-    let fluid_core = oil.core(&fit1.x);
+    let core = oil.core(&fit1.x);
     // Covariance of (walther_a, walther_b, log10 G) from that of (w_ref, b, log10 G).
     let to_ab = DMatrix::from_row_slice(3, 3, &[1.0, log_t_ref, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
-    let cov1 = &to_ab * &unc1.cov * to_ab.transpose();
-    let theta1 = [fluid_core.walther_a, fluid_core.walther_b, fit1.x[2]];
+    let cov = &to_ab * &unc1.cov * to_ab.transpose();
+    let theta = [core.walther_a, core.walther_b, fit1.x[2]];
+    Ok(PressureFit {
+        stage: Stage {
+            fit: fit1,
+            uncertainty: unc1,
+        },
+        core,
+        theta,
+        cov,
+    })
+}
 
-    let area = std::f64::consts::FRAC_PI_4 * base.core.plunger_diameter.powi(2);
-    // Stage-2 coordinates: compliance A_p / c [1e-9 m/Pa], preload [1e-5 m].
-    let spring = |core: RawCore, v: &[f64]| {
+/// Stage-2 coordinates: compliance `A_p / c` [1e-9 m/Pa], preload [1e-5 m].
+struct Spring {
+    /// The plunger's area [m^2].
+    area: f64,
+}
+
+impl Spring {
+    fn of(base: &RawCore) -> Self {
+        Spring {
+            area: std::f64::consts::FRAC_PI_4 * base.plunger_diameter.powi(2),
+        }
+    }
+
+    /// `core` with the spring at coordinates `v`.
+    fn core(&self, core: RawCore, v: &[f64]) -> RawCore {
         let mut c = core;
-        c.spring_rate = area / (v[0] * 1e-9);
+        c.spring_rate = self.area / (v[0] * 1e-9);
         c.preload = (v[1] * 1e-5).max(0.0);
         c
-    };
-    let mut core = fluid_core;
-    let mut displacement_stage = None;
-    let mut cov = cov1.clone();
-    let mut internal = theta1.to_vec();
-    if let Some(data) = displacement {
-        let names2 = [f.spring_rate.path, f.preload.path];
-        if data.len() <= 2 {
-            return Err(undetermined(
-                "--displacement-data",
-                &names2,
-                lsq::Undetermined::NoDegreesOfFreedom {
-                    points: data.len(),
-                    parameters: 2,
-                },
-            ));
-        }
-        // A displacement beyond the travel (a record in mm read as m) fits
-        // nothing and was reported as "the data do not separate" the spring.
-        let stroke = base.core.stroke;
-        let (lo, hi) = (-X_SLACK * stroke, (1.0 + X_SLACK) * stroke);
-        if let Some(i) = data.iter().position(|p| !(lo..=hi).contains(&p.x_m)) {
-            return Err(CliError::Input(format!(
-                "--displacement-data: data row {}, column x_m: {} m is outside the plunger's travel \
-                 [{}, {}] m (0 to plunger.stroke = {} m, with {} % slack){}",
-                i + 1,
-                crate::display::sig(data[i].x_m, 6),
-                crate::display::sig(lo, 4),
-                crate::display::sig(hi, 4),
-                crate::display::sig(stroke, 6),
-                X_SLACK * 100.0,
-                crate::data::column("x_m").map_or(String::new(), |c| crate::data::unit_hint(c, data[i].x_m, lo, hi))
-            )));
-        }
-        let v0 = [area / base.core.spring_rate * 1e9, base.core.preload * 1e5];
-        let r2 = |v: &[f64]| displacement_residuals(&spring(fluid_core, v), data);
-        let j0 = lsq::jacobian(r2, &v0, &steps(&v0)).ok_or_else(|| {
-            let start = spring(fluid_core, &v0);
-            let row = data
-                .iter()
-                .position(|p| model_displacement(&start, p.t_c, p.dp_pa).is_none())
-                .map_or(String::new(), |i| {
-                    let dp = data[i]
-                        .dp_pa
-                        .map_or("the base file's".to_string(), |d| format!("{} Pa", num(d)));
-                    format!(" (first at data row {}: {} C, drop {dp})", i + 1, num(data[i].t_c))
-                });
-            CliError::Input(format!(
-                "--displacement-data: the model cannot be evaluated at the data's temperatures and drops{row}"
-            ))
-        })?;
-        lsq::check_design(&j0, &names2).map_err(|e| undetermined("--displacement-data", &names2, e))?;
-        let fit2 =
-            least_squares(r2, &v0, &steps(&v0)).map_err(|e| CliError::Failed(format!("--displacement-data: {e}")))?;
-        let unc2 = lsq::analyse(&fit2.jacobian, &fit2.residuals, &names2)
-            .map_err(|e| undetermined("--displacement-data", &names2, e))?;
-        warnings.extend(unc2.warnings().into_iter().map(|w| format!("displacement data: {w}")));
-        core = spring(fluid_core, &fit2.x);
-        // Sensitivity of the displacement residuals to the oil (J21), and
-        // the propagated covariance of the two-step estimate.
-        let with_oil = |t: &[f64]| {
-            let mut c = core;
-            c.walther_a = t[0];
-            c.walther_b = t[1];
-            c.laminar_length = capillary_length_for(&base.core, 10f64.powf(t[2]));
-            c
-        };
-        let h = steps(&theta1);
-        let m = data.len();
-        let mut j21 = DMatrix::zeros(m, 3);
-        for j in 0..3 {
-            let (mut tp, mut tm) = (theta1, theta1);
-            tp[j] += h[j];
-            tm[j] -= h[j];
-            let rp = displacement_residuals(&with_oil(&tp), data);
-            let rm = displacement_residuals(&with_oil(&tm), data);
-            let (Some(rp), Some(rm)) = (rp, rm) else {
-                return Err(CliError::Failed(
-                    "--displacement-data: the model cannot be evaluated next to the fitted oil".into(),
-                ));
-            };
-            for i in 0..m {
-                j21[(i, j)] = (rp[i] - rm[i]) / (2.0 * h[j]);
-            }
-        }
-        let j2 = &fit2.jacobian;
-        let jtj = j2.transpose() * j2;
-        let inv = jtj
-            .try_inverse()
-            .ok_or_else(|| CliError::Failed("--displacement-data: singular normal equations".into()))?;
-        let sens = -(inv * j2.transpose() * &j21);
-        let cov22 = &unc2.cov + &sens * &cov1 * sens.transpose();
-        let cov21 = &sens * &cov1;
-        let mut full = DMatrix::zeros(5, 5);
-        full.view_mut((0, 0), (3, 3)).copy_from(&cov1);
-        full.view_mut((3, 3), (2, 2)).copy_from(&cov22);
-        full.view_mut((3, 0), (2, 3)).copy_from(&cov21);
-        full.view_mut((0, 3), (3, 2)).copy_from(&cov21.transpose());
-        cov = full;
-        internal.extend_from_slice(&fit2.x);
-        displacement_stage = Some(Stage {
+    }
+}
+
+/// Refuses a displacement beyond the travel (a record in mm read as m
+/// fits nothing and was reported as "the data do not separate" the
+/// spring), naming the first such row.
+fn check_travel(base: &RawCore, data: &[DisplacementPoint]) -> Result<(), CliError> {
+    let stroke = base.stroke;
+    let (lo, hi) = (-X_SLACK * stroke, (1.0 + X_SLACK) * stroke);
+    match data.iter().position(|p| !(lo..=hi).contains(&p.x_m)) {
+        None => Ok(()),
+        Some(i) => Err(CliError::Input(format!(
+            "--displacement-data: data row {}, column x_m: {} m is outside the plunger's travel \
+             [{}, {}] m (0 to plunger.stroke = {} m, with {} % slack){}",
+            i + 1,
+            crate::display::sig(data[i].x_m, 6),
+            crate::display::sig(lo, 4),
+            crate::display::sig(hi, 4),
+            crate::display::sig(stroke, 6),
+            X_SLACK * 100.0,
+            crate::data::column("x_m").map_or(String::new(), |c| crate::data::unit_hint(c, data[i].x_m, lo, hi))
+        ))),
+    }
+}
+
+/// Fits `plunger.spring_rate` and `plunger.preload` to the displacement
+/// data with the oil of the pressure stage `oil`; returns the stage and
+/// the calibrated core.
+fn fit_displacement(
+    base: &RawParams,
+    oil: &PressureFit,
+    data: &[DisplacementPoint],
+) -> Result<(Stage, RawCore), CliError> {
+    let f = &RawCore::FIELD;
+    let names2 = [f.spring_rate.path, f.preload.path];
+    enough_points("--displacement-data", &names2, data.len())?;
+    check_travel(&base.core, data)?;
+    let spring = Spring::of(&base.core);
+    let fluid_core = oil.core;
+    let v0 = [spring.area / base.core.spring_rate * 1e9, base.core.preload * 1e5];
+    let r2 = |v: &[f64]| displacement_residuals(&spring.core(fluid_core, v), data);
+    let j0 = lsq::jacobian(r2, &v0, &steps(&v0)).ok_or_else(|| {
+        let start = spring.core(fluid_core, &v0);
+        let row = data
+            .iter()
+            .position(|p| model_displacement(&start, p.t_c, p.dp_pa).is_none())
+            .map_or(String::new(), |i| {
+                let dp = data[i]
+                    .dp_pa
+                    .map_or("the base file's".to_string(), |d| format!("{} Pa", num(d)));
+                format!(" (first at data row {}: {} C, drop {dp})", i + 1, num(data[i].t_c))
+            });
+        CliError::Input(format!(
+            "--displacement-data: the model cannot be evaluated at the data's temperatures and drops{row}"
+        ))
+    })?;
+    lsq::check_design(&j0, &names2).map_err(|e| undetermined("--displacement-data", &names2, e))?;
+    let fit2 =
+        least_squares(r2, &v0, &steps(&v0)).map_err(|e| CliError::Failed(format!("--displacement-data: {e}")))?;
+    let unc2 = lsq::analyse(&fit2.jacobian, &fit2.residuals, &names2)
+        .map_err(|e| undetermined("--displacement-data", &names2, e))?;
+    let core = spring.core(fluid_core, &fit2.x);
+    Ok((
+        Stage {
             fit: fit2,
             uncertainty: unc2,
-        });
-    }
-    // From fit coordinates to the parameter file's fields (delta method):
-    // L = c 10^u (dL/du = L ln 10), spring_rate = A_p / (v 1e-9)
-    // (d/dv = -spring_rate / v), preload = 1e-5 v.
-    let mut d = vec![1.0, 1.0, core.laminar_length * std::f64::consts::LN_10];
-    if displacement_stage.is_some() {
-        d.push(-core.spring_rate / internal[3]);
-        d.push(1e-5);
-    }
-    let p = d.len();
-    let cov_named = DMatrix::from_fn(p, p, |i, j| d[i] * cov[(i, j)] * d[j]);
-    let fields = [f.walther_a, f.walther_b, f.laminar_length, f.spring_rate, f.preload];
-    // By name, from the schema's access by path.
-    let values = fields.map(|f| core.value(f.path).unwrap_or(f64::NAN));
-    let estimates: Vec<Estimate> = (0..p)
-        .map(|i| Estimate {
-            path: fields[i].path,
-            unit: fields[i].unit,
-            value: values[i],
-            std_error: cov_named[(i, i)].max(0.0).sqrt(),
-            data: if i < 3 { "pressure" } else { "displacement" },
-        })
-        .collect();
-    for e in &estimates {
-        let rel = e.std_error / e.value.abs();
-        if !(rel <= REL_SE_LIMIT) {
-            warnings.push(format!(
-                "{} = {:.4e} {} has a standard error of {:.0} % of its value (above {:.0} %): the {} data \
-                 do not determine it; it is kept in the preset only because the fit needs a value",
-                e.path,
-                e.value,
-                e.unit,
-                100.0 * rel,
-                100.0 * REL_SE_LIMIT,
-                e.data
+        },
+        core,
+    ))
+}
+
+/// The covariance of both stages' estimates together: the displacement
+/// stage's (`stage`, at `core`) propagated from the oil's (`oil`) through
+/// the sensitivity of the displacement residuals to the oil (`J21`), the
+/// two-step estimate's delta method. Order: the oil's three, the spring's
+/// two.
+fn joint_covariance(
+    base: &RawCore,
+    oil: &PressureFit,
+    stage: &Stage,
+    core: RawCore,
+    data: &[DisplacementPoint],
+) -> Result<DMatrix<f64>, CliError> {
+    let with_oil = |t: &[f64]| {
+        let mut c = core;
+        c.walther_a = t[0];
+        c.walther_b = t[1];
+        c.laminar_length = capillary_length_for(base, 10f64.powf(t[2]));
+        c
+    };
+    let theta1 = oil.theta;
+    let h = steps(&theta1);
+    let m = data.len();
+    let mut j21 = DMatrix::zeros(m, 3);
+    for j in 0..3 {
+        let (mut tp, mut tm) = (theta1, theta1);
+        tp[j] += h[j];
+        tm[j] -= h[j];
+        let rp = displacement_residuals(&with_oil(&tp), data);
+        let rm = displacement_residuals(&with_oil(&tm), data);
+        let (Some(rp), Some(rm)) = (rp, rm) else {
+            return Err(CliError::Failed(
+                "--displacement-data: the model cannot be evaluated next to the fitted oil".into(),
             ));
+        };
+        for i in 0..m {
+            j21[(i, j)] = (rp[i] - rm[i]) / (2.0 * h[j]);
         }
+    }
+    let cov1 = &oil.cov;
+    let j2 = &stage.fit.jacobian;
+    let jtj = j2.transpose() * j2;
+    let inv = jtj
+        .try_inverse()
+        .ok_or_else(|| CliError::Failed("--displacement-data: singular normal equations".into()))?;
+    let sens = -(inv * j2.transpose() * &j21);
+    let cov22 = &stage.uncertainty.cov + &sens * cov1 * sens.transpose();
+    let cov21 = &sens * cov1;
+    let mut full = DMatrix::zeros(5, 5);
+    full.view_mut((0, 0), (3, 3)).copy_from(cov1);
+    full.view_mut((3, 3), (2, 2)).copy_from(&cov22);
+    full.view_mut((3, 0), (2, 3)).copy_from(&cov21);
+    full.view_mut((0, 3), (3, 2)).copy_from(&cov21.transpose());
+    Ok(full)
+}
+
+/// Refuses `points` data points for the parameters `names` (of the data
+/// `which`) when they leave no degree of freedom.
+fn enough_points(which: &str, names: &[&str], points: usize) -> Result<(), CliError> {
+    if points <= names.len() {
+        return Err(undetermined(
+            which,
+            names,
+            lsq::Undetermined::NoDegreesOfFreedom {
+                points,
+                parameters: names.len(),
+            },
+        ));
+    }
+    Ok(())
+}
+
+/// Fits the base parameter set to the data (see the module docs).
+///
+/// Errors: [`CliError::Input`] when the data cannot determine the
+/// parameters (no degree of freedom, a rank-deficient Jacobian: the message
+/// names the data and the parameters) or the base file is not valid;
+/// [`CliError::Failed`] when the minimiser does not converge.
+pub fn fit(
+    base: &RawParams,
+    pressure: &[PressurePoint],
+    displacement: Option<&[DisplacementPoint]>,
+) -> Result<Calibration, CliError> {
+    let oil = fit_pressure(base, pressure)?;
+    let mut warnings: Vec<String> = (oil.stage.uncertainty.warnings().into_iter())
+        .map(|w| format!("pressure data: {w}"))
+        .collect();
+    let mut core = oil.core;
+    let mut displacement_stage = None;
+    let mut cov = oil.cov.clone();
+    let mut internal = oil.theta.to_vec();
+    if let Some(data) = displacement {
+        let (stage, spring_core) = fit_displacement(base, &oil, data)?;
+        warnings.extend((stage.uncertainty.warnings().into_iter()).map(|w| format!("displacement data: {w}")));
+        core = spring_core;
+        cov = joint_covariance(&base.core, &oil, &stage, core, data)?;
+        internal.extend_from_slice(&stage.fit.x);
+        displacement_stage = Some(stage);
     }
     let mut params = *base;
     params.core = core;
+    let (estimates, cov_named) = named_estimates(&params, &cov, &internal)?;
+    warnings.extend(estimates.iter().filter_map(undetermined_warning));
     params
         .validate()
         .map_err(|e| CliError::Failed(format!("calibrated parameters are not valid: {e}")))?;
@@ -549,12 +590,66 @@ pub fn fit(
         estimates,
         correlation: lsq::correlation(&cov_named),
         covariance: cov_named,
-        pressure: Stage {
-            fit: fit1,
-            uncertainty: unc1,
-        },
+        pressure: oil.stage,
         displacement: displacement_stage,
         warnings,
+    })
+}
+
+/// The estimates in the parameter file's fields, from the fit coordinates
+/// `internal` with covariance `cov` (three with the pressure stage alone,
+/// five with the displacement stage), by the delta method:
+/// `L = c 10^u` (`dL/du = L ln 10`), `spring_rate = A_p / (v 1e-9)`
+/// (`d/dv = -spring_rate / v`), `preload = 1e-5 v`. Returns them and
+/// their covariance.
+fn named_estimates(
+    params: &RawParams,
+    cov: &DMatrix<f64>,
+    internal: &[f64],
+) -> Result<(Vec<Estimate>, DMatrix<f64>), CliError> {
+    let f = &RawCore::FIELD;
+    let core = &params.core;
+    let mut d = vec![1.0, 1.0, core.laminar_length * std::f64::consts::LN_10];
+    if internal.len() > 3 {
+        d.push(-core.spring_rate / internal[3]);
+        d.push(1e-5);
+    }
+    let p = d.len();
+    let cov_named = DMatrix::from_fn(p, p, |i, j| d[i] * cov[(i, j)] * d[j]);
+    let fields = [f.walther_a, f.walther_b, f.laminar_length, f.spring_rate, f.preload];
+    let estimates = (0..p)
+        .map(|i| {
+            // By name, through the schema's access by path.
+            let value = params
+                .get(fields[i].path)
+                .map_err(|e| CliError::Failed(format!("calibrated parameters: {e}")))?;
+            Ok(Estimate {
+                path: fields[i].path,
+                unit: fields[i].unit,
+                value,
+                std_error: cov_named[(i, i)].max(0.0).sqrt(),
+                data: if i < 3 { "pressure" } else { "displacement" },
+            })
+        })
+        .collect::<Result<Vec<Estimate>, CliError>>()?;
+    Ok((estimates, cov_named))
+}
+
+/// The warning for an estimate the data do not determine (relative
+/// standard error above [`REL_SE_LIMIT`]), if it is one.
+fn undetermined_warning(e: &Estimate) -> Option<String> {
+    let rel = e.std_error / e.value.abs();
+    (!(rel <= REL_SE_LIMIT)).then(|| {
+        format!(
+            "{} = {:.4e} {} has a standard error of {:.0} % of its value (above {:.0} %): the {} data \
+             do not determine it; it is kept in the preset only because the fit needs a value",
+            e.path,
+            e.value,
+            e.unit,
+            100.0 * rel,
+            100.0 * REL_SE_LIMIT,
+            e.data
+        )
     })
 }
 
@@ -773,8 +868,10 @@ impl Calibration {
             .map(|&i| {
                 let e = &self.estimates[i];
                 let std_error = self.covariance[(i, i)].max(0.0).sqrt();
-                let base_value = base.core.value(e.path).unwrap_or(f64::NAN);
-                Held {
+                let base_value = base
+                    .get(e.path)
+                    .map_err(|e| CliError::Failed(format!("calibrated tolerances: {e}")))?;
+                Ok(Held {
                     path: e.path,
                     unit: e.unit,
                     value: e.value,
@@ -782,9 +879,9 @@ impl Calibration {
                     tolerance: cov[(i, i)].sqrt(),
                     base_value,
                     shift: (e.value - base_value).abs() / std_error,
-                }
+                })
             })
-            .collect();
+            .collect::<Result<Vec<Held>, CliError>>()?;
         Ok(Written {
             tolerances,
             covariance: cov,
@@ -1109,25 +1206,9 @@ pub fn calibrate(opts: &Options) -> Result<Output, CliError> {
         }
         None => None,
     };
-    // Every temperature inside the base file's oil model (refused naming
-    // the row otherwise); rows outside the validated range are counted.
     let params = compensator::Params::<f64>::new(&base).map_err(|e| CliError::Input(format!("--params: {e}")))?;
     let env = crate::envelope::Envelope::of(&base, &params);
-    let mut outside = 0;
-    for (flag, temps) in [
-        ("--pressure-data", pressure.iter().map(|p| p.t_c).collect::<Vec<_>>()),
-        (
-            "--displacement-data",
-            displacement.iter().flatten().map(|p| p.t_c).collect::<Vec<_>>(),
-        ),
-    ] {
-        for (i, &t) in temps.iter().enumerate() {
-            let at = format!("{flag}: data row {}, column t_c", i + 1);
-            if env.check(t, &at)? == crate::envelope::Zone::OilModel {
-                outside += 1;
-            }
-        }
-    }
+    let outside = outside_validated(&env, &pressure, displacement.as_deref())?;
     let cal = fit(&base, &pressure, displacement.as_deref())?;
     let mut held = Vec::new();
     let mut command = format!(
@@ -1158,22 +1239,59 @@ pub fn calibrate(opts: &Options) -> Result<Output, CliError> {
         ));
     }
     notes.extend(cal.warnings.iter().map(|w| format!("WARNING: {w}")));
-    for h in &held {
-        notes.push(format!(
-            "--write-preset: {}: its tolerance is the base file's, {:.3e} {} (the fit's standard error, {:.3e} {}, \
-             is above a third of the value); the other fitted fields' covariance is conditioned on it",
-            h.path, h.tolerance, h.unit, h.std_error, h.unit
-        ));
-        if h.shift > HELD_SHIFT_WARN {
-            notes.push(format!(
-                "WARNING: {}: the fitted value {} lies {:.2} standard errors from the base file's {}: the written \
-                 band assumes a value the base file does not support",
-                h.path, h.value, h.shift, h.base_value
-            ));
-        }
-    }
+    notes.extend(held.iter().flat_map(held_notes));
     Ok(Output {
         table: cal.table(),
         notes,
     })
+}
+
+/// The data rows outside the validated range of `env`; every temperature
+/// must be inside its oil model (refused naming the data and the row
+/// otherwise).
+fn outside_validated(
+    env: &crate::envelope::Envelope,
+    pressure: &[PressurePoint],
+    displacement: Option<&[DisplacementPoint]>,
+) -> Result<usize, CliError> {
+    let mut outside = 0;
+    for (flag, temps) in [
+        ("--pressure-data", pressure.iter().map(|p| p.t_c).collect::<Vec<_>>()),
+        (
+            "--displacement-data",
+            displacement
+                .iter()
+                .copied()
+                .flatten()
+                .map(|p| p.t_c)
+                .collect::<Vec<_>>(),
+        ),
+    ] {
+        for (i, &t) in temps.iter().enumerate() {
+            let at = format!("{flag}: data row {}, column t_c", i + 1);
+            if env.check(t, &at)? == crate::envelope::Zone::OilModel {
+                outside += 1;
+            }
+        }
+    }
+    Ok(outside)
+}
+
+/// The notes on a field written with the base file's tolerance
+/// ([`Written::held`]): that it is, and a warning when the fit lies far
+/// from the base file's value.
+fn held_notes(h: &Held) -> Vec<String> {
+    let mut notes = vec![format!(
+        "--write-preset: {}: its tolerance is the base file's, {:.3e} {} (the fit's standard error, {:.3e} {}, \
+         is above a third of the value); the other fitted fields' covariance is conditioned on it",
+        h.path, h.tolerance, h.unit, h.std_error, h.unit
+    )];
+    if h.shift > HELD_SHIFT_WARN {
+        notes.push(format!(
+            "WARNING: {}: the fitted value {} lies {:.2} standard errors from the base file's {}: the written \
+             band assumes a value the base file does not support",
+            h.path, h.value, h.shift, h.base_value
+        ));
+    }
+    notes
 }

@@ -88,6 +88,23 @@ impl Table {
         self.text.push('\n');
     }
 
+    /// A row per temperature of `temps`: `t` and the cells `cells(t)`
+    /// computes, or, where it fails, `t` and the error's message
+    /// ([`Self::row_error`]).
+    pub fn rows_at<E: std::fmt::Display>(&mut self, temps: &[f64], mut cells: impl FnMut(f64) -> Result<Vec<f64>, E>) {
+        for &t in temps {
+            match cells(t) {
+                Ok(c) => {
+                    let mut row = Vec::with_capacity(c.len() + 1);
+                    row.push(t);
+                    row.extend(c);
+                    self.row(&row);
+                }
+                Err(e) => self.row_error(&[t], &e.to_string()),
+            }
+        }
+    }
+
     /// Appends a row that could not be computed: its first cells `leading`
     /// (e.g. the temperature), empty cells for the rest, and `message` in
     /// the `error` column (a table made by [`Table::complete`] has none:

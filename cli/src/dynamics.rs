@@ -401,9 +401,8 @@ pub fn twin_config(path: &Path, dt: f64) -> Result<String, CliError> {
 
 /// `eigen`: eigenvalues of the linearisation per temperature.
 pub fn eigen(path: &Path, temps_spec: &str) -> Result<String, CliError> {
-    let (_, p, env) = crate::input::load_with_envelope(path)?;
-    let temps: Vec<f64> = env.temps(temps_spec)?.into_iter().map(|(t, _)| t).collect();
-    Ok(env.mark(eigen_table(&p, &temps).as_str(), &["t_c"]))
+    let input = crate::input::load_at_temps(path, temps_spec)?;
+    Ok(input.mark(eigen_table(&input.params, &input.temps).as_str()))
 }
 
 /// The `eigen` table of a parameter set at `temps` [C]: eigenvalues
@@ -427,24 +426,12 @@ pub fn eigen_table(p: &Params<f64>, temps: &[f64]) -> Table {
         "omega_n_dominant",
         "zeta_plunger",
     ]);
-    for &t in temps {
-        let l = match linearise(p, t) {
-            Ok(l) => l,
-            Err(e) => {
-                table.row_error(&[t], &e.to_string());
-                continue;
-            }
-        };
-        let mut row = vec![t];
-        for e in &l.eigenvalues {
-            row.push(e.re);
-            row.push(e.im);
-        }
-        row.push(l.damping_ratio[0]);
-        row.push(l.natural_frequency[0]);
-        row.push(l.plunger_damping_ratio);
-        table.row(&row);
-    }
+    table.rows_at(temps, |t| {
+        let l = linearise(p, t)?;
+        let mut row: Vec<f64> = l.eigenvalues.iter().flat_map(|e| [e.re, e.im]).collect();
+        row.extend([l.damping_ratio[0], l.natural_frequency[0], l.plunger_damping_ratio]);
+        Ok::<_, compensator::ModelError>(row)
+    });
     table
 }
 

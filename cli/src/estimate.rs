@@ -328,7 +328,6 @@ fn seconds(s: f64) -> String {
 /// cannot be built (named); `estimator.telemetry_hz = 0` without
 /// [`Options::every_sample`].
 pub fn run(raw: &RawParams, log: &Log, options: Options) -> Result<Replay, CliError> {
-    let bad = |i: usize, column: &str, why: String| CliError::Input(format!("{}: {why}", log.at(i, column)));
     let n = log.time_s.len();
     if n < 2 {
         return Err(CliError::Input(
@@ -338,52 +337,7 @@ pub fn run(raw: &RawParams, log: &Log, options: Options) -> Result<Replay, CliEr
     let hz = raw.estimator.tick_hz;
     let tick = 1.0 / hz;
     let t0 = log.time_s[0];
-    let mut ticks = Vec::with_capacity(n);
-    for (i, &t) in log.time_s.iter().enumerate() {
-        let k = ((t - t0) * hz + TICK_SLACK).floor();
-        if i > 0 {
-            let prev = log.time_s[i - 1];
-            if !(t > prev) {
-                return Err(bad(
-                    i,
-                    TIME_COLUMN,
-                    format!(
-                        "{} s is not after the row before ({} s): the sample times must increase",
-                        sig(t, 10),
-                        sig(prev, 10)
-                    ),
-                ));
-            }
-            if k as u64 == ticks[i - 1] {
-                return Err(bad(
-                    i,
-                    TIME_COLUMN,
-                    format!(
-                        "{} after the row before, within one tick of the estimator ({} at estimator.tick_hz = \
-                         {} Hz): it takes one reading a tick",
-                        seconds(t - prev),
-                        seconds(tick),
-                        sig(hz, 6)
-                    ),
-                ));
-            }
-        }
-        if k >= MAX_TICKS as f64 {
-            return Err(bad(
-                i,
-                TIME_COLUMN,
-                format!(
-                    "the log spans {} s, more than the limit of {} ticks ({} s at estimator.tick_hz = {} Hz): \
-                     {SPLIT}",
-                    sig(t - t0, 8),
-                    sig(MAX_TICKS as f64, 6),
-                    sig(MAX_TICKS as f64 * tick, 6),
-                    sig(hz, 6)
-                ),
-            ));
-        }
-        ticks.push(k as u64);
-    }
+    let ticks = ticks_of(log, hz)?;
     // The reading interval: the median of the intervals, in whole ticks.
     let mut gaps: Vec<u64> = ticks.windows(2).map(|w| w[1] - w[0]).collect();
     gaps.sort_unstable();
@@ -391,25 +345,7 @@ pub fn run(raw: &RawParams, log: &Log, options: Options) -> Result<Replay, CliEr
     let sample_period = median as f64 * tick;
     let config = EstimatorConfig::with_sample_period(raw, sample_period)
         .map_err(|e| CliError::Input(format!("--params: {e}")))?;
-    // More than `stale_after` ticks without a reading between two rows
-    // (readings `stale_after + 1` ticks apart keep the estimate good: the
-    // count is reset on the tick a reading arrives).
-    let timeout = u64::from(config.stale_after);
-    if let Some(w) = ticks.windows(2).position(|w| w[1] - w[0] - 1 > timeout) {
-        let i = w + 1;
-        return Err(bad(
-            i,
-            TIME_COLUMN,
-            format!(
-                "{} after the row before, longer than the estimator's fault timeout: it flags the estimate \
-                 DEGRADED after {} without a reading ({timeout} ticks at estimator.tick_hz = {} Hz); split the \
-                 log at this row and replay each part on its own",
-                seconds(log.time_s[i] - log.time_s[i - 1]),
-                seconds(timeout as f64 * tick),
-                sig(hz, 6)
-            ),
-        ));
-    }
+    check_gaps(log, &ticks, u64::from(config.stale_after), hz)?;
     if config.telemetry_every == 0 && !options.every_sample {
         return Err(CliError::Input(
             "--params: estimator.telemetry_hz = 0: the file asks for no telemetry; give --every-sample for one row \
@@ -419,41 +355,7 @@ pub fn run(raw: &RawParams, log: &Log, options: Options) -> Result<Replay, CliEr
     }
     let settings = Settings::from_params(&raw.estimator);
     let name = log.column.name;
-    let start = match sample(log, &settings, 0) {
-        Ok(Some(t)) => t,
-        _ => {
-            let v = log.value[0];
-            let curve = |t: f32| sig(f64::from(settings.cvd.resistance(settings.r0, t)), 4);
-            let range = format!(
-                "the file's RTD, estimator.rtd_r0 = {} ohm, reads {} to {} ohm over IEC 60751's {} to {} C",
-                sig(raw.estimator.rtd_r0, 6),
-                curve(rtd::T_MIN),
-                curve(rtd::T_MAX),
-                rtd::T_MIN,
-                rtd::T_MAX
-            );
-            let what = match log.column.reading {
-                Reading::Code if v == 0.0 || v >= 32767.0 => {
-                    format!(
-                        "{} is a saturated code, a sensor fault (a shorted or open RTD)",
-                        sig(v, 8)
-                    )
-                }
-                Reading::Code => format!(
-                    "code {} is {} ohm (estimator.rtd_reference = {} ohm), no temperature: {range}",
-                    sig(v, 8),
-                    sig(v * raw.estimator.rtd_reference / 32768.0, 6),
-                    sig(raw.estimator.rtd_reference, 6)
-                ),
-                _ => format!("{} ohm is no temperature: {range}", sig(v, 8)),
-            };
-            return Err(bad(
-                0,
-                name,
-                format!("{what}; the estimator starts at the first reading: begin the log at a valid one"),
-            ));
-        }
-    };
+    let start = first_reading(raw, log, &settings)?;
     let params = Params::<f64>::new(raw).map_err(|e| CliError::Input(format!("--params: {e}")))?;
     let envelope = crate::envelope::Envelope::of(raw, &params);
     envelope.check(
@@ -462,11 +364,11 @@ pub fn run(raw: &RawParams, log: &Log, options: Options) -> Result<Replay, CliEr
     )?;
     let params32 = Params::<f32>::new(raw).map_err(|e| CliError::Input(format!("--params: {e}")))?;
     let mut estimator = Estimator::new(&params32, config, start).map_err(|e| {
-        bad(
-            0,
-            name,
-            format!("the estimator cannot start at {} C: {e}", sig(f64::from(start), 6)),
-        )
+        CliError::Input(format!(
+            "{}: the estimator cannot start at {} C: {e}",
+            log.at(0, name),
+            sig(f64::from(start), 6)
+        ))
     })?;
     let last = ticks[n - 1];
     let mut out = header().join(",");
@@ -488,12 +390,12 @@ pub fn run(raw: &RawParams, log: &Log, options: Options) -> Result<Replay, CliEr
             rows += 1;
         }
     }
+    let telemetry_period = seconds(config.telemetry_every as f64 * tick);
     if rows == 0 {
         return Err(CliError::Input(format!(
-            "no telemetry tick in the log's {} s (the firmware publishes one every {}): no row to print; \
-             give --every-sample for one row per reading",
+            "no telemetry tick in the log's {} s (the firmware publishes one every {telemetry_period}): no row to \
+             print; give --every-sample for one row per reading",
             sig(log.time_s[n - 1] - t0, 8),
-            seconds(config.telemetry_every as f64 * tick)
         )));
     }
     let note = format!(
@@ -506,10 +408,7 @@ pub fn run(raw: &RawParams, log: &Log, options: Options) -> Result<Replay, CliEr
         if options.every_sample {
             String::from(", one per reading")
         } else {
-            format!(
-                ", one per telemetry period ({})",
-                seconds(config.telemetry_every as f64 * tick)
-            )
+            format!(", one per telemetry period ({telemetry_period})")
         }
     );
     Ok(Replay {
@@ -518,6 +417,121 @@ pub fn run(raw: &RawParams, log: &Log, options: Options) -> Result<Replay, CliEr
         ticks: last + 1,
         note,
     })
+}
+
+/// The estimator's tick each row of `log` is delivered on (at `hz`, from
+/// the first row's time).
+///
+/// Errors: times that do not increase, two rows within one tick, a log
+/// longer than [`MAX_TICKS`] (naming the row).
+fn ticks_of(log: &Log, hz: f64) -> Result<Vec<u64>, CliError> {
+    let bad = |i: usize, why: String| CliError::Input(format!("{}: {why}", log.at(i, TIME_COLUMN)));
+    let tick = 1.0 / hz;
+    let t0 = log.time_s[0];
+    let mut ticks: Vec<u64> = Vec::with_capacity(log.time_s.len());
+    for (i, &t) in log.time_s.iter().enumerate() {
+        let k = ((t - t0) * hz + TICK_SLACK).floor();
+        if i > 0 {
+            let prev = log.time_s[i - 1];
+            if !(t > prev) {
+                return Err(bad(
+                    i,
+                    format!(
+                        "{} s is not after the row before ({} s): the sample times must increase",
+                        sig(t, 10),
+                        sig(prev, 10)
+                    ),
+                ));
+            }
+            if k as u64 == ticks[i - 1] {
+                return Err(bad(
+                    i,
+                    format!(
+                        "{} after the row before, within one tick of the estimator ({} at estimator.tick_hz = \
+                         {} Hz): it takes one reading a tick",
+                        seconds(t - prev),
+                        seconds(tick),
+                        sig(hz, 6)
+                    ),
+                ));
+            }
+        }
+        if k >= MAX_TICKS as f64 {
+            return Err(bad(
+                i,
+                format!(
+                    "the log spans {} s, more than the limit of {} ticks ({} s at estimator.tick_hz = {} Hz): \
+                     {SPLIT}",
+                    sig(t - t0, 8),
+                    sig(MAX_TICKS as f64, 6),
+                    sig(MAX_TICKS as f64 * tick, 6),
+                    sig(hz, 6)
+                ),
+            ));
+        }
+        ticks.push(k as u64);
+    }
+    Ok(ticks)
+}
+
+/// Refuses more than `timeout` ticks without a reading between two rows
+/// (readings `timeout + 1` ticks apart keep the estimate good: the count
+/// is reset on the tick a reading arrives), naming the row after the gap.
+fn check_gaps(log: &Log, ticks: &[u64], timeout: u64, hz: f64) -> Result<(), CliError> {
+    let Some(w) = ticks.windows(2).position(|w| w[1] - w[0] - 1 > timeout) else {
+        return Ok(());
+    };
+    let i = w + 1;
+    Err(CliError::Input(format!(
+        "{}: {} after the row before, longer than the estimator's fault timeout: it flags the estimate DEGRADED \
+         after {} without a reading ({timeout} ticks at estimator.tick_hz = {} Hz); split the log at this row and \
+         replay each part on its own",
+        log.at(i, TIME_COLUMN),
+        seconds(log.time_s[i] - log.time_s[i - 1]),
+        seconds(timeout as f64 * (1.0 / hz)),
+        sig(hz, 6)
+    )))
+}
+
+/// The temperature of the log's first reading, which the estimator starts
+/// at.
+///
+/// Errors: a first reading the firmware would flag or that is no
+/// temperature (a saturated code, a resistance outside the RTD's curve),
+/// naming why.
+fn first_reading(raw: &RawParams, log: &Log, settings: &Settings) -> Result<f32, CliError> {
+    if let Ok(Some(t)) = sample(log, settings, 0) {
+        return Ok(t);
+    }
+    let v = log.value[0];
+    let curve = |t: f32| sig(f64::from(settings.cvd.resistance(settings.r0, t)), 4);
+    let range = format!(
+        "the file's RTD, estimator.rtd_r0 = {} ohm, reads {} to {} ohm over IEC 60751's {} to {} C",
+        sig(raw.estimator.rtd_r0, 6),
+        curve(rtd::T_MIN),
+        curve(rtd::T_MAX),
+        rtd::T_MIN,
+        rtd::T_MAX
+    );
+    let what = match log.column.reading {
+        Reading::Code if v == 0.0 || v >= 32767.0 => {
+            format!(
+                "{} is a saturated code, a sensor fault (a shorted or open RTD)",
+                sig(v, 8)
+            )
+        }
+        Reading::Code => format!(
+            "code {} is {} ohm (estimator.rtd_reference = {} ohm), no temperature: {range}",
+            sig(v, 8),
+            sig(v * raw.estimator.rtd_reference / 32768.0, 6),
+            sig(raw.estimator.rtd_reference, 6)
+        ),
+        _ => format!("{} ohm is no temperature: {range}", sig(v, 8)),
+    };
+    Err(CliError::Input(format!(
+        "{}: {what}; the estimator starts at the first reading: begin the log at a valid one",
+        log.at(0, log.column.name)
+    )))
 }
 
 #[cfg(test)]

@@ -119,6 +119,63 @@ pub fn load_params<T: Float>(path: &Path) -> Result<(RawParams, Params<T>), CliE
     Ok((raw, params))
 }
 
+/// [`load_params`] in `f64` of the file `path`, or without one of the
+/// built-in [`PAPER_PRESET`] (`paper` and `report`).
+///
+/// # Errors
+///
+/// As [`load_params`].
+pub fn load_or_paper(path: Option<&Path>) -> Result<(RawParams, Params<f64>), CliError> {
+    match path {
+        Some(path) => load_params::<f64>(path),
+        None => {
+            let raw = params_file::parse(PAPER_PRESET)?;
+            let p = Params::<f64>::new(&raw).map_err(|e| CliError::Input(e.to_string()))?;
+            Ok((raw, p))
+        }
+    }
+}
+
+/// What a table with a row per temperature is computed from: the file in
+/// `f64` with its envelope, and the temperature list checked against it.
+pub struct AtTemps {
+    /// The file as read.
+    pub raw: RawParams,
+    /// The file in `f64`.
+    pub params: Params<f64>,
+    /// Its temperature envelope.
+    pub envelope: crate::envelope::Envelope,
+    /// The list's temperatures [C], each within the envelope.
+    pub temps: Vec<f64>,
+}
+
+impl AtTemps {
+    /// `csv`, a table whose rows start with `t_c`, with the envelope's
+    /// column.
+    pub fn mark(&self, csv: &str) -> String {
+        self.envelope.mark(csv, &["t_c"])
+    }
+}
+
+/// Loads the file `path` ([`load_with_envelope`]) and the list
+/// `temps_spec` (`--temps`), each temperature checked against the file's
+/// envelope.
+///
+/// # Errors
+///
+/// As [`load_with_envelope`]; a list that does not parse or a temperature
+/// outside the oil model (naming `--temps`).
+pub fn load_at_temps(path: &Path, temps_spec: &str) -> Result<AtTemps, CliError> {
+    let (raw, params, envelope) = load_with_envelope(path)?;
+    let temps = envelope.temps(temps_spec)?.into_iter().map(|(t, _)| t).collect();
+    Ok(AtTemps {
+        raw,
+        params,
+        envelope,
+        temps,
+    })
+}
+
 /// [`load_params`] in `f64` with the file's temperature envelope.
 ///
 /// # Errors

@@ -13,9 +13,9 @@
 use crate::csv::{self, Table};
 use crate::dynamics::{Precision, eigen_table, simulate, step_indicators};
 use crate::error::CliError;
-use crate::input::load_params;
-use crate::paper::tables::{BAR, load_tables, table1_residuals, table2_residuals};
-use crate::paper::{self, asymptotic_search};
+use crate::input::load_or_paper;
+use crate::paper::tables::{BAR, Table1, Table2, load_tables, table1_residuals, table2_residuals};
+use crate::paper::{self, AsymptoticMatch, asymptotic_search};
 use crate::plot::{self, Figure, Series, panel};
 use crate::sizing::compensation_of;
 use crate::statics::find_balance;
@@ -110,17 +110,6 @@ const STEP_T_END: f64 = 0.1;
 const INDICATOR_DT: f64 = 1.0e-4;
 const INDICATOR_T_END: f64 = 1.0;
 
-fn load(path: Option<&Path>) -> Result<(RawParams, Params<f64>), CliError> {
-    match path {
-        Some(path) => load_params::<f64>(path),
-        None => {
-            let raw = crate::params_file::parse(crate::input::PAPER_PRESET)?;
-            let p = Params::<f64>::new(&raw).map_err(|e| CliError::Input(e.to_string()))?;
-            Ok((raw, p))
-        }
-    }
-}
-
 /// A number for a markdown table: four significant digits.
 fn sig(v: f64) -> String {
     if !v.is_finite() {
@@ -175,53 +164,77 @@ fn responses(raw: &RawParams, steps: &[(f64, f64)]) -> Result<Vec<Run>, CliError
         .collect()
 }
 
-/// Writes the report into `opts.out`; returns the list of files written
-/// (one per line).
-pub fn report(opts: &Options) -> Result<String, CliError> {
-    let u = opts.units;
-    let (raw, p) = load(opts.params)?;
-    let (t1, t2) = load_tables(opts.data).map_err(CliError::Input)?;
-    let t3 = Table3::load(opts.data).map_err(CliError::Input)?;
-    std::fs::create_dir_all(opts.out).map_err(|e| CliError::Input(format!("--dir: {}: {e}", opts.out.display())))?;
-    let mut written: Vec<PathBuf> = Vec::new();
-    let shown = opts
-        .params
-        .map_or("presets/paper.toml (built in)".into(), |p| p.display().to_string());
+/// What the report is computed from: the parameter set, the paper's
+/// tables and the expansion that best reproduces Table 2's "asym" column
+/// (as `paper` finds it).
+struct Inputs {
+    raw: RawParams,
+    p: Params<f64>,
+    t1: Table1,
+    t2: Table2,
+    t3: Table3,
+    expansion: Option<(AsymptoticMatch, Expansion<f64>)>,
+}
 
-    // Table 1: p_b - p_a at the three drops.
-    let r1 = table1_residuals(&p, &t1);
-    let mut table1 = Table::new(&["t_c", "dp_pa", "paper_dp_ab_pa", "model_dp_ab_pa", "residual_pa"]);
+impl Inputs {
+    fn load(opts: &Options) -> Result<Self, CliError> {
+        let (raw, p) = load_or_paper(opts.params)?;
+        let (t1, t2) = load_tables(opts.data).map_err(CliError::Input)?;
+        let t3 = Table3::load(opts.data).map_err(CliError::Input)?;
+        let balance = find_balance(&raw, &p).ok();
+        let (best, _) = asymptotic_search(&p, &t2, 26.0, 80.0, balance);
+        let best = best.into_iter().min_by(|a, b| a.rms_mm.total_cmp(&b.rms_mm));
+        let expansion = best.and_then(|b| Expansion::new(&p, b.t0, b.reading).ok().map(|e| (b, e)));
+        Ok(Inputs {
+            raw,
+            p,
+            t1,
+            t2,
+            t3,
+            expansion,
+        })
+    }
+
+    /// The best expansion's displacement at `t` [m] (NaN without one, or
+    /// where it cannot be evaluated).
+    fn asym_x(&self, t: f64) -> f64 {
+        self.expansion
+            .as_ref()
+            .and_then(|(b, e)| e.at(t).ok().map(|terms| terms.x(b.order).0))
+            .unwrap_or(f64::NAN)
+    }
+}
+
+/// Table 1: p_b - p_a at the three drops, the paper's beside the model's
+/// (SI CSV), and the residuals [bar].
+fn table1(inp: &Inputs) -> (Table, Vec<f64>) {
+    let t1 = &inp.t1;
+    let r1 = table1_residuals(&inp.p, t1);
+    let mut table = Table::new(&["t_c", "dp_pa", "paper_dp_ab_pa", "model_dp_ab_pa", "residual_pa"]);
     let nd = t1.drops_bar.len();
     for (i, &t) in t1.temps.iter().enumerate() {
         for (j, &dp) in t1.drops_bar.iter().enumerate() {
             let paper = t1.values[i][j];
             let r = r1[i * nd + j];
             if r.is_finite() {
-                table1.row(&[t, dp * BAR, paper * BAR, (paper + r) * BAR, r * BAR]);
+                table.row(&[t, dp * BAR, paper * BAR, (paper + r) * BAR, r * BAR]);
             } else {
-                table1.row_error(
+                table.row_error(
                     &[t, dp * BAR, paper * BAR],
                     "the model cannot evaluate this temperature",
                 );
             }
         }
     }
-    let table1 = u.convert_csv(table1.as_str());
+    (table, r1)
+}
 
-    // Table 2: quasi-static and "asymptotic" displacement; the expansion is
-    // the one that reproduces the "asym" column best (as `paper` finds).
-    let r2 = table2_residuals(&p, &t2);
-    let balance = find_balance(&raw, &p).ok();
-    let (best, _) = asymptotic_search(&p, &t2, 26.0, 80.0, balance);
-    let best = best.into_iter().min_by(|a, b| a.rms_mm.total_cmp(&b.rms_mm));
-    let expansion = best.and_then(|b| Expansion::new(&p, b.t0, b.reading).ok().map(|e| (b, e)));
-    let asym_x = |t: f64| {
-        expansion
-            .as_ref()
-            .and_then(|(b, e)| e.at(t).ok().map(|terms| terms.x(b.order).0))
-            .unwrap_or(f64::NAN)
-    };
-    let mut table2 = Table::new(&[
+/// Table 2: quasi-static and "asymptotic" displacement, the paper's beside
+/// the model's (SI CSV), and the quasi-static residuals [mm].
+fn table2(inp: &Inputs) -> (Table, Vec<f64>) {
+    let t2 = &inp.t2;
+    let r2 = table2_residuals(&inp.p, t2);
+    let mut table = Table::new(&[
         "t_c",
         "paper_x_qs_m",
         "model_x_qs_m",
@@ -233,22 +246,26 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
     for (i, &t) in t2.temps.iter().enumerate() {
         let (pq, pa) = (t2.x_qs_mm[i] * 1e-3, t2.x_asym_mm[i] * 1e-3);
         let mq = pq + r2[i] * 1e-3;
-        let ma = asym_x(t);
+        let ma = inp.asym_x(t);
         if mq.is_finite() && ma.is_finite() {
-            table2.row(&[t, pq, mq, mq - pq, pa, ma, ma - pa]);
+            table.row(&[t, pq, mq, mq - pq, pa, ma, ma - pa]);
         } else {
-            table2.row_error(&[t, pq], "the model cannot evaluate this temperature");
+            table.row_error(&[t, pq], "the model cannot evaluate this temperature");
         }
     }
-    let table2 = u.convert_csv(table2.as_str());
+    (table, r2)
+}
 
-    // Table 3: step indicators (reference solver), steps in parallel.
+/// Table 3: the step indicators (reference solver, steps in parallel),
+/// the paper's beside the model's (SI CSV).
+fn table3(inp: &Inputs) -> Table {
+    let t3 = &inp.t3;
     let indicators: Vec<Result<crate::dynamics::Indicators, CliError>> = t3
         .steps
         .par_iter()
-        .map(|&(from, to)| step_indicators(&raw, &p, from, to, INDICATOR_DT, INDICATOR_T_END))
+        .map(|&(from, to)| step_indicators(&inp.raw, &inp.p, from, to, INDICATOR_DT, INDICATOR_T_END))
         .collect();
-    let mut table3 = Table::new(&[
+    let mut table = Table::new(&[
         "from_c",
         "to_c",
         "paper_x_star_m",
@@ -263,7 +280,7 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
     for (k, ind) in indicators.iter().enumerate() {
         let (from, to) = t3.steps[k];
         match ind {
-            Ok(ind) => table3.row(&[
+            Ok(ind) => table.row(&[
                 from,
                 to,
                 t3.x_star_mm[k] * 1e-3,
@@ -275,33 +292,32 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
                 t3.dominant_re[k],
                 ind.dominant_re,
             ]),
-            Err(e) => table3.row_error(&[from, to], &e.to_string()),
+            Err(e) => table.row_error(&[from, to], &e.to_string()),
         }
     }
-    let table3 = u.convert_csv(table3.as_str());
-    for (name, text) in [
-        ("table1.csv", &table1),
-        ("table2.csv", &table2),
-        ("table3.csv", &table3),
-    ] {
-        let path = opts.out.join(name);
-        write_file(&path, text)?;
-        written.push(path);
-    }
+    table
+}
 
-    // Figures.
-    let (pr, len) = (u.pressure(), u.length());
-    let fine: Vec<f64> = (0..=112).map(|i| 26.0 + 0.5 * i as f64).collect();
-    let mut figures: Vec<(&str, &str, Figure)> = Vec::new();
+/// A figure of the report: its file name (without extension), its caption
+/// in `report.md`, the figure.
+type Named = (&'static str, &'static str, Figure);
 
-    // Figure 2: p_b - p_a over temperature at the three drops.
+/// The temperatures the figures' model curves are drawn at [C].
+fn fine() -> Vec<f64> {
+    (0..=112).map(|i| 26.0 + 0.5 * i as f64).collect()
+}
+
+/// Figure 2: p_b - p_a over temperature at the three drops, the model's
+/// lines and the paper's Table 1 points.
+fn figure2(inp: &Inputs, u: Units) -> Named {
+    let (p, t1, pr) = (&inp.p, &inp.t1, u.pressure());
     let mut fig2 = Vec::new();
     for (j, &dp) in t1.drops_bar.iter().enumerate() {
-        let curve: Vec<(f64, f64)> = fine
+        let curve: Vec<(f64, f64)> = fine()
             .iter()
             .filter_map(|&t| {
                 let f = p.oil.state(t).ok()?;
-                Some((t, pr.apply(pressure_difference(a_parameter(&p, &f), dp * BAR))))
+                Some((t, pr.apply(pressure_difference(a_parameter(p, &f), dp * BAR))))
             })
             .collect();
         let mut line = Series::line(format!("model, dp = {dp} bar"), curve);
@@ -324,7 +340,7 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
         s.color = Some(j);
         fig2.push(s);
     }
-    figures.push((
+    (
         "fig2_pressure_difference",
         "Figure 2: the pressure difference p_b - p_a between the chambers against temperature at the three pressure drops (lines: model; circles: the paper's Table 1)",
         Figure {
@@ -332,48 +348,48 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
             x_desc: "temperature [C]".into(),
             panels: vec![panel(&format!("p_b - p_a [{}]", pr.unit), fig2)],
         },
-    ));
+    )
+}
 
-    // Figure 3: quasi-static against asymptotic displacement.
+/// Figure 3: quasi-static against asymptotic displacement, the model's
+/// lines and the paper's Table 2 points.
+fn figure3(inp: &Inputs, u: Units) -> Named {
+    let (t2, len) = (&inp.t2, u.length());
+    let fine = fine();
     let qs: Vec<(f64, f64)> = fine
         .iter()
-        .filter_map(|&t| equilibrium(&p, t).ok().map(|e| (t, len.apply(e.x))))
+        .filter_map(|&t| equilibrium(&inp.p, t).ok().map(|e| (t, len.apply(e.x))))
         .collect();
     let mut fig3 = vec![Series::line("model, quasi-static", qs)];
-    if let Some((b, _)) = &expansion {
+    if let Some((b, _)) = &inp.expansion {
         let reading = match b.reading {
             Reading::Temperature => "temperature",
             Reading::Property => "property",
         };
         let mut s = Series::line(
             format!("model, order-{} series in {reading}, t0 = {:.1} C", b.order, b.t0),
-            fine.iter().map(|&t| (t, len.apply(asym_x(t)))).collect(),
+            fine.iter().map(|&t| (t, len.apply(inp.asym_x(t)))).collect(),
         );
         s.dashed = true;
         s.color = Some(1);
         fig3.push(s);
     }
-    let mut s = Series::points(
-        "paper Table 2, quasi-static",
-        t2.temps
-            .iter()
-            .zip(&t2.x_qs_mm)
-            .map(|(&t, &x)| (t, len.apply(x * 1e-3)))
-            .collect(),
-    );
-    s.color = Some(0);
-    fig3.push(s);
-    let mut s = Series::points(
-        "paper Table 2, asymptotic",
-        t2.temps
-            .iter()
-            .zip(&t2.x_asym_mm)
-            .map(|(&t, &x)| (t, len.apply(x * 1e-3)))
-            .collect(),
-    );
-    s.color = Some(1);
-    fig3.push(s);
-    figures.push((
+    for (label, column, color) in [
+        ("paper Table 2, quasi-static", &t2.x_qs_mm, 0),
+        ("paper Table 2, asymptotic", &t2.x_asym_mm, 1),
+    ] {
+        let mut s = Series::points(
+            label,
+            t2.temps
+                .iter()
+                .zip(column)
+                .map(|(&t, &x)| (t, len.apply(x * 1e-3)))
+                .collect(),
+        );
+        s.color = Some(color);
+        fig3.push(s);
+    }
+    (
         "fig3_displacement",
         "Figure 3: quasi-static against asymptotic equilibrium displacement (lines: model, the expansion that best reproduces the paper's column; circles: the paper's Table 2)",
         Figure {
@@ -381,19 +397,23 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
             x_desc: "temperature [C]".into(),
             panels: vec![panel(&format!("x [{}]", len.unit), fig3)],
         },
-    ));
+    )
+}
 
-    // Figures 4 and 5: step responses, absolute and normalised.
-    let runs = responses(&raw, &t3.steps)?;
+/// Figures 4 and 5: the step responses of Table 3 (reference solver),
+/// absolute and normalised with the settling band.
+fn figures45(inp: &Inputs, u: Units) -> Result<[Named; 2], CliError> {
+    let len = u.length();
+    let runs = responses(&inp.raw, &inp.t3.steps)?;
     let mut abs = Vec::new();
     let mut norm = Vec::new();
-    for (&(from, to), (time, x)) in t3.steps.iter().zip(&runs) {
+    for (&(from, to), (time, x)) in inp.t3.steps.iter().zip(&runs) {
         let label = format!("{from} -> {to} C");
         abs.push(Series::line(
             label.clone(),
             time.iter().zip(x).map(|(&t, &x)| (t * 1e3, len.apply(x))).collect(),
         ));
-        let x_star = equilibrium(&p, to).map(|e| e.x).unwrap_or(f64::NAN);
+        let x_star = equilibrium(&inp.p, to).map(|e| e.x).unwrap_or(f64::NAN);
         let x0 = x.first().copied().unwrap_or(f64::NAN);
         norm.push(Series::line(
             label,
@@ -412,63 +432,91 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
     band.dashed = true;
     band.color = Some(5);
     norm.push(band);
-    figures.push((
-        "fig4_step_responses",
-        "Figure 4: plunger displacement after the temperature steps of Table 3 (reference solver, Radau5)",
-        Figure {
-            title: "Figure 4: step responses of the plunger displacement".into(),
-            x_desc: "time [ms]".into(),
-            panels: vec![panel(&format!("x [{}]", len.unit), abs)],
-        },
-    ));
-    figures.push((
-        "fig5_normalised_responses",
-        "Figure 5: the same responses normalised, (x - x0) / (x* - x0), with the +-2 % band of the settling time",
-        Figure {
-            title: "Figure 5: normalised step responses".into(),
-            x_desc: "time [ms]".into(),
-            panels: vec![panel("(x - x0) / (x* - x0) [-]", norm)],
-        },
-    ));
+    Ok([
+        (
+            "fig4_step_responses",
+            "Figure 4: plunger displacement after the temperature steps of Table 3 (reference solver, Radau5)",
+            Figure {
+                title: "Figure 4: step responses of the plunger displacement".into(),
+                x_desc: "time [ms]".into(),
+                panels: vec![panel(&format!("x [{}]", len.unit), abs)],
+            },
+        ),
+        (
+            "fig5_normalised_responses",
+            "Figure 5: the same responses normalised, (x - x0) / (x* - x0), with the +-2 % band of the settling time",
+            Figure {
+                title: "Figure 5: normalised step responses".into(),
+                x_desc: "time [ms]".into(),
+                panels: vec![panel("(x - x0) / (x* - x0) [-]", norm)],
+            },
+        ),
+    ])
+}
 
-    // Eigenvalue map over the validated range.
-    let (lo, hi) = (raw.estimator.valid_min, raw.estimator.valid_max);
+/// The eigenvalue map over the validated range and, with a `[machine]`,
+/// the compensation error curve.
+fn validated_range_figures(inp: &Inputs, u: Units) -> Result<Vec<Named>, CliError> {
+    let (lo, hi) = (inp.raw.estimator.valid_min, inp.raw.estimator.valid_max);
     let grid: Vec<f64> = (0..=((hi - lo) / 0.5).floor() as usize)
         .map(|i| lo + 0.5 * i as f64)
         .collect();
-    let eig = eigen_table(&p, &grid);
-    figures.push((
+    let eig = eigen_table(&inp.p, &grid);
+    let mut figures = vec![(
         "eigenvalues",
         "Eigenvalue map: decay rates, oscillation frequencies and the dominant damping ratio of the linearisation over the validated range",
         plot::eigen(eig.as_str())?,
-    ));
-
-    // Compensation error curve (needs a [machine]).
-    if p.machine.is_some() {
-        let comp = compensation_of(&p, &grid);
+    )];
+    if inp.p.machine.is_some() {
+        let comp = compensation_of(&inp.p, &grid);
         figures.push((
             "compensation",
             "Compensation: the flow supplied against the machine's demand, their difference, and the displacement the demand requires",
             plot::compensation(comp.as_str(), u)?,
         ));
     }
+    Ok(figures)
+}
 
-    let mut figure_links = String::new();
-    for (name, caption, fig) in &figures {
+/// Writes `figures` into `opts.out` as SVG (and PNG with `--png`), adding
+/// the files to `written`; returns their captions and links for
+/// `report.md`.
+fn write_figures(opts: &Options, figures: &[Named], written: &mut Vec<PathBuf>) -> Result<String, CliError> {
+    let mut links = String::new();
+    for (name, caption, fig) in figures {
         let svg = opts.out.join(format!("{name}.svg"));
         plot::write(&svg, fig).map_err(|e| CliError::Input(e.to_string().replace("--plot", "--dir")))?;
         written.push(svg);
-        let _ = write!(figure_links, "\n{caption}.\n\n![{name}]({name}.svg)");
+        let _ = write!(links, "\n{caption}.\n\n![{name}]({name}.svg)");
         if opts.png {
             let png = opts.out.join(format!("{name}.png"));
             plot::write(&png, fig).map_err(|e| CliError::Input(e.to_string().replace("--plot", "--dir")))?;
             written.push(png);
-            let _ = write!(figure_links, " ([PNG]({name}.png))");
+            let _ = write!(links, " ([PNG]({name}.png))");
         }
-        figure_links.push('\n');
+        links.push('\n');
     }
+    Ok(links)
+}
 
-    // report.md
+/// The tables as written (in the report's units) and their residuals.
+struct Tables {
+    table1: String,
+    table2: String,
+    table3: String,
+    /// Table 1's residuals [bar].
+    r1: Vec<f64>,
+    /// Table 2's quasi-static residuals [mm].
+    r2: Vec<f64>,
+}
+
+/// `report.md`: the tables with their residuals, the best expansion, the
+/// figures (`figure_links`) and the findings of `compensator paper`.
+fn summary(opts: &Options, inp: &Inputs, tables: &Tables, figure_links: &str) -> Result<String, CliError> {
+    let u = opts.units;
+    let shown = opts
+        .params
+        .map_or("presets/paper.toml (built in)".into(), |p| p.display().to_string());
     let units_note = match u {
         Units::Si => "SI units (m, Pa, m^3/s)",
         Units::Eng => "engineering units (mm, bar, L/min)",
@@ -489,23 +537,23 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
         }
     );
     let fin = |v: &[f64]| v.iter().copied().filter(|x| x.is_finite()).collect::<Vec<_>>();
-    let (r1f, r2f) = (fin(&r1), fin(&r2));
+    let (r1f, r2f) = (fin(&tables.r1), fin(&tables.r2));
     let _ = writeln!(
         md,
         "## Table 1: pressure difference p_b - p_a (`table1.csv`)\n\nRMS residual {:.4} bar, max {:.4} bar over {} of {} points.\n",
         crate::lsq::rms(&r1f),
         crate::lsq::max_abs(&r1f),
         r1f.len(),
-        r1.len()
+        tables.r1.len()
     );
-    md.push_str(&markdown(&table1));
+    md.push_str(&markdown(&tables.table1));
     let _ = writeln!(
         md,
         "\n## Table 2: equilibrium displacement (`table2.csv`)\n\nQuasi-static column: RMS residual {:.4} mm, max {:.4} mm.",
         crate::lsq::rms(&r2f),
         crate::lsq::max_abs(&r2f)
     );
-    if let Some((b, _)) = &expansion {
+    if let Some((b, _)) = &inp.expansion {
         let _ = writeln!(
             md,
             "\"asym\" column: best reproduced by the order-{} series in {} about t0 = {:.1} C (RMS {:.4} mm, max {:.4} mm).",
@@ -520,7 +568,7 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
         );
     }
     md.push('\n');
-    md.push_str(&markdown(&table2));
+    md.push_str(&markdown(&tables.table2));
     let _ = writeln!(
         md,
         "\n## Table 3: step-response indicators (`table3.csv`)\n\n\
@@ -528,14 +576,44 @@ pub fn report(opts: &Options) -> Result<String, CliError> {
          overshoot in % of the step, dominant eigenvalue at the final temperature. The paper's settling times are relative to a \
          time scale it does not define, and its Table 3 is illustrative (docs/paper.md: the physical model is overdamped).\n"
     );
-    md.push_str(&markdown(&table3));
+    md.push_str(&markdown(&tables.table3));
     let _ = writeln!(md, "\n## Figures\n{figure_links}");
     let findings = paper::report(opts.params, opts.data)?;
     let _ = writeln!(md, "## Findings (`compensator paper`)\n\n```text\n{}```", findings);
-    let md_path = opts.out.join("report.md");
-    write_file(&md_path, &md)?;
-    written.insert(0, md_path);
+    Ok(md)
+}
 
+/// Writes the report into `opts.out`; returns the list of files written
+/// (one per line).
+pub fn report(opts: &Options) -> Result<String, CliError> {
+    let u = opts.units;
+    let inp = Inputs::load(opts)?;
+    std::fs::create_dir_all(opts.out).map_err(|e| CliError::Input(format!("--dir: {}: {e}", opts.out.display())))?;
+    let mut written: Vec<PathBuf> = Vec::new();
+    let ((table1, r1), (table2, r2)) = (table1(&inp), table2(&inp));
+    let tables = Tables {
+        table1: u.convert_csv(table1.as_str()),
+        table2: u.convert_csv(table2.as_str()),
+        table3: u.convert_csv(table3(&inp).as_str()),
+        r1,
+        r2,
+    };
+    for (name, text) in [
+        ("table1.csv", &tables.table1),
+        ("table2.csv", &tables.table2),
+        ("table3.csv", &tables.table3),
+    ] {
+        let path = opts.out.join(name);
+        write_file(&path, text)?;
+        written.push(path);
+    }
+    let mut figures = vec![figure2(&inp, u), figure3(&inp, u)];
+    figures.extend(figures45(&inp, u)?);
+    figures.extend(validated_range_figures(&inp, u)?);
+    let figure_links = write_figures(opts, &figures, &mut written)?;
+    let md_path = opts.out.join("report.md");
+    write_file(&md_path, &summary(opts, &inp, &tables, &figure_links)?)?;
+    written.insert(0, md_path);
     let mut listing = String::new();
     for path in written {
         let _ = writeln!(listing, "{}", path.display());

@@ -143,15 +143,14 @@ pub fn fit_slot(p: &Params<f64>, temps: &[f64]) -> Result<Fit, String> {
 
 /// `compensation`: demand, supply, error and the Eq. (9) window per temperature.
 pub fn compensation_table(path: &Path, temps_spec: &str) -> Result<String, CliError> {
-    let (_, p, env) = crate::input::load_with_envelope(path)?;
-    let temps: Vec<f64> = env.temps(temps_spec)?.into_iter().map(|(t, _)| t).collect();
-    if p.machine.is_none() {
+    let input = crate::input::load_at_temps(path, temps_spec)?;
+    if input.params.machine.is_none() {
         return Err(CliError::Input(format!(
             "{}: no [machine] section (see `compensator size --for machine`)",
             path.display()
         )));
     }
-    Ok(env.mark(compensation_of(&p, &temps).as_str(), &["t_c"]))
+    Ok(input.mark(compensation_of(&input.params, &input.temps).as_str()))
 }
 
 /// The `compensation` table of a parameter set with a `[machine]` at
@@ -168,25 +167,19 @@ pub fn compensation_of(p: &Params<f64>, temps: &[f64]) -> Table {
         "required_x_m",
         "x_m",
     ]);
-    for &t in temps {
-        let c = match compensation(p, t) {
-            Ok(c) => c,
-            Err(e) => {
-                table.row_error(&[t], &e.to_string());
-                continue;
-            }
-        };
-        table.row(&[
-            t,
-            c.losses,
-            c.demand,
-            c.equilibrium.q_total,
-            c.error,
-            c.required_area,
-            c.required_x,
-            c.equilibrium.x,
-        ]);
-    }
+    table.rows_at(temps, |t| {
+        compensation(p, t).map(|c| {
+            vec![
+                c.losses,
+                c.demand,
+                c.equilibrium.q_total,
+                c.error,
+                c.required_area,
+                c.required_x,
+                c.equilibrium.x,
+            ]
+        })
+    });
     table
 }
 
@@ -203,8 +196,12 @@ fn finite(quantities: &[(&str, f64)]) -> Result<(), CliError> {
 
 /// `size`: the machine a compensator serves best, or the window a machine needs.
 pub fn size(path: &Path, what: &str, temps_spec: &str, reference: f64) -> Result<String, CliError> {
-    let (_, p, env) = crate::input::load_with_envelope(path)?;
-    let temps: Vec<f64> = env.temps(temps_spec)?.into_iter().map(|(t, _)| t).collect();
+    let crate::input::AtTemps {
+        params: p,
+        envelope: env,
+        temps,
+        ..
+    } = crate::input::load_at_temps(path, temps_spec)?;
     env.check(reference, "--reference")?;
     let mut o = String::new();
     match what {

@@ -7,7 +7,7 @@
 use crate::csv::Table;
 use crate::envelope::Envelope;
 use crate::error::CliError;
-use crate::input::load_with_envelope;
+use crate::input::{AtTemps, load_at_temps};
 use compensator::asymptotic::{Expansion, Reading, sensitivity as sens};
 use compensator::equilibrium::{self as eq, balance_temperature};
 use compensator::{Params, RawParams};
@@ -21,8 +21,12 @@ fn widen(v: f32) -> f64 {
 
 /// `equilibrium`: the quasi-static operating point per temperature.
 pub fn equilibrium_table(path: &Path, temps_spec: &str, single: bool) -> Result<(Table, Envelope), CliError> {
-    let (raw, p64, env) = load_with_envelope(path)?;
-    let temps: Vec<f64> = env.temps(temps_spec)?.into_iter().map(|(t, _)| t).collect();
+    let AtTemps {
+        raw,
+        params: p64,
+        envelope: env,
+        temps,
+    } = load_at_temps(path, temps_spec)?;
     let mut table = Table::new(&[
         "t_c",
         "a_sqrt_pa",
@@ -37,52 +41,33 @@ pub fn equilibrium_table(path: &Path, temps_spec: &str, single: bool) -> Result<
     ]);
     if single {
         let p = Params::<f32>::new(&raw).map_err(|e| CliError::Input(e.to_string()))?;
-        for &t in &temps {
-            let e = match eq::equilibrium(&p, t as f32) {
-                Ok(e) => e,
-                Err(e) => {
-                    table.row_error(&[t], &e.to_string());
-                    continue;
-                }
-            };
-            table.row(&[
-                t,
-                widen(e.a),
-                widen(e.p_a),
-                widen(e.p_b),
-                widen(e.dp_ab),
-                widen(e.x),
-                widen(e.q_branch),
-                widen(e.q_throt),
-                widen(e.q_total),
-                widen(e.fluid.kinematic_viscosity),
-            ]);
-        }
+        table.rows_at(&temps, |t| {
+            eq::equilibrium(&p, t as f32).map(|e| equilibrium_cells(&e, widen))
+        });
     } else {
-        let p = p64;
-        for &t in &temps {
-            let e = match eq::equilibrium(&p, t) {
-                Ok(e) => e,
-                Err(e) => {
-                    table.row_error(&[t], &e.to_string());
-                    continue;
-                }
-            };
-            table.row(&[
-                t,
-                e.a,
-                e.p_a,
-                e.p_b,
-                e.dp_ab,
-                e.x,
-                e.q_branch,
-                e.q_throt,
-                e.q_total,
-                e.fluid.kinematic_viscosity,
-            ]);
-        }
+        table.rows_at(&temps, |t| {
+            eq::equilibrium(&p64, t).map(|e| equilibrium_cells(&e, |v| v))
+        });
     }
     Ok((table, env))
+}
+
+/// The `equilibrium` cells after `t_c` of `e`, each through `f` (to
+/// `f64`).
+fn equilibrium_cells<T: Copy>(e: &eq::Equilibrium<T>, f: impl Fn(T) -> f64) -> Vec<f64> {
+    [
+        e.a,
+        e.p_a,
+        e.p_b,
+        e.dp_ab,
+        e.x,
+        e.q_branch,
+        e.q_throt,
+        e.q_total,
+        e.fluid.kinematic_viscosity,
+    ]
+    .map(f)
+    .to_vec()
 }
 
 /// `equilibrium` as text.
@@ -124,10 +109,10 @@ pub fn find_balance(raw: &RawParams, p: &Params<f64>) -> Result<f64, CliError> {
 
 /// `asymptotic`: quasi-static and series displacement per temperature.
 pub fn asymptotic(path: &Path, order: usize, reading: Reading, t0: &str, temps_spec: &str) -> Result<String, CliError> {
-    let (raw, p, env) = load_with_envelope(path)?;
-    let temps: Vec<f64> = env.temps(temps_spec)?.into_iter().map(|(t, _)| t).collect();
+    let input = load_at_temps(path, temps_spec)?;
+    let (raw, p, env) = (&input.raw, &input.params, &input.envelope);
     let t0 = if t0.trim() == "balance" {
-        find_balance(&raw, &p)?
+        find_balance(raw, p)?
     } else {
         let v: f64 = t0
             .trim()
@@ -139,28 +124,22 @@ pub fn asymptotic(path: &Path, order: usize, reading: Reading, t0: &str, temps_s
         env.check(v, "--t0")?;
         v
     };
-    let e = Expansion::new(&p, t0, reading).map_err(|e| CliError::Input(format!("--t0: {t0} C: {e}")))?;
+    let e = Expansion::new(p, t0, reading).map_err(|e| CliError::Input(format!("--t0: {t0} C: {e}")))?;
     let mut table = Table::new(&["t_c", "x_qs_m", "x_asym_m"]);
-    for &t in &temps {
-        match eq::equilibrium(&p, t).and_then(|qs| Ok((qs, e.at(t)?))) {
-            Ok((qs, terms)) => table.row(&[t, qs.x, terms.x(order).0]),
-            Err(e) => table.row_error(&[t], &e.to_string()),
-        }
-    }
-    Ok(env.mark(table.as_str(), &["t_c"]))
+    table.rows_at(&input.temps, |t| {
+        let qs = eq::equilibrium(p, t)?;
+        Ok::<_, compensator::ModelError>(vec![qs.x, e.at(t)?.x(order).0])
+    });
+    Ok(input.mark(table.as_str()))
 }
 
 /// `sensitivity`: Eqs. (30)-(31) per temperature, then the Eq. (32)
 /// verdict over the listed range as a trailing comment line.
 pub fn sensitivity(path: &Path, temps_spec: &str) -> Result<String, CliError> {
-    let (_, p, env) = load_with_envelope(path)?;
-    let temps: Vec<f64> = env.temps(temps_spec)?.into_iter().map(|(t, _)| t).collect();
+    let input = load_at_temps(path, temps_spec)?;
     let mut table = Table::new(&["t_c", "dx_dt_branch_m_k", "dx_dt_m_k", "dq_throt_dt_m3s_k"]);
-    for &t in &temps {
-        match sens(&p, t) {
-            Ok(s) => table.row(&[t, s.dx_dt_branch, s.dx_dt, s.dq_throt_dt]),
-            Err(e) => table.row_error(&[t], &e.to_string()),
-        }
-    }
-    Ok(env.mark(table.as_str(), &["t_c"]))
+    table.rows_at(&input.temps, |t| {
+        sens(&input.params, t).map(|s| vec![s.dx_dt_branch, s.dx_dt, s.dq_throt_dt])
+    });
+    Ok(input.mark(table.as_str()))
 }

@@ -31,6 +31,7 @@ use compensator::dynamics::linear::linearise;
 use compensator::equilibrium::equilibrium;
 use compensator::params::Field;
 use compensator::{Params, RawParams};
+use compensator_params::{PathError, PathProblem};
 use rand::{RngExt, SeedableRng, rngs::Xoshiro256PlusPlus};
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -60,9 +61,9 @@ pub fn field(name: &str) -> Option<&'static Field> {
 ///
 /// An unknown name (with the nearest valid one), a `[machine]` field when
 /// `raw` has no `[machine]` section.
-pub fn with_value(raw: &RawParams, path: &str, value: f64) -> Result<RawParams, String> {
+pub fn with_value<'a>(raw: &RawParams, path: &'a str, value: f64) -> Result<RawParams, PathError<'a>> {
     let mut out = *raw;
-    out.set(path, value).map_err(|e| e.to_string())?;
+    out.set(path, value)?;
     Ok(out)
 }
 
@@ -95,9 +96,9 @@ fn name_and_spec<'a>(flag: &str, arg: &'a str) -> Result<(&'static Field, &'a st
         .ok_or_else(|| CliError::Input(format!("{flag}: '{arg}' is not of the form section.key=...")))?;
     let name = name.trim();
     let f = field(name).ok_or_else(|| {
-        let e = compensator_params::PathError {
+        let e = PathError {
             path: name,
-            problem: compensator_params::PathProblem::Unknown,
+            problem: PathProblem::Unknown,
         };
         CliError::Input(format!("{flag}: {e}"))
     })?;
@@ -236,21 +237,33 @@ impl Sweep {
     /// order), in variant order: grid points, and for each `samples`
     /// draws from one generator seeded with `seed` (Xoshiro256++).
     pub fn variants(&self) -> Result<Vec<Vec<f64>>, CliError> {
-        Ok(self.variants_in(0, self.variant_count()?).map(|(_, v)| v).collect())
+        Ok(self.variants_in(0, self.variant_count()?)?.map(|(_, v)| v).collect())
     }
 
     /// Variants `start..end` (`end` at most [`Self::variant_count`]) with
     /// their index, as [`Self::variants`] numbers and draws them: the draws
     /// of the variants before `start` are replayed (drawn and discarded),
     /// so a shard's variants are the single run's.
-    pub fn variants_in(&self, start: usize, end: usize) -> Variants<'_> {
+    ///
+    /// # Errors
+    ///
+    /// A parameter the base set does not have (bad input naming it, as
+    /// [`RawParams::get`]; [`build`] refuses it before).
+    pub fn variants_in(&self, start: usize, end: usize) -> Result<Variants<'_>, CliError> {
         let names = self.parameter_names();
-        let base_value = |name: &str| self.base.get(name).unwrap_or(f64::NAN);
-        let base: Vec<f64> = names.iter().map(|name| base_value(name)).collect();
+        let base = names
+            .iter()
+            .map(|name| self.base.get(name).map_err(|e| CliError::Input(e.to_string())))
+            .collect::<Result<Vec<f64>, _>>()?;
         let slots = self
             .vary
             .iter()
-            .map(|t| names.iter().position(|n| *n == t.name).unwrap_or(0))
+            .map(|t| {
+                names
+                    .iter()
+                    .position(|n| *n == t.name)
+                    .expect("parameter_names lists every varied field")
+            })
             .collect();
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(self.seed);
         for _ in 0..start {
@@ -258,14 +271,14 @@ impl Sweep {
                 let _: f64 = rng.random_range(-1.0..=1.0);
             }
         }
-        Variants {
+        Ok(Variants {
             sweep: self,
             base,
             slots,
             rng,
             next: start,
             end,
-        }
+        })
     }
 }
 
@@ -476,7 +489,7 @@ pub fn build(
     }
     // An absolute tolerance far below the value is most likely a
     // percentage written without its `%` (plunger.spring_rate=5 is +-5 N/m
-    // on 23,116 N/m).
+    // on 23,116 N/m). (A field the file does not have is refused below.)
     for t in vary.iter().filter(|t| !t.relative) {
         if let Ok(v) = base.get(t.name)
             && t.half_width > 0.0
@@ -493,12 +506,10 @@ pub fn build(
             );
         }
     }
+    // Every field named is one of the file's (a `[machine]` one needs that
+    // section), by the schema's access by name.
     for name in grid.iter().map(|a| a.name).chain(vary.iter().map(|t| t.name)) {
-        if name.starts_with("machine.") && base.machine.is_none() {
-            return Err(CliError::Input(format!(
-                "{name}: the parameter file has no [machine] section"
-            )));
-        }
+        base.get(name).map_err(|e| CliError::Input(e.to_string()))?;
     }
     let samples = match (samples, vary.is_empty()) {
         (Some(0), _) => return Err(CliError::Input("--samples: must be at least 1".into())),

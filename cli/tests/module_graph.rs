@@ -1,5 +1,6 @@
 //! The CLI's modules import each other without a circle: each `crate::X`
-//! a module names (outside comments and its tests) is an edge, and the
+//! a module names (outside comments and its tests), braced imports
+//! `crate::{X, Y}` included, is an edge, and the
 //! graph of `cli/src`'s top-level modules has no cycle. A circle (the
 //! error type importing the file reader that returns it, say) fails here
 //! with the modules that form it.
@@ -38,20 +39,54 @@ fn graph() -> BTreeMap<String, BTreeSet<String>> {
             let text = std::fs::read_to_string(&path).unwrap();
             let code = text.split("#[cfg(test)]").next().unwrap();
             let edges = out.entry(top.clone()).or_default();
-            for line in code.lines().filter(|l| !l.trim_start().starts_with("//")) {
-                for (i, _) in line.match_indices("crate::") {
-                    let name: String = line[i + 7..]
-                        .chars()
-                        .take_while(|c| c.is_alphanumeric() || *c == '_')
-                        .collect();
-                    if !name.is_empty() && name != top {
-                        edges.insert(name);
-                    }
-                }
-            }
+            edges.extend(named(code).into_iter().filter(|name| *name != top));
         }
     }
     out
+}
+
+/// The top-level modules `code` names outside comments: `crate::X` and
+/// each `X` of a braced `crate::{X, Y::Z, ...}` (over several lines too).
+fn named(code: &str) -> BTreeSet<String> {
+    let code: String = code
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("//"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let ident = |s: &str| -> String { s.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect() };
+    let mut out = BTreeSet::new();
+    for (i, _) in code.match_indices("crate::") {
+        let rest = &code[i + 7..];
+        let Some(group) = rest.strip_prefix('{') else {
+            out.insert(ident(rest));
+            continue;
+        };
+        // The names at the group's top level, before its closing brace.
+        let mut depth = 0;
+        let mut start = true;
+        for (j, c) in group.char_indices() {
+            match c {
+                '{' => depth += 1,
+                '}' if depth == 0 => break,
+                '}' => depth -= 1,
+                ',' if depth == 0 => start = true,
+                c if start && !c.is_whitespace() => {
+                    out.insert(ident(&group[j..]));
+                    start = false;
+                }
+                _ => {}
+            }
+        }
+    }
+    out.remove("");
+    out
+}
+
+#[test]
+fn the_scan_reads_plain_and_braced_imports() {
+    let code = "use crate::error::CliError;\n// crate::commented\nuse crate::{\n    plot,\n    sweep::{self, stream},\n    units::Units,\n};\nlet x = crate::display::sig(1.0, 2);";
+    let want: BTreeSet<String> = ["display", "error", "plot", "sweep", "units"].map(String::from).into();
+    assert_eq!(named(code), want);
 }
 
 #[test]

@@ -1,6 +1,6 @@
 //! `asymptotic`: the asymptotic displacement (Eqs. 16-21) beside the quasi-static one.
 
-use crate::args::{Every10, Output, ParamsArg, PlotArg, TableArgs, Temps};
+use crate::args::{Every10, Output, ParamsArg, PlottedTable, Temps, rows_help};
 use crate::error::CliError;
 use crate::{plot, statics};
 use compensator::asymptotic::Reading;
@@ -14,14 +14,13 @@ pub enum ReadingArg {
     Property,
 }
 
-const HELP: &str = "\
-Output: CSV, one row per temperature:
-  t_c [C], x_qs_m [m] (quasi-static), x_asym_m [m] (the series),
-  envelope (validated | oil_model: outside the validated range, extrapolated),
-  error (why the row could not be computed; empty when it was)
-
-Example:
-  compensator asymptotic --params presets/paper.toml --order 2 --reading temperature --t0 balance";
+const HELP: &str = rows_help!(
+    "temperature",
+    "\
+  t_c [C], x_qs_m [m] (quasi-static), x_asym_m [m] (the series),",
+    "",
+    "compensator asymptotic --params presets/paper.toml --order 2 --reading temperature --t0 balance"
+);
 
 /// Asymptotic displacement (Eqs. 16-21) beside the quasi-static one.
 #[derive(clap::Args, Debug, Clone)]
@@ -41,9 +40,7 @@ pub struct Args {
     #[command(flatten)]
     temps: Temps<Every10>,
     #[command(flatten)]
-    plot: PlotArg,
-    #[command(flatten)]
-    table: TableArgs,
+    output: PlottedTable,
 }
 
 impl Args {
@@ -59,8 +56,7 @@ impl Args {
         };
         let order = usize::from(self.order);
         let csv = statics::asymptotic(&self.params.params, order, reading, &self.t0, &self.temps.temps)?;
-        let units = self.table.units.units;
-        self.plot.draw(&csv, |csv| plot::asymptotic(csv, order, units))?;
-        Ok(Output::table(csv, &self.table))
+        self.output
+            .output(csv, |csv, units| plot::asymptotic(csv, order, units))
     }
 }

@@ -1,6 +1,6 @@
 //! `calibrate`: the static parameters fitted to measured data.
 
-use crate::args::{FormatArg, Output, PlotArg};
+use crate::args::{Calibrate, FitTable, Output};
 use crate::calibration;
 use crate::error::CliError;
 use std::path::PathBuf;
@@ -55,13 +55,8 @@ pub struct Args {
     /// Displacement data t_c,x_m[,dp_pa] (CSV) [default: the paper's Table 2 without --pressure-data].
     #[arg(long, value_name = "X.csv")]
     displacement_data: Option<PathBuf>,
-    /// Write the calibrated parameter file (TOML, the fit in comments, its standard errors and correlations in [tolerances] and [[correlation]]) to FILE.
-    #[arg(long, value_name = "FILE")]
-    write_preset: Option<PathBuf>,
     #[command(flatten)]
-    plot: PlotArg,
-    #[command(flatten)]
-    format: FormatArg,
+    output: FitTable<Calibrate>,
 }
 
 impl Args {
@@ -75,12 +70,9 @@ impl Args {
             base: self.params,
             pressure: self.pressure_data,
             displacement: self.displacement_data,
-            write_preset: self.write_preset,
-            plot: self.plot.plot,
+            write_preset: self.output.write_preset.clone(),
+            plot: self.output.plot.plot.clone(),
         })?;
-        for line in &out.notes {
-            eprintln!("calibrate: {line}");
-        }
-        Ok(Output::si_table(out.table, &self.format))
+        Ok(self.output.output(out.table, &out.notes))
     }
 }

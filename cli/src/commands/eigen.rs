@@ -1,34 +1,29 @@
 //! `eigen`: eigenvalues of the linearisation (Eq. 37) per temperature.
 
-use crate::args::{Every10, Output, ParamsArg, PlotArg, TableArgs, Temps};
+use crate::args::{Every10, Output, OverTemps, PlottedTable, rows_help};
 use crate::error::CliError;
 use crate::plot;
 
-const HELP: &str = "\
-Output: CSV, one row per temperature:
+const HELP: &str = rows_help!(
+    "temperature",
+    "\
   t_c [C], re_1, im_1, ..., re_4, im_4 [1/s] (eigenvalues),
   zeta_dominant [-], omega_n_dominant [rad/s] (the dominant mode: 1 and
   |lambda| when it is real), zeta_plunger [-] (the plunger with the
   chambers' hydraulic damping, (b + b_hyd) / (2 sqrt(c m)): above 1,
-  overdamped),
-  envelope (validated | oil_model: outside the validated range, extrapolated),
-  error (why the row could not be computed; empty when it was)
-
-Example:
-  compensator eigen --params presets/paper.toml --temps 30:80:10";
+  overdamped),",
+    "",
+    "compensator eigen --params presets/paper.toml --temps 30:80:10"
+);
 
 /// Eigenvalues of the linearisation at the equilibrium (Eq. 37).
 #[derive(clap::Args, Debug, Clone)]
 #[command(after_long_help = HELP)]
 pub struct Args {
     #[command(flatten)]
-    params: ParamsArg,
+    over: OverTemps<Every10>,
     #[command(flatten)]
-    temps: Temps<Every10>,
-    #[command(flatten)]
-    plot: PlotArg,
-    #[command(flatten)]
-    table: TableArgs,
+    output: PlottedTable,
 }
 
 impl Args {
@@ -38,8 +33,7 @@ impl Args {
     ///
     /// Bad input (the file, the list), naming it.
     pub fn run(self) -> Result<Output, CliError> {
-        let csv = crate::dynamics::eigen(&self.params.params, &self.temps.temps)?;
-        self.plot.draw(&csv, plot::eigen)?;
-        Ok(Output::table(csv, &self.table))
+        let csv = self.over.table(crate::dynamics::eigen)?;
+        self.output.output(csv, |csv, _| plot::eigen(csv))
     }
 }

@@ -1,6 +1,6 @@
 //! `estimate`: the firmware's estimator replayed over a recorded probe log.
 
-use crate::args::{Output, ParamsArg, PlotArg, TableArgs};
+use crate::args::{Output, ParamsArg, PlottedTable};
 use crate::error::CliError;
 use crate::estimate::{self, Options};
 use std::path::PathBuf;
@@ -53,9 +53,7 @@ pub struct Args {
     #[arg(long)]
     every_sample: bool,
     #[command(flatten)]
-    plot: PlotArg,
-    #[command(flatten)]
-    table: TableArgs,
+    output: PlottedTable,
 }
 
 impl Args {
@@ -98,10 +96,8 @@ impl Args {
             e => e,
         })?;
         eprintln!("{}", replay.note);
-        let units = self.table.units.units;
-        self.plot.draw(&replay.table, |csv| {
+        self.output.output(replay.table, |csv, units| {
             crate::plot::estimate(csv, raw.core.stroke, &format!("Estimate over {shown}"), units)
-        })?;
-        Ok(Output::table(replay.table, &self.table))
+        })
     }
 }

@@ -1,6 +1,6 @@
 //! `identify`: the dynamic parameters fitted to a measured transient.
 
-use crate::args::{FormatArg, Output, ParamsArg, PlotArg};
+use crate::args::{FitTable, Identify, Output, ParamsArg};
 use crate::error::CliError;
 use crate::identify;
 use std::path::PathBuf;
@@ -42,13 +42,8 @@ pub struct Args {
     /// Parameters to fit, comma list of mass, damping, bulk_modulus, volume_a, volume_b.
     #[arg(long, default_value = "mass,damping,bulk_modulus")]
     fit: String,
-    /// Write the parameter file with the identified values (TOML) to FILE.
-    #[arg(long, value_name = "FILE")]
-    write_preset: Option<PathBuf>,
     #[command(flatten)]
-    plot: PlotArg,
-    #[command(flatten)]
-    format: FormatArg,
+    output: FitTable<Identify>,
 }
 
 impl Args {
@@ -62,12 +57,9 @@ impl Args {
             params: self.params.params,
             data: self.data,
             fit: Some(self.fit),
-            write_preset: self.write_preset,
-            plot: self.plot.plot,
+            write_preset: self.output.write_preset.clone(),
+            plot: self.output.plot.plot.clone(),
         })?;
-        for line in &notes {
-            eprintln!("identify: {line}");
-        }
-        Ok(Output::si_table(table, &self.format))
+        Ok(self.output.output(table, &notes))
     }
 }

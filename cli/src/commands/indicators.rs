@@ -1,17 +1,16 @@
 //! `indicators`: the step-response indicators of the paper's Table 3.
 
-use crate::args::{Output, ParamsArg, TableArgs};
+use crate::args::{Output, ParamsArg, TableArgs, rows_help};
 use crate::error::CliError;
 
-const HELP: &str = "\
-Output: CSV, one row per step:
+const HELP: &str = rows_help!(
+    "step",
+    "\
   from_c [C], to_c [C], x_star_m [m] (final displacement),
-  settling_time_s [s], overshoot_pct [%], dominant_re [1/s],
-  envelope (validated | oil_model: outside the validated range, extrapolated),
-  error (why the row could not be computed; empty when it was)
-
-Example:
-  compensator indicators --params presets/paper.toml --steps 30:40,40:50";
+  settling_time_s [s], overshoot_pct [%], dominant_re [1/s],",
+    "",
+    "compensator indicators --params presets/paper.toml --steps 30:40,40:50"
+);
 
 /// Step-response indicators of Table 3 (reference solver).
 #[derive(clap::Args, Debug, Clone)]

@@ -4,10 +4,13 @@
 //! computations live in the library modules they call ([`crate::statics`],
 //! [`crate::dynamics`], ...), so that tests call the same code.
 //!
-//! Adding a command: a module here with `Args` and `run`, a variant of
-//! [`Command`] and its arm in [`Command::run`]; it then has the error
-//! path, the envelope check of its temperatures, the output formats and
-//! the doc-example tests of every other command.
+//! Adding a command: a module here with `Args` (the shared options as the
+//! groups of [`crate::args`], flattened: [`crate::args::OverTemps`],
+//! [`crate::args::PlottedTable`], ...) and `run`, a variant of [`Command`]
+//! and its arm in [`Command::run`]; it then has the error path, the
+//! envelope check of its temperatures, the output formats and the
+//! doc-example tests of every other command (ARCHITECTURE.md, "Add a CLI
+//! command").
 
 use crate::args::Output;
 use crate::error::CliError;

@@ -1,8 +1,7 @@
 //! `paper`: the paper's tables reproduced and its findings, as text.
 
-use crate::args::Output;
+use crate::args::{Output, PaperInputs, Tables12};
 use crate::error::CliError;
-use std::path::PathBuf;
 
 const HELP: &str = "\
 Output: a text report: Table 1 inverted for A(t) [sqrt(Pa)], Table 1
@@ -19,12 +18,8 @@ Example:
 #[derive(clap::Args, Debug, Clone)]
 #[command(after_long_help = HELP)]
 pub struct Args {
-    /// Parameter file (TOML) [default: the built-in presets/paper.toml].
-    #[arg(long, value_name = "FILE")]
-    params: Option<PathBuf>,
-    /// Folder with table1.csv and table2.csv [default: the built-in data/paper].
-    #[arg(long, value_name = "DIR")]
-    data: Option<PathBuf>,
+    #[command(flatten)]
+    inputs: PaperInputs<Tables12>,
 }
 
 impl Args {
@@ -35,8 +30,8 @@ impl Args {
     /// Bad input (the file, the tables), naming it.
     pub fn run(self) -> Result<Output, CliError> {
         Ok(Output::Text(crate::paper::report(
-            self.params.as_deref(),
-            self.data.as_deref(),
+            self.inputs.params.as_deref(),
+            self.inputs.data.as_deref(),
         )?))
     }
 }

@@ -1,6 +1,6 @@
 //! `report`: the paper's tables and figures recomputed, as files in a folder.
 
-use crate::args::{Output, UnitsArg};
+use crate::args::{Output, PaperInputs, Tables123, UnitsArg};
 use crate::error::CliError;
 use std::path::PathBuf;
 
@@ -26,12 +26,8 @@ Example:
 #[derive(clap::Args, Debug, Clone)]
 #[command(after_long_help = HELP)]
 pub struct Args {
-    /// Parameter file (TOML) [default: the built-in presets/paper.toml].
-    #[arg(long, value_name = "FILE")]
-    params: Option<PathBuf>,
-    /// Folder with table1.csv, table2.csv and table3.csv [default: the built-in data/paper].
-    #[arg(long, value_name = "DIR")]
-    data: Option<PathBuf>,
+    #[command(flatten)]
+    inputs: PaperInputs<Tables123>,
     /// Folder to write into (created if absent; files in it are replaced).
     #[arg(long, value_name = "DIR", alias = "out")]
     dir: PathBuf,
@@ -50,8 +46,8 @@ impl Args {
     /// Bad input (the file, the tables, the folder), naming it.
     pub fn run(self) -> Result<Output, CliError> {
         Ok(Output::Text(crate::report::report(&crate::report::Options {
-            params: self.params.as_deref(),
-            data: self.data.as_deref(),
+            params: self.inputs.params.as_deref(),
+            data: self.inputs.data.as_deref(),
             out: &self.dir,
             png: self.png,
             units: self.units.units,

@@ -11,15 +11,14 @@
 pub mod tables;
 
 use crate::error::CliError;
-use crate::input::load_params;
 use crate::lsq::{max_abs, rms};
 use crate::statics::find_balance;
-use compensator::Params;
 use compensator::asymptotic::{Expansion, Reading, monotonicity};
 use compensator::equilibrium::equilibrium;
+use compensator::{Params, RawParams};
 use std::fmt::Write as _;
 use std::path::Path;
-use tables::{BAR, Table2, invert_table1, load_tables, table1_residuals, table2_residuals};
+use tables::{BAR, Table1, Table2, invert_table1, load_tables, table1_residuals, table2_residuals};
 
 /// One candidate of [`asymptotic_search`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -116,20 +115,23 @@ pub fn chamber_gradient(params: &Params<f64>, dp: f64, lo: f64, hi: f64) -> Resu
 /// file `path` and the tables in `data` (without them: the built-in
 /// `presets/paper.toml` and `data/paper/`).
 pub fn report(path: Option<&Path>, data: Option<&Path>) -> Result<String, CliError> {
-    let (raw, p) = match path {
-        Some(path) => load_params::<f64>(path)?,
-        None => {
-            let raw = crate::params_file::parse(crate::input::PAPER_PRESET)?;
-            let p = Params::<f64>::new(&raw).map_err(|e| CliError::Input(e.to_string()))?;
-            (raw, p)
-        }
-    };
+    let (raw, p) = crate::input::load_or_paper(path)?;
     let (t1, t2) = load_tables(data).map_err(CliError::Input)?;
     let mut o = String::new();
     let shown = path.map_or("presets/paper.toml".into(), |p| p.display().to_string());
     let _ = writeln!(o, "# Paper reproduction with {shown}");
+    table1_inverted(&mut o, &t1);
+    table1_section(&mut o, &p, &t1);
+    table2_section(&mut o, &p, &t2);
+    asym_section(&mut o, &raw, &p, &t2);
+    gradient_section(&mut o, &p)?;
+    monotonicity_section(&mut o, &p)?;
+    Ok(o)
+}
 
-    let inv = invert_table1(&t1);
+/// Table 1 inverted for `A(t)`, column by column, with the spread between the drops.
+fn table1_inverted(o: &mut String, t1: &Table1) {
+    let inv = invert_table1(t1);
     let _ = writeln!(o, "\n## Table 1 inverted for A(t) [sqrt(Pa)], column by column");
     let _ = writeln!(
         o,
@@ -146,8 +148,11 @@ pub fn report(path: Option<&Path>, data: Option<&Path>) -> Result<String, CliErr
     }
     let max_spread = inv.spread.iter().fold(0.0f64, |m, v| m.max(*v));
     let _ = writeln!(o, "largest spread between the three drops: {:.1} %", max_spread * 100.0);
+}
 
-    let r1 = table1_residuals(&p, &t1);
+/// Table 1: the model's `p_b - p_a` beside the paper's, with the residuals.
+fn table1_section(o: &mut String, p: &Params<f64>, t1: &Table1) {
+    let r1 = table1_residuals(p, t1);
     let _ = writeln!(o, "\n## Table 1: model p_b - p_a against the paper [bar]");
     let _ = writeln!(
         o,
@@ -172,8 +177,11 @@ pub fn report(path: Option<&Path>, data: Option<&Path>) -> Result<String, CliErr
         max_abs(&r1),
         r1.len()
     );
+}
 
-    let r2 = table2_residuals(&p, &t2);
+/// Table 2: the model's quasi-static displacement beside the paper's.
+fn table2_section(o: &mut String, p: &Params<f64>, t2: &Table2) {
+    let r2 = table2_residuals(p, t2);
     let _ = writeln!(
         o,
         "\n## Table 2: quasi-static displacement at {} bar [mm]",
@@ -188,9 +196,12 @@ pub fn report(path: Option<&Path>, data: Option<&Path>) -> Result<String, CliErr
         );
     }
     let _ = writeln!(o, "RMS {:.4} mm, max {:.4} mm", rms(&r2), max_abs(&r2));
+}
 
-    let balance = find_balance(&raw, &p).ok();
-    let (best, at_balance) = asymptotic_search(&p, &t2, 26.0, 80.0, balance);
+/// Table 2's "asym" column: which expansion (reading, order, `t0`) reproduces it best, and each at the balance temperature.
+fn asym_section(o: &mut String, raw: &RawParams, p: &Params<f64>, t2: &Table2) {
+    let balance = find_balance(raw, p).ok();
+    let (best, at_balance) = asymptotic_search(p, t2, 26.0, 80.0, balance);
     let _ = writeln!(o, "\n## Table 2 \"asym\" column: which expansion reproduces it");
     if let Some(tb) = balance {
         let _ = writeln!(o, "balance temperature (p_a = p_b, Eq. 2): {tb:.2} C");
@@ -230,12 +241,15 @@ pub fn report(path: Option<&Path>, data: Option<&Path>) -> Result<String, CliErr
             b.rms_mm
         );
     }
+}
 
+/// Eq. (1): the chamber-pressure gradient at 0.2 MPa against the paper's, and its bound.
+fn gradient_section(o: &mut String, p: &Params<f64>) -> Result<(), CliError> {
     let _ = writeln!(
         o,
         "\n## Eq. (1): chamber-pressure gradient at dp = 0.2 MPa over 26-78 C"
     );
-    let (mean_a, max_a, mean_b) = chamber_gradient(&p, 2.0e5, 26.0, 78.0).map_err(CliError::Failed)?;
+    let (mean_a, max_a, mean_b) = chamber_gradient(p, 2.0e5, 26.0, 78.0).map_err(CliError::Failed)?;
     let _ = writeln!(
         o,
         "model: mean |dp_a/dt| {:.2} kPa/C (max {:.2}), mean |dp_b/dt| {:.2} kPa/C; paper: 8.3 kPa/C",
@@ -248,12 +262,16 @@ pub fn report(path: Option<&Path>, data: Option<&Path>) -> Result<String, CliErr
         "bound: a chamber pressure stays within [p_c, p_p], so over 52 C its mean gradient cannot exceed {:.2} kPa/C at 0.2 MPa",
         2.0e5 / 52.0 / 1e3
     );
+    Ok(())
+}
 
-    let mono = monotonicity(&p, 26.0, 78.0, 521).map_err(|e| CliError::Failed(e.to_string()))?;
+/// Eq. (32) over 26-78 C.
+fn monotonicity_section(o: &mut String, p: &Params<f64>) -> Result<(), CliError> {
+    let mono = monotonicity(p, 26.0, 78.0, 521).map_err(|e| CliError::Failed(e.to_string()))?;
     let _ = writeln!(
         o,
         "\n## Eq. (32) over 26-78 C: monotonic = {}, smallest |dx/dt| = {:.3e} m/K at {:.1} C",
         mono.monotonic, mono.worst_dx_dt, mono.worst_temperature
     );
-    Ok(o)
+    Ok(())
 }

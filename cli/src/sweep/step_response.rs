@@ -157,21 +157,48 @@ struct Rest {
     w_min: f64,
 }
 
-/// The twin's states at the output samples it lands on, from 0 to at
-/// least `samples` (or to rest): the first `plan.window` samples one twin
-/// tick of `dt` each (the transient right after the step is not a cubic
-/// over a coarse tick), then one coarse tick per `plan.per_tick` samples,
-/// the coarse twin started from the fine one's state. `None` when a coarse
-/// tick has a stop event (the caller runs again at a tick of `dt`).
-fn integrate(
-    p: &Params<f64>,
-    plan: Plan,
+/// A step response to run: the step `from -> to` [C] of `p`, sampled
+/// every `dt` [s] to `samples`, or to rest when `rest` is given.
+#[derive(Clone, Copy)]
+struct Run<'a> {
+    p: &'a Params<f64>,
     from: f64,
     to: f64,
     dt: f64,
     samples: usize,
     rest: Option<Rest>,
-) -> Result<Option<Vec<End>>, String> {
+}
+
+impl<'a> Run<'a> {
+    /// The step `from -> to` of `p` sampled every `dt` to
+    /// `round(t_end / dt) dt`, run to the end.
+    fn new(p: &'a Params<f64>, from: f64, to: f64, dt: f64, t_end: f64) -> Self {
+        Run {
+            p,
+            from,
+            to,
+            dt,
+            samples: (t_end / dt).round() as usize,
+            rest: None,
+        }
+    }
+}
+
+/// The twin's states at the output samples `run` lands on, from 0 to at
+/// least `samples` (or to rest): the first `plan.window` samples one twin
+/// tick of `dt` each (the transient right after the step is not a cubic
+/// over a coarse tick), then one coarse tick per `plan.per_tick` samples,
+/// the coarse twin started from the fine one's state. `None` when a coarse
+/// tick has a stop event (the caller runs again at a tick of `dt`).
+fn integrate(run: Run, plan: Plan) -> Result<Option<Vec<End>>, String> {
+    let Run {
+        p,
+        from,
+        to,
+        dt,
+        samples,
+        rest,
+    } = run;
     let fine = TwinConfig {
         tick: dt,
         substeps: if plan.per_tick > 1 {
@@ -226,21 +253,13 @@ fn integrate(
 
 /// [`integrate`], again at a tick of `dt` throughout when the plan's
 /// coarse ticks meet a stop event; and whether it was.
-fn states(
-    p: &Params<f64>,
-    plan: Plan,
-    from: f64,
-    to: f64,
-    dt: f64,
-    samples: usize,
-    rest: Option<Rest>,
-) -> Result<(Vec<End>, bool), String> {
-    if let Some(ends) = integrate(p, plan, from, to, dt, samples, rest)? {
+fn states(run: Run, plan: Plan) -> Result<(Vec<End>, bool), String> {
+    if let Some(ends) = integrate(run, plan)? {
         return Ok((ends, false));
     }
     let fine = Plan {
         config: TwinConfig {
-            tick: dt,
+            tick: run.dt,
             substeps: plan.window_substeps,
             ..plan.config
         },
@@ -248,8 +267,7 @@ fn states(
         window: 1,
         window_substeps: plan.window_substeps,
     };
-    let ends = integrate(p, fine, from, to, dt, samples, rest)?
-        .ok_or("unreachable: a run at the output interval has no coarse tick")?;
+    let ends = integrate(run, fine)?.ok_or("unreachable: a run at the output interval has no coarse tick")?;
     Ok((ends, true))
 }
 
@@ -268,7 +286,8 @@ pub fn settling_time(
     t_end: f64,
     x_star: f64,
 ) -> Result<Settling, String> {
-    let samples = (t_end / dt).round() as usize;
+    let run = Run::new(p, from, to, dt, t_end);
+    let samples = run.samples;
     let band = 0.02 * x_star.abs();
     let rest = Rest {
         x_star,
@@ -279,7 +298,11 @@ pub fn settling_time(
             .map(|l| l.re.hypot(l.im))
             .fold(f64::INFINITY, f64::min),
     };
-    let (ends, fine) = states(p, plan(lin, dt, t_end), from, to, dt, samples, Some(rest))?;
+    let run = Run {
+        rest: Some(rest),
+        ..run
+    };
+    let (ends, fine) = states(run, plan(lin, dt, t_end))?;
     let ticks = ends.len() - 1;
     let done = |k: usize| Settling {
         time: if k < samples {
@@ -334,8 +357,9 @@ pub fn sampled(
     dt: f64,
     t_end: f64,
 ) -> Result<Vec<f64>, String> {
-    let samples = (t_end / dt).round() as usize;
-    let (ends, _) = states(p, plan(lin, dt, t_end), from, to, dt, samples, None)?;
+    let run = Run::new(p, from, to, dt, t_end);
+    let samples = run.samples;
+    let (ends, _) = states(run, plan(lin, dt, t_end))?;
     let mut out = vec![ends[0].x];
     for w in ends.windows(2) {
         let (a, b) = (w[0], w[1]);

@@ -141,7 +141,7 @@ pub fn write(sweep: &Sweep, shard: Option<Shard>, units: Units, out: &mut dyn Wr
         put(out, &units.convert_csv(&head), &mut written)?;
     }
     let progress = Progress::new(range.len());
-    let mut variants = sweep.variants_in(range.start, range.end);
+    let mut variants = sweep.variants_in(range.start, range.end)?;
     while !written.closed {
         let block: Vec<(usize, Vec<f64>)> = variants.by_ref().take(BLOCK).collect();
         if block.is_empty() {
@@ -181,7 +181,7 @@ fn row(sweep: &Sweep, names: &[&'static str], shared: &Shared, i: usize, values:
     for (name, &v) in names.iter().zip(values) {
         match with_value(&raw, name, v) {
             Ok(next) => raw = next,
-            Err(e) => r = Err(e),
+            Err(e) => r = Err(e.to_string()),
         }
     }
     let result = r.and_then(|()| evaluate_with(&raw, &sweep.metrics, shared));
