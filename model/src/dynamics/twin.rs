@@ -473,7 +473,7 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// `fine`: a piece of a graded substep (see [`Twin::substep`]).
     fn piece(&self, y: &[T; 4], frac: T, carry: &mut T, fine: bool) -> Result<([T; 4], u8), StepError> {
         match self.coefficients.contact(y) {
-            Contact::Free => self.free_piece(y, frac, carry, EVENTS_PER_SUBSTEP, fine),
+            Contact::Free => self.free_piece(y, frac, carry, EVENTS_PER_SUBSTEP, fine, None),
             held => self.held_piece(y, frac, held, carry, EVENTS_PER_SUBSTEP, fine),
         }
     }
@@ -506,8 +506,11 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// beyond a stop stops at the impact (located on its cubic Hermite
     /// interpolant; the pressures there interpolated over the step) at rest
     /// (inelastic), and the rest of the piece is held (or free again after
-    /// a touch). With no `events` left the rest is held. Returns the state
-    /// and the events.
+    /// a touch). With no `events` left the rest is held. `released`: the
+    /// stop the piece was just released from and the state held on it to
+    /// the piece's end; a step that ends back beyond that stop returns that
+    /// held state (the release did not last: see [`Twin::held_piece`]).
+    /// Returns the state and the events.
     fn free_piece(
         &self,
         y: &[T; 4],
@@ -515,6 +518,7 @@ impl<F: Float, T: Real> Twin<F, T> {
         carry: &mut T,
         events: u8,
         fine: bool,
+        released: Option<(Contact, &[T; 4])>,
     ) -> Result<([T; 4], u8), StepError> {
         let mut tried = *carry;
         let next = self.step(y, frac, Contact::Free, &mut tried, fine)?;
@@ -526,6 +530,12 @@ impl<F: Float, T: Real> Twin<F, T> {
             *carry = tried;
             return Ok((next, 0));
         };
+        if let Some((from, held)) = released
+            && from == contact
+        {
+            *carry = T::ZERO;
+            return Ok((*held, RELEASE | IMPACT));
+        }
         *carry = T::ZERO;
         let theta = self.impact_fraction(y, &next, frac, stop);
         // The pressures at the impact, interpolated over the step.
@@ -548,7 +558,7 @@ impl<F: Float, T: Real> Twin<F, T> {
         // Held for the rest, unless the plunger travelled before the impact
         // and the force there pulls it off the stop again (a touch).
         let (end, e) = if theta > T::ZERO && away_from(&self.coefficients, contact, &at) > T::ZERO {
-            self.free_piece(&at, rest, carry, events - 1, fine)?
+            self.free_piece(&at, rest, carry, events - 1, fine, None)?
         } else {
             self.held_piece(&at, rest, contact, carry, events - 1, fine)?
         };
@@ -561,7 +571,12 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// the force, interpolated linearly over the step, crosses zero (exact
     /// for the slow drift of a ramp; after an abrupt change the graded
     /// tick's short pieces follow the transient) and the piece goes on free
-    /// from there.
+    /// from there. In a plain substep, a free rest that ends back beyond the
+    /// same stop (the force barely pulls: the motion's own pressures push
+    /// the plunger back) leaves the plunger held for the whole piece, with
+    /// the held step's state: it did not leave in the net, and the held
+    /// rest after the bounce would cost a third step for a motion below the
+    /// step's resolution.
     fn held_piece(
         &self,
         y: &[T; 4],
@@ -584,7 +599,8 @@ impl<F: Float, T: Real> Twin<F, T> {
         if f0 > T::ZERO {
             // Held although pulled away at the start (the piece after an
             // impact at its start): released there.
-            let (end, e) = self.free_piece(&y0, frac, carry, events - 1, fine)?;
+            let back = (!fine).then_some((held, &end));
+            let (end, e) = self.free_piece(&y0, frac, carry, events - 1, fine, back)?;
             return Ok((end, e | RELEASE));
         }
         // Released where the held force, interpolated linearly over the
@@ -606,7 +622,8 @@ impl<F: Float, T: Real> Twin<F, T> {
         if !(rest > T::ZERO) {
             return Ok((at, RELEASE));
         }
-        let (end, e) = self.free_piece(&at, rest, carry, events - 1, fine)?;
+        let back = (!fine).then_some((held, &end));
+        let (end, e) = self.free_piece(&at, rest, carry, events - 1, fine, back)?;
         Ok((end, e | RELEASE))
     }
 
