@@ -188,9 +188,7 @@ fn move_oil<T: Real>(
     let now = prev.state.temperature;
     let dln_mu = libm::fabsf(prev.viscosity.d1 / prev.viscosity.value + prev.density.d1 / prev.density.value);
     let max_step = if dln_mu > 0.0 { slew / dln_mu } else { f32::INFINITY };
-    // max/min, not `f32::clamp`: its assertion formats f32 with
-    // core::fmt, 17 KiB of flash on the controller.
-    let step = (target - now).max(-max_step).min(max_step);
+    let step = super::clamp(target - now, -max_step, max_step);
     let point = p.oil.point(now + step)?;
     statics.slewing = step != target - now;
     apply(p, twin, design, statics, point)

@@ -156,6 +156,21 @@ pub const X_TOLERANCE: f32 = 1e-2;
 /// fraction of `dp` (as [`X_TOLERANCE`]).
 pub const P_TOLERANCE: f32 = 1e-2;
 
+/// `x` inside `[lo, hi]` (`lo <= hi`), NaN taken to `lo` (as `x.max(lo).min(hi)`),
+/// inline: `f32::max` and `min` are calls to `fmaxf` and `fminf` on the
+/// Cortex-M4F (its FPU has no `vmaxnm`), about 11 instructions each, on
+/// every tick; `f32::clamp`'s assertion formats f32 with `core::fmt`.
+#[inline(always)]
+pub(crate) fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
+    if !(x >= lo) {
+        lo
+    } else if x > hi {
+        hi
+    } else {
+        x
+    }
+}
+
 /// The estimator, its twin integrating in `T` (`f32` where there is an
 /// FPU, [`Fixed`](crate::scalar::Fixed) where there is none); everything
 /// else (observer, jobs, flows) is `f32`.
@@ -309,7 +324,7 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
         }
         // The estimated oil temperature, inside the range the oil model is
         // used in (the observer may overshoot it for a moment).
-        let t = self.observer.oil().max(self.config.oil.min).min(self.config.oil.max);
+        let t = clamp(self.observer.oil(), self.config.oil.min, self.config.oil.max);
         flags.insert(self.plant.flags_at(&self.config, t));
         // The twin first: its events (an impact, a release) cost it a few
         // steps more, and the tick then runs neither a job nor telemetry
@@ -357,5 +372,20 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
     /// the scheduled one.
     pub fn telemetry_due(&self) -> bool {
         self.publish
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::clamp;
+
+    #[test]
+    fn clamp_is_max_then_min_without_the_calls() {
+        for x in [f32::NAN, f32::NEG_INFINITY, -3.0, -1.0, 0.5, 2.0, 7.0, f32::INFINITY] {
+            for (lo, hi) in [(-1.0f32, 2.0f32), (0.5, 0.5), (f32::NEG_INFINITY, f32::INFINITY)] {
+                let expected = x.max(lo).min(hi);
+                assert_eq!(clamp(x, lo, hi).to_bits(), expected.to_bits(), "{x} in [{lo}, {hi}]");
+            }
+        }
     }
 }
