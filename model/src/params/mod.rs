@@ -12,7 +12,8 @@
 pub use compensator_params::{
     CORE_FIELDS, Compact, CoreFields, Correlation, ECHO_MAX, ESTIMATOR_FIELDS, Echo, EstimatorFields, Field, Kind,
     MACHINE_FIELDS, MAX_CORRELATIONS, MachineFields, Named, PROBE_FIELDS, ParamError, ProbeFields, Problem, Range,
-    RawCore, RawEstimator, RawMachine, RawParams, RawProbe, RawTolerances, VISCOSITY_40C_CST,
+    RawCore, RawEstimator, RawMachine, RawParams, RawProbe, RawTolerances, KELVIN, NTC_FAULT_CODES, SENSOR_KINDS,
+    VISCOSITY_40C_CST,
 };
 
 use crate::fluid::Oil;
