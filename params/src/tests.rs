@@ -380,7 +380,7 @@ fn file_errors_are_one_bounded_line_naming_the_key() {
 #[cfg(feature = "toml")]
 #[test]
 fn tolerances_and_correlations_round_trip_and_are_checked_by_name() {
-    use crate::file::{fmt_float, parse, to_toml};
+    use crate::file::{parse, to_toml};
     use std::fmt::Write as _;
 
     let mut base = String::new();
