@@ -18,8 +18,9 @@
 //! NTC (`estimator.sensor = "ntc"`: `build.rs` sets `cfg(sensor_ntc)`):
 //! the series resistor `estimator.ntc_series` from VDDA (V_REF+) to PA1
 //! (ADC1_IN1), the NTC from PA1 to GND, 100 nF from PA1 to GND beside the
-//! pin. The HAL (`stm32f4xx_hal::adc::Adc`) enables and resets ADC1 and
-//! sets the channel's sampling time (480 cycles); conversions are then
+//! pin. The HAL (`stm32f4xx_hal::adc::Adc`) enables, resets and calibrates
+//! ADC1 (ADCCLK 21 MHz) and sets the channel's sampling time (84 cycles);
+//! conversions are then
 //! started and read through the register driver the simulator shares
 //! (`compensator::sensor::ntc::RegisterAdc`: SWSTART, a bounded EOC poll,
 //! DR), since the HAL's `convert` waits for EOC without a bound.
@@ -209,7 +210,7 @@ fn main() -> ! {
     #[cfg(sensor_ntc)]
     let mut sensor = {
         use stm32f4xx_hal::adc::Adc;
-        use stm32f4xx_hal::adc::config::{AdcConfig, SampleTime, Sequence};
+        use stm32f4xx_hal::adc::config::{AdcConfig, Clock, SampleTime, Sequence};
         // The divider, the NTC's curve, the ADC's bits and oversampling
         // from the parameter file; readings outside the oil's range are
         // out of range.
@@ -218,8 +219,11 @@ fn main() -> ! {
         // Clock, reset, calibration (VREFINT) and the channel's sampling
         // time by the HAL; the resolution and the conversions by the
         // register driver.
-        let mut adc = Adc::new(dp.ADC1, true, AdcConfig::default(), &mut rcc);
-        adc.configure_channel(&pa1, Sequence::One, SampleTime::Cycles_480);
+        // ADCCLK = PCLK2 / 4 = 21 MHz (at most 36 MHz, DS8626); 84 cycles
+        // of sampling: the 100 nF at the pin charges the sampling capacitor.
+        let config = AdcConfig::default().clock(Clock::Pclk2_div_4);
+        let mut adc = Adc::new(dp.ADC1, true, config, &mut rcc);
+        adc.configure_channel(&pa1, Sequence::One, SampleTime::Cycles_84);
         // ADC1 stays configured; its registers are driven from here on.
         core::mem::forget(adc);
         Ntc::new(RegisterAdc::new(Adc1, settings.bits), settings)

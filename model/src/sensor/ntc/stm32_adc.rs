@@ -58,10 +58,12 @@ pub mod reg {
     }
 }
 
-/// Status register polls before a conversion counts as not ended (a
-/// 12-bit conversion with the shortest sampling time takes 15 ADC clocks,
-/// 0.5 us at 30 MHz: a few polls).
-pub const EOC_POLLS: u32 = 64;
+/// Status register polls before a conversion counts as not ended: the
+/// board's 12-bit conversion (84 sampling cycles + 12) takes 96 ADC clocks,
+/// 4.6 us at 21 MHz, some 770 core cycles at 168 MHz, and a poll (an APB2
+/// read and a branch) several core cycles, so that 1024 polls outlast a
+/// few conversions; the simulator converts at once.
+pub const EOC_POLLS: u32 = 1024;
 
 /// Word access to an ADC's registers (offsets of [`reg`]).
 pub trait AdcRegisters {
