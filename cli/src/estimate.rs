@@ -38,9 +38,9 @@ use compensator::Params;
 use compensator::estimator::telemetry::{Encoding, FIELDS, Record};
 use compensator::estimator::{Estimator, EstimatorConfig, StateEstimate};
 use compensator::params::RawParams;
-use compensator::sensor::{Detail, SensorFault};
 use compensator::sensor::max31865::Settings;
 use compensator::sensor::rtd;
+use compensator::sensor::{Detail, SensorFault};
 
 /// What a log's reading column holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -457,7 +457,11 @@ pub fn field_table() -> String {
             }
         };
         let range = match f.kind {
-            Kind::Named(names) => names.iter().map(|n| format!("`\"{n}\"`")).collect::<Vec<_>>().join(", "),
+            Kind::Named(names) => names
+                .iter()
+                .map(|n| format!("`\"{n}\"`"))
+                .collect::<Vec<_>>()
+                .join(", "),
             _ => format!("[{}, {}]", Compact(f.min), Compact(f.max)),
         };
         let range = if f.kind == Kind::OrZero {

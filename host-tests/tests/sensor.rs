@@ -242,11 +242,26 @@ fn a_fault_bit_reads_the_status_clears_it_and_names_the_fault() {
 
 #[test]
 fn status_bits_map_to_faults_and_impossible_bytes_to_the_bus() {
-    assert_eq!(classify(fault::RTD_HIGH), SensorFault::OpenCircuit(status(fault::RTD_HIGH)));
-    assert_eq!(classify(fault::RTD_LOW), SensorFault::ShortCircuit(status(fault::RTD_LOW)));
-    assert_eq!(classify(fault::REFIN_HIGH), SensorFault::Wiring(status(fault::REFIN_HIGH)));
-    assert_eq!(classify(fault::REFIN_LOW | fault::RTD_HIGH), SensorFault::Wiring(status(fault::REFIN_LOW | fault::RTD_HIGH)));
-    assert_eq!(classify(fault::RTDIN_LOW), SensorFault::Wiring(status(fault::RTDIN_LOW)));
+    assert_eq!(
+        classify(fault::RTD_HIGH),
+        SensorFault::OpenCircuit(status(fault::RTD_HIGH))
+    );
+    assert_eq!(
+        classify(fault::RTD_LOW),
+        SensorFault::ShortCircuit(status(fault::RTD_LOW))
+    );
+    assert_eq!(
+        classify(fault::REFIN_HIGH),
+        SensorFault::Wiring(status(fault::REFIN_HIGH))
+    );
+    assert_eq!(
+        classify(fault::REFIN_LOW | fault::RTD_HIGH),
+        SensorFault::Wiring(status(fault::REFIN_LOW | fault::RTD_HIGH))
+    );
+    assert_eq!(
+        classify(fault::RTDIN_LOW),
+        SensorFault::Wiring(status(fault::RTDIN_LOW))
+    );
     assert_eq!(classify(fault::VOLTAGE), SensorFault::Supply(status(fault::VOLTAGE)));
     assert_eq!(classify(0), SensorFault::OutOfRange(status(0)));
     // MISO stuck high: 0xFF sets the unused D1:D0 and RTD high and low at
@@ -429,14 +444,22 @@ fn the_simulated_converter_shows_wiring_faults_only_to_the_detection_cycle() {
     let mut drv = Max31865::new(SimulatedMax31865::new(settings, 30.0), settings);
     drv.device_mut().fault = fault::RTDIN_LOW;
     drv.configure().unwrap();
-    assert_eq!(drv.read(), Err(SensorFault::Wiring(status(fault::RTDIN_LOW))), "the start-up cycle");
+    assert_eq!(
+        drv.read(),
+        Err(SensorFault::Wiring(status(fault::RTDIN_LOW))),
+        "the start-up cycle"
+    );
     let readings: Vec<_> = (0..40).map(|_| drv.read()).collect();
     assert!(
         readings
             .iter()
             .all(|r| matches!(r, Ok(None) | Err(SensorFault::Wiring(_))))
     );
-    assert!(readings.iter().any(|r| r == &Err(SensorFault::Wiring(status(fault::RTDIN_LOW)))));
+    assert!(
+        readings
+            .iter()
+            .any(|r| r == &Err(SensorFault::Wiring(status(fault::RTDIN_LOW))))
+    );
     assert!(drv.device_mut().detection_cycles > 3, "rechecked while faulted");
     // Repaired: the next cycle passes and readings come back.
     drv.device_mut().fault = 0;
@@ -509,9 +532,7 @@ fn no_reading_call_clocks_more_than_nine_bytes() {
 // The NTC thermistor on the STM32F4's ADC.
 // ---------------------------------------------------------------------------
 
-use compensator::sensor::ntc::{
-    self, AdcChannel, AdcRegisters, Curve, Ntc, RegisterAdc, SimulatedStm32Adc, reg,
-};
+use compensator::sensor::ntc::{self, AdcChannel, AdcRegisters, Curve, Ntc, RegisterAdc, SimulatedStm32Adc, reg};
 use compensator::sensor::simulated::{Injection, SimulatedNtc, SimulatedSource};
 
 /// The default NTC channel: 10 kohm NTCLE100E3103 (B25/85 = 3977 K), 10
@@ -546,7 +567,11 @@ fn sh_resistance(t: f64) -> f64 {
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);
         // Higher resistance, colder.
-        if sh_reference(mid.exp()) > t { lo = mid } else { hi = mid }
+        if sh_reference(mid.exp()) > t {
+            lo = mid
+        } else {
+            hi = mid
+        }
     }
     (0.5 * (lo + hi)).exp()
 }
@@ -628,10 +653,17 @@ fn the_divider_reads_back_every_temperature_within_half_a_code() {
             let h = 0.01;
             let per_code = 2.0 * h
                 / (code_reference(resistance(t - h), 10_000.0, 12) - code_reference(resistance(t + h), 10_000.0, 12));
-            assert!((read - t).abs() <= 0.5 * per_code + 2e-3, "{t} C read as {read} ({per_code} C a code)");
+            assert!(
+                (read - t).abs() <= 0.5 * per_code + 2e-3,
+                "{t} C read as {read} ({per_code} C a code)"
+            );
             t += 0.7;
         }
-        assert_eq!(drv.device_mut().registers_mut().conversions % 4, 0, "4 conversions a reading");
+        assert_eq!(
+            drv.device_mut().registers_mut().conversions % 4,
+            0,
+            "4 conversions a reading"
+        );
     }
     // Mid-range resolution of the default divider (docs/firmware.md's
     // error budget): 0.035 C a code at 52 C.
@@ -724,8 +756,8 @@ fn the_register_adc_starts_polls_and_reads_as_the_reference_manual_says() {
 
 #[test]
 fn the_parameter_file_chooses_and_checks_the_ntc() {
-    use compensator_params::file::parse;
     use compensator::sensor::device::{SensorKind, sample_period};
+    use compensator_params::file::parse;
     let base = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../presets/paper.toml")).unwrap();
     let rtd = parse(&base).unwrap();
     assert_eq!(SensorKind::of(&rtd.estimator), SensorKind::Rtd);

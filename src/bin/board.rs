@@ -385,7 +385,10 @@ impl AdcRegisters for Adc1 {
         // SAFETY: as in `read`; every value the driver writes is a valid
         // setting of these registers (RES, ADON, SWSTART; SR's rc_w0 bits).
         let adc = unsafe { &*pac::ADC1::ptr() };
-        #[allow(unused_unsafe, reason = "bits() is unsafe on some registers of the PAC, safe on others")]
+        #[allow(
+            unused_unsafe,
+            reason = "bits() is unsafe on some registers of the PAC, safe on others"
+        )]
         match offset {
             reg::SR => adc.sr().write(|w| unsafe { w.bits(value) }),
             reg::CR1 => adc.cr1().write(|w| unsafe { w.bits(value) }),

@@ -355,11 +355,7 @@ fn replay(params: &Params<f32>, config: BuiltConfig) -> bool {
 /// (`read`), then the estimator (filter, twin, job). Not inlined, so that
 /// `cargo xtask test` can check that nothing reachable from it panics.
 #[inline(never)]
-fn tick_path(
-    sensor: &mut Sensor,
-    estimator: &mut BuiltEstimator<TwinScalar>,
-    read: bool,
-) -> StateEstimate {
+fn tick_path(sensor: &mut Sensor, estimator: &mut BuiltEstimator<TwinScalar>, read: bool) -> StateEstimate {
     let sample = if read { sensor.read() } else { Ok(None) };
     estimator.tick(sample)
 }

@@ -532,15 +532,28 @@ fn ntc_twin(tc: &toolchain::Toolchain, root: &Path, timeout: Duration) -> Result
         for l in &run.lines {
             eprintln!("{}", telemetry::humanize(l));
         }
-        return Err(format!("the twin built for {} exited with {}", file.display(), run.code));
+        return Err(format!(
+            "the twin built for {} exited with {}",
+            file.display(),
+            run.code
+        ));
     }
     let stack = run
         .lines
         .iter()
-        .find_map(|l| l.split("[measure] peak stack ").nth(1)?.split_whitespace().next()?.parse::<u64>().ok())
+        .find_map(|l| {
+            l.split("[measure] peak stack ")
+                .nth(1)?
+                .split_whitespace()
+                .next()?
+                .parse::<u64>()
+                .ok()
+        })
         .ok_or("the NTC twin reported no peak stack")?;
     if stack > TWIN_STACK_BUDGET {
-        return Err(format!("the NTC twin's peak stack {stack} bytes exceeds {TWIN_STACK_BUDGET}"));
+        return Err(format!(
+            "the NTC twin's peak stack {stack} bytes exceeds {TWIN_STACK_BUDGET}"
+        ));
     }
     let csv_path = root.join("target/xtask/twin-ntc-telemetry.csv");
     let mut csv = telemetry::CsvFile::create(&csv_path)?;
@@ -655,7 +668,9 @@ fn cmd_test(bless: bool) -> Outcome {
             .find(|l| l.contains("checks:"))
             .map_or("", String::as_str)
     );
-    step("an NTC device file (presets/paper-ntc.toml) builds the twin; on QEMU it passes its checks within the stack budget and matches the host replica");
+    step(
+        "an NTC device file (presets/paper-ntc.toml) builds the twin; on QEMU it passes its checks within the stack budget and matches the host replica",
+    );
     ntc_twin(&tc, &root, minutes(5))?;
     step("a parameter file the CLI refuses fails the firmware build in one line naming the field");
     firmware::check_refused_file(&tc, &root)?;

@@ -7,8 +7,8 @@
 //! its simulator ([`SimulatedRtd`], [`SimulatedNtc`]).
 
 pub use super::max31865::SimulatedMax31865;
-pub use super::ntc::SimulatedStm32Adc;
 use super::max31865::{self, Max31865};
+pub use super::ntc::SimulatedStm32Adc;
 use super::ntc::{self, Ntc, RegisterAdc};
 use super::{SensorFault, TemperatureSource};
 

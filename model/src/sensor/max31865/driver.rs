@@ -1,7 +1,9 @@
 //! The MAX31865 driver over an `embedded-hal` 1.0 [`SpiDevice`], with
 //! the fault-detection schedule of the module docs.
 
-use super::registers::{REG_CONFIG, REG_FAULT_STATUS, REG_HIGH_FAULT_MSB, REG_RTD_MSB, WRITE, classify, code_of, config};
+use super::registers::{
+    REG_CONFIG, REG_FAULT_STATUS, REG_HIGH_FAULT_MSB, REG_RTD_MSB, WRITE, classify, code_of, config,
+};
 use super::{Error, Mains, Settings, Wires};
 use crate::sensor::{Detail, SensorFault, TemperatureSource};
 use embedded_hal::spi::{Operation, SpiDevice};

@@ -191,4 +191,3 @@ impl Settings {
         (if (whole as f32) < n { whole + 1 } else { whole }) + 1
     }
 }
-
