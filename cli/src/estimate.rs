@@ -289,14 +289,14 @@ fn sample(log: &Log, settings: &Settings, i: usize) -> Result<Option<f32>, Senso
         Reading::Resistance => v as f32,
         // As the driver: saturated codes are faults, R = code R_ref / 2^15.
         Reading::Code if v == 0.0 || v >= 32767.0 => {
-            return Err(SensorFault::OutOfRange(Detail::Code(v as u16)));
+            return Err(SensorFault::OutOfRange(Detail::code(v as u16)));
         }
         Reading::Code => v as u16 as f32 * settings.reference / 32768.0,
     };
     match settings.cvd.temperature(settings.r0, ohm) {
         Some(t) => Ok(Some(t)),
-        None if log.column.reading == Reading::Code => Err(SensorFault::OutOfRange(Detail::Code(v as u16))),
-        None => Err(SensorFault::OutOfRange(Detail::None)),
+        None if log.column.reading == Reading::Code => Err(SensorFault::OutOfRange(Detail::code(v as u16))),
+        None => Err(SensorFault::OutOfRange(Detail::NONE)),
     }
 }
 

@@ -73,11 +73,11 @@ pub const STEP_TICKS: u32 = 4096;
 
 const FAULTS: [SensorFault; 7] = [
     SensorFault::Bus,
-    SensorFault::OpenCircuit(Detail::Max31865Status(fault::RTD_HIGH)),
-    SensorFault::ShortCircuit(Detail::Code(0)),
-    SensorFault::Wiring(Detail::Max31865Status(fault::REFIN_LOW)),
-    SensorFault::Supply(Detail::Max31865Status(fault::VOLTAGE)),
-    SensorFault::OutOfRange(Detail::None),
+    SensorFault::OpenCircuit(Detail::max31865_status(fault::RTD_HIGH)),
+    SensorFault::ShortCircuit(Detail::code(0)),
+    SensorFault::Wiring(Detail::max31865_status(fault::REFIN_LOW)),
+    SensorFault::Supply(Detail::max31865_status(fault::VOLTAGE)),
+    SensorFault::OutOfRange(Detail::NONE),
     SensorFault::Stale,
 ];
 

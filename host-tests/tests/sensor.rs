@@ -19,7 +19,7 @@ use embedded_hal_mock::eh1::spi::{Mock, Transaction as T};
 
 /// The MAX31865's fault status byte as a fault's detail.
 fn status(byte: u8) -> Detail {
-    Detail::Max31865Status(byte)
+    Detail::max31865_status(byte)
 }
 
 /// PT100, 430 ohm, 3 wires, 50 Hz, IEC 60751, fault band -60..250 C, a
@@ -386,7 +386,7 @@ fn saturated_codes_are_out_of_range_not_temperatures() {
         let expectations = read_rtd(code, false);
         let mut spi = Mock::new(&expectations);
         let mut drv = Max31865::new(spi.clone(), SETTINGS);
-        assert_eq!(drv.read(), Err(SensorFault::OutOfRange(Detail::Code(code))));
+        assert_eq!(drv.read(), Err(SensorFault::OutOfRange(Detail::code(code))));
         spi.done();
     }
 }
@@ -425,7 +425,7 @@ fn the_simulated_converter_speaks_the_same_register_map() {
     drv.device_mut().fault = 0;
     assert!(drv.read().unwrap().is_some());
     drv.device_mut().forced_code = Some(0x7FFF);
-    assert_eq!(drv.read(), Err(SensorFault::OutOfRange(Detail::Code(0x7FFF))));
+    assert_eq!(drv.read(), Err(SensorFault::OutOfRange(Detail::code(0x7FFF))));
     drv.device_mut().forced_code = None;
     drv.device_mut().bus_error = true;
     assert_eq!(drv.read(), Err(SensorFault::Bus));
@@ -679,11 +679,11 @@ fn open_short_and_out_of_range_codes_are_faults_with_their_code() {
     assert!(drv.start().is_ok());
     assert!((drv.read().unwrap().unwrap() - 40.0).abs() < 0.05);
     drv.inject(Some(Injection::Open));
-    assert_eq!(drv.read(), Err(SensorFault::OpenCircuit(Detail::Code(4095))));
+    assert_eq!(drv.read(), Err(SensorFault::OpenCircuit(Detail::code(4095))));
     drv.inject(Some(Injection::Short));
-    assert_eq!(drv.read(), Err(SensorFault::ShortCircuit(Detail::Code(0))));
+    assert_eq!(drv.read(), Err(SensorFault::ShortCircuit(Detail::code(0))));
     drv.inject(Some(Injection::Saturated));
-    assert_eq!(drv.read(), Err(SensorFault::OpenCircuit(Detail::Code(4095))));
+    assert_eq!(drv.read(), Err(SensorFault::OpenCircuit(Detail::code(4095))));
     drv.inject(Some(Injection::Stuck));
     assert_eq!(drv.read(), Err(SensorFault::Stale));
     drv.inject(Some(Injection::Bus));
@@ -694,7 +694,7 @@ fn open_short_and_out_of_range_codes_are_faults_with_their_code() {
     drv.set_temperature(170.0);
     let code = NTC.code_of(170.0);
     assert!(code > 8, "{code}");
-    assert_eq!(drv.read(), Err(SensorFault::OutOfRange(Detail::Code(code))));
+    assert_eq!(drv.read(), Err(SensorFault::OutOfRange(Detail::code(code))));
     // Just inside the bands: 9 and 4086 are temperatures (if in the band)
     // or out of range, never open or short.
     let mut mock = Codes(vec![]);
@@ -789,4 +789,27 @@ fn the_parameter_file_chooses_and_checks_the_ntc() {
     assert_eq!(e.to_string(), "estimator.sensor: expected \"rtd\" or \"ntc\"");
     let e = with("sensor = 1\n").unwrap_err();
     assert_eq!(e.field(), Some("estimator.sensor"));
+}
+
+#[test]
+fn a_fault_carries_the_chips_word_and_a_reading_stays_eight_bytes() {
+    use compensator::sensor::Word;
+    assert_eq!(Detail::NONE.word(), Word::None);
+    assert_eq!(Detail::max31865_status(0x84).word(), Word::Max31865Status(0x84));
+    assert_eq!(Detail::max31865_status(0).word(), Word::Max31865Status(0));
+    for code in [0u16, 1, 4095, 0x7FFF] {
+        assert_eq!(Detail::code(code).word(), Word::Code(code));
+    }
+    assert_eq!(
+        SensorFault::OpenCircuit(Detail::code(4095)).detail(),
+        Detail::code(4095)
+    );
+    assert_eq!(SensorFault::Stale.detail(), Detail::NONE);
+    assert_eq!(
+        SensorFault::Wiring(Detail::max31865_status(fault::REFIN_LOW)).to_string(),
+        "a force or reference line of the element is open or shorted (MAX31865 fault status 0x10)"
+    );
+    // The estimator's tick takes the reading by value: as small as it was
+    // with fieldless faults.
+    assert_eq!(core::mem::size_of::<Result<Option<f32>, SensorFault>>(), 8);
 }

@@ -2,7 +2,7 @@
 //!
 //! * [`TemperatureSource`]: the one interface the estimator needs, and
 //!   [`SensorFault`], why a source gave no temperature (general causes,
-//!   the chip's own detail inside: [`Detail`]).
+//!   the chip's own word inside: [`Detail`], [`Word`]).
 //! * [`rtd`]: platinum RTD resistance to temperature (Callendar-Van Dusen).
 //! * [`max31865`]: the MAX31865 RTD-to-digital converter over an
 //!   `embedded-hal` 1.0 [`SpiDevice`](embedded_hal::spi::SpiDevice), the
@@ -23,26 +23,77 @@ pub mod ntc;
 pub mod rtd;
 pub mod simulated;
 
-/// What the chip said about a fault, beyond its general cause.
+/// What the chip said about a fault, beyond its general cause, packed in
+/// 16 bits ([`Detail::word`] unpacks it): a reading's
+/// `Result<Option<f32>, SensorFault>` stays 8 bytes, as it was with
+/// fieldless faults (the estimator's tick takes it by value every tick).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub struct Detail(u16);
+
+/// A [`Detail`] unpacked.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Detail {
+pub enum Word {
     /// Nothing more (a reading that is not a number, a log's entry).
     None,
     /// The MAX31865's fault status register (D7 RTD high ... D2
     /// over/under-voltage, [`max31865::fault`]).
     Max31865Status(u8),
-    /// The converter's raw code: the MAX31865's 15-bit RTD code, or the
-    /// ADC's (averaged) code of an NTC divider.
+    /// The converter's raw code (15 bits at most): the MAX31865's RTD
+    /// code, or the ADC's (mean) code of an NTC divider.
     Code(u16),
+}
+
+impl Detail {
+    /// Nothing more.
+    pub const NONE: Detail = Detail(0);
+    /// Tag of a status byte (bits 15:8 = 0x01).
+    const STATUS: u16 = 0x0100;
+    /// Tag of a code (bit 15).
+    const CODE: u16 = 0x8000;
+
+    /// The MAX31865's fault status byte.
+    pub const fn max31865_status(status: u8) -> Detail {
+        Detail(Detail::STATUS | status as u16)
+    }
+
+    /// A converter's raw code (its 15 low bits: every code of the
+    /// MAX31865's 15-bit and the STM32F4's 12-bit converters).
+    pub const fn code(code: u16) -> Detail {
+        Detail(Detail::CODE | (code & 0x7FFF))
+    }
+
+    /// What it says.
+    pub const fn word(self) -> Word {
+        if self.0 & Detail::CODE != 0 {
+            Word::Code(self.0 & 0x7FFF)
+        } else if self.0 & Detail::STATUS != 0 {
+            Word::Max31865Status(self.0 as u8)
+        } else {
+            Word::None
+        }
+    }
+}
+
+impl core::fmt::Debug for Detail {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        core::fmt::Debug::fmt(&self.word(), f)
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Detail {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        defmt::Format::format(&self.word(), f);
+    }
 }
 
 impl core::fmt::Display for Detail {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        match self {
-            Detail::None => Ok(()),
-            Detail::Max31865Status(s) => write!(f, " (MAX31865 fault status {s:#04x})"),
-            Detail::Code(c) => write!(f, " (code {c})"),
+        match self.word() {
+            Word::None => Ok(()),
+            Word::Max31865Status(s) => write!(f, " (MAX31865 fault status {s:#04x})"),
+            Word::Code(c) => write!(f, " (code {c})"),
         }
     }
 }
@@ -84,7 +135,7 @@ impl SensorFault {
             | SensorFault::Wiring(d)
             | SensorFault::Supply(d)
             | SensorFault::OutOfRange(d) => d,
-            SensorFault::Bus | SensorFault::Stale => Detail::None,
+            SensorFault::Bus | SensorFault::Stale => Detail::NONE,
         }
     }
 }

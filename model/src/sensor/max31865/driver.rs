@@ -234,7 +234,7 @@ impl<SPI: SpiDevice> Max31865<SPI> {
             Ok(t) => Ok(Some(t)),
             Err(Error::Spi(_)) => Err(SensorFault::Bus),
             Err(Error::Fault(status)) => Err(classify(status)),
-            Err(Error::OutOfRange(code)) => Err(SensorFault::OutOfRange(Detail::Code(code))),
+            Err(Error::OutOfRange(code)) => Err(SensorFault::OutOfRange(Detail::code(code))),
         };
         match (self.suspect, reading) {
             // A wiring fault makes readings look valid: not one is trusted.

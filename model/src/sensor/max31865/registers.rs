@@ -84,10 +84,10 @@ pub fn is_chip_answer(status: u8) -> bool {
 }
 
 /// The fault a status byte stands for (the most specific bit first), with
-/// the byte as its [`Detail::Max31865Status`]; a byte no chip can answer is
+/// the byte as its [`Detail::max31865_status`]; a byte no chip can answer is
 /// a bus fault, a byte without a fault bit a reading out of range.
 pub fn classify(status: u8) -> SensorFault {
-    let d = Detail::Max31865Status(status);
+    let d = Detail::max31865_status(status);
     if !is_chip_answer(status) {
         SensorFault::Bus
     } else if status & fault::WIRING != 0 {

@@ -144,9 +144,9 @@ impl<ADC: AdcChannel> TemperatureSource for Ntc<ADC> {
         match self.read_temperature() {
             Ok(t) => Ok(Some(t)),
             Err(Error::Adc(e)) => Err(ADC::fault(&e)),
-            Err(Error::Open(c)) => Err(SensorFault::OpenCircuit(Detail::Code(c))),
-            Err(Error::Short(c)) => Err(SensorFault::ShortCircuit(Detail::Code(c))),
-            Err(Error::OutOfRange(c)) => Err(SensorFault::OutOfRange(Detail::Code(c))),
+            Err(Error::Open(c)) => Err(SensorFault::OpenCircuit(Detail::code(c))),
+            Err(Error::Short(c)) => Err(SensorFault::ShortCircuit(Detail::code(c))),
+            Err(Error::OutOfRange(c)) => Err(SensorFault::OutOfRange(Detail::code(c))),
         }
     }
 }

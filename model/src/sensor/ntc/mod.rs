@@ -39,7 +39,7 @@
 //! [`OutOfRange`](super::SensorFault::OutOfRange); a conversion that does
 //! not end is [`Stale`](super::SensorFault::Stale), an ADC error
 //! [`Bus`](super::SensorFault::Bus). Each carries the mean code as its
-//! [`Detail::Code`](super::Detail::Code).
+//! [`Detail::code`](super::Detail::code).
 //!
 //! # The ADC
 //!
