@@ -515,7 +515,8 @@ const TWIN_STACK_BUDGET: u64 = 6 << 10;
 /// The twin built for the NTC preset (`presets/paper-ntc.toml`: the NTC
 /// on the STM32F4's ADC, simulated at register level), run on QEMU: its
 /// self-checks pass, its peak stack is within [`TWIN_STACK_BUDGET`], and
-/// its telemetry is the host replica's, row by row.
+/// its telemetry is the host replica's, row by row; nothing reachable from
+/// its tick paths, nor from the NTC board image's, panics.
 fn ntc_twin(tc: &toolchain::Toolchain, root: &Path, timeout: Duration) -> Result<(), String> {
     let file = root.join("presets/paper-ntc.toml");
     let built = firmware::build_with(
@@ -573,6 +574,17 @@ fn ntc_twin(tc: &toolchain::Toolchain, root: &Path, timeout: Duration) -> Result
             .find(|l| l.contains("checks:"))
             .map_or("", String::as_str),
         replica::compare(&decoded, &host)?
+    );
+    // The NTC's tick paths, on QEMU and on the board (its ADC registers),
+    // link no panic either.
+    eprintln!(
+        "xtask: NTC twin: {}",
+        panic_free::check(&built.elf, &["tick_path", "telemetry_path"], &[])?
+    );
+    let board = firmware::build(tc, root, &firmware::Image::BOARD, Some(&file))?;
+    eprintln!(
+        "xtask: NTC board: {}",
+        panic_free::check(&board, &["tick_path"], &["_defmt_acquire", "_defmt_release"])?
     );
     Ok(())
 }
