@@ -681,7 +681,7 @@ fn cmd_test(bless: bool) -> Outcome {
             .map_or("", String::as_str)
     );
     step(
-        "an NTC device file (presets/paper-ntc.toml) builds the twin; on QEMU it passes its checks within the stack budget and matches the host replica",
+        "an NTC device file (presets/paper-ntc.toml) builds the twin and the board; on QEMU the twin passes its checks within the stack budget and matches the host replica; neither tick links a panic",
     );
     ntc_twin(&tc, &root, minutes(5))?;
     step("a parameter file the CLI refuses fails the firmware build in one line naming the field");
