@@ -61,6 +61,8 @@ fn main() {
     let board = env::var_os("CARGO_FEATURE_BOARD").is_some();
     let qemu = env::var_os("CARGO_FEATURE_QEMU").is_some();
     println!("cargo:rerun-if-changed=build.rs");
+    // Set for an NTC device (`estimator.sensor = "ntc"`), below.
+    println!("cargo::rustc-check-cfg=cfg(sensor_ntc)");
 
     println!("cargo:rerun-if-changed=memory.x");
     if target.starts_with("thumb") && !board {
@@ -128,6 +130,10 @@ fn main() {
         println!("cargo::warning=parameter file {}: {w}", params.display());
     }
     fs::write(out.join("params.rs"), generated.code).expect("write params.rs");
+    // The sensor the file chose: the images compile its driver alone.
+    if raw.estimator.is_ntc() {
+        println!("cargo::rustc-cfg=sensor_ntc");
+    }
     #[cfg(feature = "qemu")]
     {
         use compensator_codegen::replay;

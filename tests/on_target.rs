@@ -174,6 +174,27 @@ mod tests {
     }
 
     #[test]
+    fn ntc_conversion_round_trips_through_the_adc_registers() {
+        // The beta curve's f32 logf/expf on the M4F, through the simulated
+        // STM32F4 ADC's registers and the real driver: within half a code
+        // of the temperature (the widest, 0.26 C a code, at 120 C for the
+        // 10 kohm NTC and resistor).
+        use compensator::sensor::ntc::{self, Ntc, RegisterAdc};
+        use compensator::sensor::simulated::SimulatedStm32Adc;
+        let s = ntc::Settings::NTC10K;
+        let mut sensor = Ntc::new(RegisterAdc::new(SimulatedStm32Adc::new(s, 25.0), s.bits), s);
+        let mut t = -30.0f32;
+        while t <= 120.0 {
+            sensor.device_mut().registers_mut().temperature = t;
+            let back = sensor.read().unwrap().unwrap();
+            assert!((back - t).abs() < 0.2, "{=f32} -> {=f32}", t, back);
+            t += 2.5;
+        }
+        sensor.device_mut().registers_mut().open = true;
+        assert!(matches!(sensor.read(), Err(SensorFault::OpenCircuit(_))));
+    }
+
+    #[test]
     fn sensor_faults_become_flags_not_numbers(p: &mut Params<f32>) {
         let settings = Settings::PT100_430;
         let mut sensor = Max31865::new(SimulatedMax31865::new(settings, 45.0), settings);

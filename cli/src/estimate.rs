@@ -38,9 +38,9 @@ use compensator::Params;
 use compensator::estimator::telemetry::{Encoding, FIELDS, Record};
 use compensator::estimator::{Estimator, EstimatorConfig, StateEstimate};
 use compensator::params::RawParams;
-use compensator::sensor::SensorFault;
 use compensator::sensor::max31865::Settings;
 use compensator::sensor::rtd;
+use compensator::sensor::{Detail, SensorFault};
 
 /// What a log's reading column holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -288,12 +288,15 @@ fn sample(log: &Log, settings: &Settings, i: usize) -> Result<Option<f32>, Senso
         Reading::Temperature => return Ok(Some(v as f32)),
         Reading::Resistance => v as f32,
         // As the driver: saturated codes are faults, R = code R_ref / 2^15.
-        Reading::Code if v == 0.0 || v >= 32767.0 => return Err(SensorFault::Implausible),
+        Reading::Code if v == 0.0 || v >= 32767.0 => {
+            return Err(SensorFault::OutOfRange(Detail::code(v as u16)));
+        }
         Reading::Code => v as u16 as f32 * settings.reference / 32768.0,
     };
     match settings.cvd.temperature(settings.r0, ohm) {
         Some(t) => Ok(Some(t)),
-        None => Err(SensorFault::Implausible),
+        None if log.column.reading == Reading::Code => Err(SensorFault::OutOfRange(Detail::code(v as u16))),
+        None => Err(SensorFault::OutOfRange(Detail::NONE)),
     }
 }
 

@@ -269,10 +269,16 @@ pub fn adapt(raw: &RawParams) -> Replay {
     }
 }
 
-/// Half a MAX31865 code in degrees at `t` \[C\]: `(R_ref / 2^16) / (dR/dt)`,
-/// with the device's Callendar-Van Dusen slope.
+/// Half a code of the device's sensor in degrees at `t` \[C\]: for the
+/// MAX31865 `(R_ref / 2^16) / (dR/dt)`, with the device's Callendar-Van
+/// Dusen slope; for the NTC half an ADC code over the divider's slope
+/// (`RawEstimator::resolution`).
 pub fn half_code(est: &RawEstimator, t: f64) -> f64 {
-    (est.rtd_reference / 65536.0) / est.rtd_slope(t)
+    if est.is_ntc() {
+        0.5 * est.resolution(t)
+    } else {
+        (est.rtd_reference / 65536.0) / est.rtd_slope(t)
+    }
 }
 
 #[cfg(feature = "replay")]

@@ -138,16 +138,16 @@ const NO_MACHINE: [f64; 3] = [0.0, 0.0, 40.0];
 impl Setup {
     /// The values of a parameter file.
     pub fn from_raw(raw: &RawParams) -> Setup {
-        let machine = raw.machine.map(|m| m.named().into_array().map(|n| n.value));
-        let values: Vec<f64> = raw
-            .core
-            .named()
-            .into_array()
-            .iter()
-            .map(|n| n.value)
-            .chain(machine.unwrap_or(NO_MACHINE))
-            .chain(raw.estimator.named().into_array().iter().map(|n| n.value))
-            .chain(raw.probe.named().into_array().iter().map(|n| n.value))
+        // In the variables' order ([`fields`]); a machine's fields at
+        // their placeholders when the file has none.
+        let values: Vec<f64> = fields()
+            .map(|f| match raw.get(f.path) {
+                Ok(v) => v,
+                Err(_) => MACHINE_FIELDS
+                    .iter()
+                    .position(|m| m.path == f.path)
+                    .map_or(f64::NAN, |i| NO_MACHINE[i]),
+            })
             .collect();
         Setup {
             values: values.try_into().expect("one value per field"),

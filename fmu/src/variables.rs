@@ -125,15 +125,29 @@ pub const OUTPUTS: [Variable; 10] = [
 /// Index of `flags` in [`OUTPUTS`].
 pub const FLAGS_OUTPUT: usize = 9;
 
-/// The parameter file's fields in file order: core, machine, estimator,
-/// probe (its `[tolerances]` are not variables: they travel with the
-/// packaged file, [`crate::instance::Setup`]).
+/// The parameter file's fields in the variables' order: core, machine,
+/// estimator, probe in file order, then the estimator's sensor-kind fields
+/// (its `[tolerances]` are not variables: they travel with the packaged
+/// file, [`crate::instance::Setup`]).
 pub fn fields() -> impl Iterator<Item = &'static Field> {
+    let (estimator, sensor) = ESTIMATOR_FIELDS.split_at(first_sensor_kind_field());
     CORE_FIELDS
         .iter()
         .chain(MACHINE_FIELDS.iter())
-        .chain(ESTIMATOR_FIELDS.iter())
+        .chain(estimator.iter())
         .chain(PROBE_FIELDS.iter())
+        .chain(sensor.iter())
+}
+
+/// Where `[estimator]`'s sensor-kind fields start (`estimator.sensor`, the
+/// NTC's): they came after the `[probe]` fields, and take the value
+/// references after theirs, so that every earlier variable keeps its
+/// reference.
+fn first_sensor_kind_field() -> usize {
+    ESTIMATOR_FIELDS
+        .iter()
+        .position(|f| f.path == "estimator.sensor")
+        .unwrap_or(ESTIMATOR_FIELDS.len())
 }
 
 /// Number of parameter-file fields.
@@ -175,7 +189,7 @@ const fn unit(name: &'static str, exponents: [i8; 8]) -> Unit {
 }
 
 /// Every unit the FMU declares: the schema's units and the outputs'.
-pub const UNITS: [Unit; 17] = [
+pub const UNITS: [Unit; 18] = [
     unit("m", [0, 1, 0, 0, 0, 0, 0, 0]),
     unit("m/s", [0, 1, -1, 0, 0, 0, 0, 0]),
     unit("Pa", [1, -1, -2, 0, 0, 0, 0, 0]),
@@ -183,6 +197,7 @@ pub const UNITS: [Unit; 17] = [
     unit("m3", [0, 3, 0, 0, 0, 0, 0, 0]),
     unit("kg", [1, 0, 0, 0, 0, 0, 0, 0]),
     unit("kg/m3", [1, -3, 0, 0, 0, 0, 0, 0]),
+    unit("K", [0, 0, 0, 0, 1, 0, 0, 0]),
     unit("1/K", [0, 0, 0, 0, -1, 0, 0, 0]),
     unit("1/K2", [0, 0, 0, 0, -2, 0, 0, 0]),
     unit("1/K4", [0, 0, 0, 0, -4, 0, 0, 0]),
@@ -211,6 +226,7 @@ pub fn fmi_unit(schema_unit: &str) -> Option<&'static str> {
         "m^3/s" => "m3/s",
         "kg" => "kg",
         "kg/m^3" => "kg/m3",
+        "K" => "K",
         "1/K" | "1/C" => "1/K",
         "1/C^2" => "1/K2",
         "1/C^4" => "1/K4",

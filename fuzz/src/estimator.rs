@@ -18,8 +18,8 @@
 //! * then steps, up to 256, while bytes remain (4,096 ticks at most in
 //!   all): a kind byte `k`, a 16-bit code `c` and a gap byte `g`.
 //!   - directly: the sample of one tick is, by `k % 8`, 0-4
-//!     `Ok(Some(temperature(c)))`, 5 `Ok(None)`, 6 `Err(fault)` (`c % 6`
-//!     of the six `SensorFault`s), 7 `Ok(Some(f32::from_bits(c << 16)))`
+//!     `Ok(Some(temperature(c)))`, 5 `Ok(None)`, 6 `Err(fault)` (`c % 7`
+//!     of seven `SensorFault`s, one of each cause), 7 `Ok(Some(f32::from_bits(c << 16)))`
 //!     (any `f32`); then `g % 64` ticks of `Ok(None)`;
 //!   - through the driver: the converter's RTD is put at
 //!     `temperature(c)`; `k % 8` picks its fault cause (0-3 none, 4 RTD
@@ -63,7 +63,7 @@ use compensator::estimator::{Estimator, EstimatorConfig, Flags, StateEstimate, T
 use compensator::params::RawEstimator;
 use compensator::sensor::max31865::{Max31865, Settings, fault};
 use compensator::sensor::simulated::SimulatedMax31865;
-use compensator::sensor::{SensorFault, TemperatureSource};
+use compensator::sensor::{Detail, SensorFault, TemperatureSource};
 use compensator::{Params, RawParams};
 
 /// Most steps of an input.
@@ -71,13 +71,14 @@ pub const STEPS: usize = 256;
 /// Most ticks of the steps of an input.
 pub const STEP_TICKS: u32 = 4096;
 
-const FAULTS: [SensorFault; 6] = [
+const FAULTS: [SensorFault; 7] = [
     SensorFault::Bus,
-    SensorFault::RtdHigh,
-    SensorFault::RtdLow,
-    SensorFault::Wiring,
-    SensorFault::Voltage,
-    SensorFault::Implausible,
+    SensorFault::OpenCircuit(Detail::max31865_status(fault::RTD_HIGH)),
+    SensorFault::ShortCircuit(Detail::code(0)),
+    SensorFault::Wiring(Detail::max31865_status(fault::REFIN_LOW)),
+    SensorFault::Supply(Detail::max31865_status(fault::VOLTAGE)),
+    SensorFault::OutOfRange(Detail::NONE),
+    SensorFault::Stale,
 ];
 
 /// The `[estimator]` section of six setting bytes (0: the default).
@@ -202,7 +203,7 @@ pub fn run(data: &[u8]) {
             let sample = match s.kind % 8 {
                 0..=4 => Ok(Some(temperature(s.code) as f32)),
                 5 => Ok(None),
-                6 => Err(FAULTS[usize::from(s.code % 6)]),
+                6 => Err(FAULTS[usize::from(s.code) % FAULTS.len()]),
                 _ => Ok(Some(f32::from_bits(u32::from(s.code) << 16))),
             };
             if let Ok(Some(v)) = sample

@@ -53,8 +53,8 @@ use compensator::dynamics::Model;
 use compensator::dynamics::linear::{hurwitz_stable, jacobian_at_equilibrium, linearise};
 use compensator::equilibrium::{Equilibrium, Stop, equilibrium};
 use compensator::estimator::{ConfigError, EstimatorConfig};
-use compensator::uncertainty::UncertaintyError;
 use compensator::params::{CORE_FIELDS, ESTIMATOR_FIELDS, MACHINE_FIELDS, Named, Problem};
+use compensator::uncertainty::UncertaintyError;
 use compensator::{Float, Params, RawParams};
 use compensator_params::file::{parse, to_toml};
 
@@ -148,9 +148,15 @@ pub fn check_set(raw: &RawParams, temps: &[f64]) {
     // The file refuses what the tolerances' own rules refuse (naming the
     // tolerance), and reads back the rest exactly.
     let written = to_toml(raw);
-    match (parse(&written), raw.tolerances.validate(&raw.core, raw.machine.as_ref())) {
+    match (
+        parse(&written),
+        raw.tolerances.validate(&raw.core, raw.machine.as_ref()),
+    ) {
         (Ok(back), Ok(())) => assert!(back == *raw, "{raw:?} written as {written:?} reads back as {back:?}"),
-        (Err(e), Err(t)) => assert!(e.to_string().contains(t.field), "{raw:?}: the file says {e}, the rule {t}"),
+        (Err(e), Err(t)) => assert!(
+            e.to_string().contains(t.field),
+            "{raw:?}: the file says {e}, the rule {t}"
+        ),
         (Ok(_), Err(t)) => panic!("{raw:?} written as {written:?} is taken, its tolerance refused: {t}"),
         (Err(e), Ok(())) => panic!("{raw:?} written as {written:?} is refused: {e}"),
     }

@@ -148,7 +148,7 @@ pub fn run(raw: &RawParams, pieces: &Pieces, faults: bool, seed: u64) -> Result<
             match fault_at(time as f32).map(|i| FAULTS[i].injected) {
                 Some(Injected::Spike) => sim.temperature += 2.0 * raw.estimator.spike_threshold as f32,
                 Some(Injected::BusError) => sim.bus_error = true,
-                Some(Injected::OpenRtd) => sim.fault = fault::RTD_HIGH,
+                Some(Injected::Open) => sim.fault = fault::RTD_HIGH,
                 Some(Injected::SaturatedCode) => sim.forced_code = Some(0x7FFF),
                 None => {}
             }

@@ -157,6 +157,14 @@ impl Case {
         } else {
             field.min - 1e-6 * field.min.abs()
         };
+        if let Kind::Named(names) = field.kind {
+            // A named field's range is its names: the first and the last.
+            match self {
+                Case::AtMin => return names.first().map(|n| format!("\"{n}\"")),
+                Case::AtMax => return names.last().map(|n| format!("\"{n}\"")),
+                _ => {}
+            }
+        }
         Some(match self {
             Case::Missing => return None,
             Case::Negative => "-1.0".into(),
@@ -261,6 +269,7 @@ impl Refusal {
     fn of_load(e: &LoadError) -> Self {
         let rule = match e {
             LoadError::NotANumber { .. } => "type",
+            LoadError::NotAName { .. } => "name",
             LoadError::Param(p) => rule_of(p.problem),
             LoadError::Syntax(_) => "syntax",
             _ => "other",
@@ -280,7 +289,7 @@ fn rule_of(problem: Problem) -> &'static str {
         Problem::Infinite => "inf",
         Problem::Implausible(_) => "range",
         Problem::NotWhole => "whole",
-        Problem::NotOneOf(_) => "choice",
+        Problem::NotOneOf(_) | Problem::NotNamed(_) => "choice",
         Problem::NotRepresentable(_) => "type",
         _ => "rule",
     }
@@ -429,10 +438,11 @@ pub fn field_table() -> String {
     s += "| field | unit | plausible range | default | also | description |\n";
     s += "|---|---|---|---|---|---|\n";
     for f in fields() {
-        let default = match f.default {
-            Some(d) => Compact(d).to_string(),
-            None if f.section == "machine" => "required in `[machine]`".into(),
-            None => "required".into(),
+        let default = match (f.default, f.kind) {
+            (Some(d), Kind::Named(names)) => format!("`\"{}\"`", names.get(d as usize).copied().unwrap_or("?")),
+            (Some(d), _) => Compact(d).to_string(),
+            (None, _) if f.section == "machine" => "required in `[machine]`".into(),
+            (None, _) => "required".into(),
         };
         let also = match f.kind {
             Kind::Real | Kind::OrZero => String::new(),
@@ -441,8 +451,19 @@ pub fn field_table() -> String {
                 let v: Vec<String> = values.iter().map(|x| Compact(*x).to_string()).collect();
                 format!("one of {}", v.join(", "))
             }
+            Kind::Named(names) => {
+                let v: Vec<String> = names.iter().map(|n| format!("`\"{n}\"`")).collect();
+                format!("a name: {}", v.join(", "))
+            }
         };
-        let range = format!("[{}, {}]", Compact(f.min), Compact(f.max));
+        let range = match f.kind {
+            Kind::Named(names) => names
+                .iter()
+                .map(|n| format!("`\"{n}\"`"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            _ => format!("[{}, {}]", Compact(f.min), Compact(f.max)),
+        };
         let range = if f.kind == Kind::OrZero {
             format!("0 or {range}")
         } else {

@@ -136,7 +136,9 @@ fn bad_samples_are_flags_and_never_numbers() {
     let (_, cfg, mut est) = setup(45.0);
     let garbage = [
         Err(SensorFault::Bus),
-        Err(SensorFault::RtdHigh),
+        Err(SensorFault::OpenCircuit(compensator::sensor::Detail::max31865_status(
+            0x80,
+        ))),
         Ok(Some(f32::NAN)),
         Ok(Some(f32::INFINITY)),
         Ok(Some(-1e30)),

@@ -1,8 +1,11 @@
-//! The MAX31865 driver against the datasheet's register map (mock SPI
+//! The sensors. The MAX31865 driver against the datasheet's register map (mock SPI
 //! transactions): configuration, conversion, the fault-detection cycle at
 //! start-up and on its schedule, fault decoding (a status no chip can
 //! answer is a bus fault), bus errors, and the simulated converter the QEMU
-//! twin reads.
+//! twin reads. The NTC on the STM32F4's ADC against independent f64
+//! references of the beta and Steinhart-Hart equations and of the divider,
+//! a round trip through the simulated ADC's registers, the fault codes, the
+//! oversampling, and the parameter file's choice of the sensor.
 
 use compensator::params::RawEstimator;
 use compensator::sensor::max31865::{
@@ -10,9 +13,14 @@ use compensator::sensor::max31865::{
 };
 use compensator::sensor::rtd::Cvd;
 use compensator::sensor::simulated::SimulatedMax31865;
-use compensator::sensor::{SensorFault, TemperatureSource, rtd};
+use compensator::sensor::{Detail, SensorFault, TemperatureSource, rtd};
 use embedded_hal::spi::{ErrorKind, ErrorType, Operation, SpiDevice};
 use embedded_hal_mock::eh1::spi::{Mock, Transaction as T};
+
+/// The MAX31865's fault status byte as a fault's detail.
+fn status(byte: u8) -> Detail {
+    Detail::max31865_status(byte)
+}
 
 /// PT100, 430 ohm, 3 wires, 50 Hz, IEC 60751, fault band -60..250 C, a
 /// detection cycle every 500 readings.
@@ -185,7 +193,7 @@ fn a_still_running_cycle_is_polled_then_restarted() {
     drv.configure().unwrap();
     assert_eq!(drv.read(), Ok(None));
     assert_eq!(drv.read(), Ok(None));
-    assert_eq!(drv.read(), Err(SensorFault::Implausible));
+    assert_eq!(drv.read(), Err(SensorFault::Stale));
     assert_eq!(drv.phase(), Phase::Detecting { polls: 0 });
     spi.done();
 }
@@ -205,12 +213,12 @@ fn a_wiring_fault_found_by_the_cycle_withholds_readings_until_a_cycle_passes() {
     let mut spi = Mock::new(&expectations);
     let mut drv = Max31865::new(spi.clone(), SETTINGS);
     drv.configure().unwrap();
-    assert_eq!(drv.read(), Err(SensorFault::Wiring));
+    assert_eq!(drv.read(), Err(SensorFault::Wiring(status(fault::REFIN_LOW))));
     for _ in 0..4 {
         assert_eq!(drv.read(), Ok(None));
     }
     // A valid-looking code, withheld; the next cycle starts.
-    assert_eq!(drv.read(), Err(SensorFault::Wiring));
+    assert_eq!(drv.read(), Err(SensorFault::Wiring(status(fault::REFIN_LOW))));
     assert_eq!(drv.phase(), Phase::Detecting { polls: 0 });
     // The fault is gone: the cycle passes, readings resume.
     assert_eq!(drv.read(), Ok(None));
@@ -228,19 +236,34 @@ fn a_fault_bit_reads_the_status_clears_it_and_names_the_fault() {
     expectations.extend(write_config(CONTINUOUS_CLEAR));
     let mut spi = Mock::new(&expectations);
     let mut drv = Max31865::new(spi.clone(), SETTINGS);
-    assert_eq!(drv.read(), Err(SensorFault::RtdHigh));
+    assert_eq!(drv.read(), Err(SensorFault::OpenCircuit(status(fault::RTD_HIGH))));
     spi.done();
 }
 
 #[test]
 fn status_bits_map_to_faults_and_impossible_bytes_to_the_bus() {
-    assert_eq!(classify(fault::RTD_HIGH), SensorFault::RtdHigh);
-    assert_eq!(classify(fault::RTD_LOW), SensorFault::RtdLow);
-    assert_eq!(classify(fault::REFIN_HIGH), SensorFault::Wiring);
-    assert_eq!(classify(fault::REFIN_LOW | fault::RTD_HIGH), SensorFault::Wiring);
-    assert_eq!(classify(fault::RTDIN_LOW), SensorFault::Wiring);
-    assert_eq!(classify(fault::VOLTAGE), SensorFault::Voltage);
-    assert_eq!(classify(0), SensorFault::Implausible);
+    assert_eq!(
+        classify(fault::RTD_HIGH),
+        SensorFault::OpenCircuit(status(fault::RTD_HIGH))
+    );
+    assert_eq!(
+        classify(fault::RTD_LOW),
+        SensorFault::ShortCircuit(status(fault::RTD_LOW))
+    );
+    assert_eq!(
+        classify(fault::REFIN_HIGH),
+        SensorFault::Wiring(status(fault::REFIN_HIGH))
+    );
+    assert_eq!(
+        classify(fault::REFIN_LOW | fault::RTD_HIGH),
+        SensorFault::Wiring(status(fault::REFIN_LOW | fault::RTD_HIGH))
+    );
+    assert_eq!(
+        classify(fault::RTDIN_LOW),
+        SensorFault::Wiring(status(fault::RTDIN_LOW))
+    );
+    assert_eq!(classify(fault::VOLTAGE), SensorFault::Supply(status(fault::VOLTAGE)));
+    assert_eq!(classify(0), SensorFault::OutOfRange(status(0)));
     // MISO stuck high: 0xFF sets the unused D1:D0 and RTD high and low at
     // once; no chip answers that.
     for status in [0xFF, 0x01, 0x02, fault::RTD_HIGH | fault::RTD_LOW] {
@@ -358,12 +381,12 @@ fn two_and_four_wire_and_60_hz_configure_their_bits() {
 }
 
 #[test]
-fn saturated_codes_are_implausible_not_temperatures() {
+fn saturated_codes_are_out_of_range_not_temperatures() {
     for code in [0u16, 0x7FFF] {
         let expectations = read_rtd(code, false);
         let mut spi = Mock::new(&expectations);
         let mut drv = Max31865::new(spi.clone(), SETTINGS);
-        assert_eq!(drv.read(), Err(SensorFault::Implausible));
+        assert_eq!(drv.read(), Err(SensorFault::OutOfRange(Detail::code(code))));
         spi.done();
     }
 }
@@ -396,13 +419,13 @@ fn the_simulated_converter_speaks_the_same_register_map() {
     let first = (0..5).map(|_| drv.read()).find(|r| r != &Ok(None));
     assert!((first.unwrap().unwrap().unwrap() - 61.2).abs() < 0.02);
     drv.device_mut().fault = fault::RTD_LOW;
-    assert_eq!(drv.read(), Err(SensorFault::RtdLow));
+    assert_eq!(drv.read(), Err(SensorFault::ShortCircuit(status(fault::RTD_LOW))));
     // The cause persists: clearing the latch does not hide it.
-    assert_eq!(drv.read(), Err(SensorFault::RtdLow));
+    assert_eq!(drv.read(), Err(SensorFault::ShortCircuit(status(fault::RTD_LOW))));
     drv.device_mut().fault = 0;
     assert!(drv.read().unwrap().is_some());
     drv.device_mut().forced_code = Some(0x7FFF);
-    assert_eq!(drv.read(), Err(SensorFault::Implausible));
+    assert_eq!(drv.read(), Err(SensorFault::OutOfRange(Detail::code(0x7FFF))));
     drv.device_mut().forced_code = None;
     drv.device_mut().bus_error = true;
     assert_eq!(drv.read(), Err(SensorFault::Bus));
@@ -421,14 +444,22 @@ fn the_simulated_converter_shows_wiring_faults_only_to_the_detection_cycle() {
     let mut drv = Max31865::new(SimulatedMax31865::new(settings, 30.0), settings);
     drv.device_mut().fault = fault::RTDIN_LOW;
     drv.configure().unwrap();
-    assert_eq!(drv.read(), Err(SensorFault::Wiring), "the start-up cycle");
+    assert_eq!(
+        drv.read(),
+        Err(SensorFault::Wiring(status(fault::RTDIN_LOW))),
+        "the start-up cycle"
+    );
     let readings: Vec<_> = (0..40).map(|_| drv.read()).collect();
     assert!(
         readings
             .iter()
-            .all(|r| matches!(r, Ok(None) | Err(SensorFault::Wiring)))
+            .all(|r| matches!(r, Ok(None) | Err(SensorFault::Wiring(_))))
     );
-    assert!(readings.iter().any(|r| r == &Err(SensorFault::Wiring)));
+    assert!(
+        readings
+            .iter()
+            .any(|r| r == &Err(SensorFault::Wiring(status(fault::RTDIN_LOW))))
+    );
     assert!(drv.device_mut().detection_cycles > 3, "rechecked while faulted");
     // Repaired: the next cycle passes and readings come back.
     drv.device_mut().fault = 0;
@@ -495,4 +526,290 @@ fn no_reading_call_clocks_more_than_nine_bytes() {
         worst = worst.max(drv.device_mut().bytes);
     }
     assert_eq!(worst, 9);
+}
+
+// ---------------------------------------------------------------------------
+// The NTC thermistor on the STM32F4's ADC.
+// ---------------------------------------------------------------------------
+
+use compensator::sensor::ntc::{self, AdcChannel, AdcRegisters, Curve, Ntc, RegisterAdc, SimulatedStm32Adc, reg};
+use compensator::sensor::simulated::{Injection, SimulatedNtc, SimulatedSource};
+
+/// The default NTC channel: 10 kohm NTCLE100E3103 (B25/85 = 3977 K), 10
+/// kohm series resistor, 12 bits, 4 conversions a reading, -40..125 C.
+const NTC: ntc::Settings = ntc::Settings::NTC10K;
+
+/// Steinhart-Hart coefficients of a 10 kohm NTC (1/K; R in ohm).
+const SH: (f64, f64, f64) = (1.1292e-3, 2.3411e-4, 8.7755e-8);
+
+/// Beta equation in f64, written again from the datasheet form: the
+/// temperature [C] of an NTC of `r25` ohm at 25 C and beta `b` K reading
+/// `r` ohm.
+fn beta_reference(r25: f64, b: f64, r: f64) -> f64 {
+    1.0 / (1.0 / 298.15 + (r / r25).ln() / b) - 273.15
+}
+
+/// Its inverse: the resistance [ohm] at `t` [C].
+fn beta_resistance(r25: f64, b: f64, t: f64) -> f64 {
+    r25 * (b * (1.0 / (t + 273.15) - 1.0 / 298.15)).exp()
+}
+
+/// Steinhart-Hart in f64: the temperature [C] at `r` ohm.
+fn sh_reference(r: f64) -> f64 {
+    let l = r.ln();
+    1.0 / (SH.0 + SH.1 * l + SH.2 * l * l * l) - 273.15
+}
+
+/// Steinhart-Hart inverted by bisection on ln R (monotonic): the
+/// resistance [ohm] at `t` [C].
+fn sh_resistance(t: f64) -> f64 {
+    let (mut lo, mut hi) = (0.0f64, 20.0f64);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        // Higher resistance, colder.
+        if sh_reference(mid.exp()) > t {
+            lo = mid
+        } else {
+            hi = mid
+        }
+    }
+    (0.5 * (lo + hi)).exp()
+}
+
+/// The divider's ideal code (not rounded) at `r` ohm with `series` ohm and
+/// `bits`: 2^bits R / (R + R_series).
+fn code_reference(r: f64, series: f64, bits: u32) -> f64 {
+    f64::from(1u32 << bits) * r / (r + series)
+}
+
+#[test]
+fn the_beta_equation_matches_an_independent_f64_reference() {
+    let curve = Curve::NTCLE100E3103;
+    // R25 at 25 C exactly; the datasheet's B25/85 through 85 C.
+    assert!((curve.temperature(10_000.0).unwrap() - 25.0).abs() < 1e-4);
+    let r85 = beta_resistance(10_000.0, 3977.0, 85.0);
+    assert!((r85 - 1070.0).abs() < 1.0, "{r85}");
+    let mut t = -40.0;
+    while t <= 125.0 {
+        let r = beta_resistance(10_000.0, 3977.0, t);
+        let got = f64::from(curve.temperature(r as f32).unwrap());
+        assert!((got - t).abs() < 2e-3, "{t} C: {got}");
+        let back = f64::from(curve.resistance(t as f32));
+        assert!((back / r - 1.0).abs() < 1e-5, "{t} C: {back} ohm against {r}");
+        assert!((beta_reference(10_000.0, 3977.0, r) - t).abs() < 1e-9);
+        t += 2.5;
+    }
+    // No temperature for no resistance.
+    for r in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+        assert_eq!(curve.temperature(r), None, "{r}");
+    }
+}
+
+#[test]
+fn steinhart_hart_matches_an_independent_f64_reference_and_inverts() {
+    let curve = Curve::SteinhartHart {
+        a: SH.0 as f32,
+        b: SH.1 as f32,
+        c: SH.2 as f32,
+    };
+    let mut t = -40.0;
+    while t <= 150.0 {
+        let r = sh_resistance(t);
+        let got = f64::from(curve.temperature(r as f32).unwrap());
+        assert!((got - t).abs() < 2e-3, "{t} C: {got}");
+        // Cardano's root, in f32, against the bisection.
+        let back = f64::from(curve.resistance(t as f32));
+        assert!((back / r - 1.0).abs() < 2e-5, "{t} C: {back} ohm against {r}");
+        t += 2.5;
+    }
+}
+
+#[test]
+fn the_divider_reads_back_every_temperature_within_half_a_code() {
+    // Through the simulated ADC's registers and the real driver, over the
+    // element's range, beta and Steinhart-Hart: the reading is the
+    // temperature within half a code's worth (the reference's slope) plus
+    // the curve's f32 error.
+    let sh = ntc::Settings {
+        curve: Curve::SteinhartHart {
+            a: SH.0 as f32,
+            b: SH.1 as f32,
+            c: SH.2 as f32,
+        },
+        ..NTC
+    };
+    for (settings, resistance) in [
+        (NTC, (|t| beta_resistance(10_000.0, 3977.0, t)) as fn(f64) -> f64),
+        (sh, sh_resistance as fn(f64) -> f64),
+    ] {
+        let mut drv: SimulatedNtc = Ntc::new(
+            RegisterAdc::new(SimulatedStm32Adc::new(settings, 25.0), settings.bits),
+            settings,
+        );
+        let mut t = -35.0f64;
+        while t <= 120.0 {
+            drv.set_temperature(t as f32);
+            let read = f64::from(drv.read().unwrap().unwrap());
+            let h = 0.01;
+            let per_code = 2.0 * h
+                / (code_reference(resistance(t - h), 10_000.0, 12) - code_reference(resistance(t + h), 10_000.0, 12));
+            assert!(
+                (read - t).abs() <= 0.5 * per_code + 2e-3,
+                "{t} C read as {read} ({per_code} C a code)"
+            );
+            t += 0.7;
+        }
+        assert_eq!(
+            drv.device_mut().registers_mut().conversions % 4,
+            0,
+            "4 conversions a reading"
+        );
+    }
+    // Mid-range resolution of the default divider (docs/firmware.md's
+    // error budget): 0.035 C a code at 52 C.
+    let mut raw = RawEstimator::DEFAULT;
+    raw.sensor = 1.0;
+    let res = raw.resolution(52.0);
+    assert!((res - 0.0348).abs() < 5e-4, "{res}");
+}
+
+#[test]
+fn open_short_and_out_of_range_codes_are_faults_with_their_code() {
+    let mut drv = SimulatedNtc::simulated(&RawEstimator::DEFAULT, NTC.band, 40.0);
+    assert!(drv.start().is_ok());
+    assert!((drv.read().unwrap().unwrap() - 40.0).abs() < 0.05);
+    drv.inject(Some(Injection::Open));
+    assert_eq!(drv.read(), Err(SensorFault::OpenCircuit(Detail::code(4095))));
+    drv.inject(Some(Injection::Short));
+    assert_eq!(drv.read(), Err(SensorFault::ShortCircuit(Detail::code(0))));
+    drv.inject(Some(Injection::Saturated));
+    assert_eq!(drv.read(), Err(SensorFault::OpenCircuit(Detail::code(4095))));
+    drv.inject(Some(Injection::Stuck));
+    assert_eq!(drv.read(), Err(SensorFault::Stale));
+    drv.inject(Some(Injection::Bus));
+    assert_eq!(drv.read(), Err(SensorFault::Stale));
+    drv.inject(None);
+    // Hotter than the element's band (-20..150 C from the defaults) but a
+    // code off the short band: out of range, with its code.
+    drv.set_temperature(170.0);
+    let code = NTC.code_of(170.0);
+    assert!(code > 8, "{code}");
+    assert_eq!(drv.read(), Err(SensorFault::OutOfRange(Detail::code(code))));
+    // Just inside the bands: 9 and 4086 are temperatures (if in the band)
+    // or out of range, never open or short.
+    let mut mock = Codes(vec![]);
+    for (code, open_or_short) in [(8u16, true), (9, false), (4086, false), (4087, true)] {
+        mock.0 = vec![code; 4];
+        let mut drv = Ntc::new(&mut mock, NTC);
+        let r = drv.read();
+        assert_eq!(
+            matches!(r, Err(SensorFault::OpenCircuit(_) | SensorFault::ShortCircuit(_))),
+            open_or_short,
+            "{code}: {r:?}"
+        );
+    }
+}
+
+/// An ADC that returns these codes, last first; an error when none is
+/// left.
+struct Codes(Vec<u16>);
+impl AdcChannel for Codes {
+    type Error = ();
+    fn read_code(&mut self) -> Result<u16, ()> {
+        self.0.pop().ok_or(())
+    }
+}
+
+#[test]
+fn oversampling_averages_the_codes_and_an_adc_error_is_a_bus_fault() {
+    let mut adc = Codes(vec![2003, 2002, 2001, 2000]);
+    let mut drv = Ntc::new(&mut adc, NTC);
+    let t = f64::from(drv.read().unwrap().unwrap());
+    let r = 10_000.0 * 2001.5 / (4096.0 - 2001.5);
+    assert!((t - beta_reference(10_000.0, 3977.0, r)).abs() < 2e-3, "{t}");
+    // Three codes left of four: the reading fails as a whole.
+    let mut adc = Codes(vec![2000, 2000, 2000]);
+    let mut drv = Ntc::new(&mut adc, NTC);
+    assert_eq!(drv.read(), Err(SensorFault::Bus));
+}
+
+#[test]
+fn the_register_adc_starts_polls_and_reads_as_the_reference_manual_says() {
+    let mut sim = SimulatedStm32Adc::new(NTC, 25.0);
+    let mut adc = RegisterAdc::new(&mut sim, 10);
+    // 10 bits: half scale at 25 C, R = R_series.
+    assert_eq!(adc.read_code(), Ok(512));
+    let regs = adc.registers_mut();
+    assert_eq!(regs.read(reg::CR1), 1 << 24, "RES = 01: 10 bits");
+    assert_eq!(regs.read(reg::CR2) & reg::CR2_SWSTART, 0, "SWSTART cleared by hardware");
+    assert_eq!(regs.read(reg::SR) & reg::SR_EOC, 0, "reading DR cleared EOC");
+    assert_eq!(regs.read(reg::SR) & reg::SR_OVR, 0, "no overrun");
+    // A conversion whose code is not read, then another: overrun.
+    regs.write(reg::CR2, reg::CR2_ADON | reg::CR2_SWSTART);
+    regs.write(reg::CR2, reg::CR2_ADON | reg::CR2_SWSTART);
+    assert_ne!(regs.read(reg::SR) & reg::SR_OVR, 0);
+    // Off: SWSTART converts nothing.
+    let before = sim.conversions;
+    sim.write(reg::CR2, reg::CR2_SWSTART);
+    assert_eq!(sim.conversions, before);
+}
+
+#[test]
+fn the_parameter_file_chooses_and_checks_the_ntc() {
+    use compensator::sensor::device::{SensorKind, sample_period};
+    use compensator_params::file::parse;
+    let base = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../presets/paper.toml")).unwrap();
+    let rtd = parse(&base).unwrap();
+    assert_eq!(SensorKind::of(&rtd.estimator), SensorKind::Rtd);
+    let with = |extra: &str| parse(&format!("{base}\n[estimator]\n{extra}"));
+    let raw = with("sensor = \"ntc\"\nntc_series = 4700.0\nadc_bits = 10\n").unwrap();
+    assert_eq!(SensorKind::of(&raw.estimator), SensorKind::Ntc);
+    let s = ntc::Settings::from_params(&raw.estimator);
+    assert_eq!((s.series, s.bits, s.oversampling), (4700.0, 10, 4));
+    assert_eq!(s.band, (-20.0, 150.0));
+    assert_eq!(s.curve, Curve::NTCLE100E3103);
+    assert_eq!(s.period, sample_period(&raw.estimator));
+    // Steinhart-Hart when its three coefficients are given.
+    let raw = with("sensor = \"ntc\"\nntc_sh_a = 1.1292e-3\nntc_sh_b = 2.3411e-4\nntc_sh_c = 8.7755e-8\n").unwrap();
+    assert!(matches!(
+        ntc::Settings::from_params(&raw.estimator).curve,
+        Curve::SteinhartHart { .. }
+    ));
+    // Refused by name: one coefficient missing; a divider whose codes reach
+    // the short band at oil_max (a 1 Mohm series resistor); a kind that is
+    // not one.
+    let e = with("sensor = \"ntc\"\nntc_sh_a = 1.1292e-3\nntc_sh_c = 8.7755e-8\n").unwrap_err();
+    assert_eq!(e.field(), Some("estimator.ntc_sh_b"), "{e}");
+    let e = with("sensor = \"ntc\"\nntc_series = 1e6\n").unwrap_err();
+    assert_eq!(e.field(), Some("estimator.ntc_series"), "{e}");
+    assert!(e.to_string().contains("saturates the ADC"), "{e}");
+    // The same divider does not matter to an RTD device.
+    assert!(with("ntc_series = 1e6\n").is_ok());
+    let e = with("sensor = \"pt1000\"\n").unwrap_err();
+    assert_eq!(e.to_string(), "estimator.sensor: expected \"rtd\" or \"ntc\"");
+    let e = with("sensor = 1\n").unwrap_err();
+    assert_eq!(e.field(), Some("estimator.sensor"));
+}
+
+#[test]
+fn a_fault_carries_the_chips_word_and_a_reading_stays_eight_bytes() {
+    use compensator::sensor::Word;
+    assert_eq!(Detail::NONE.word(), Word::None);
+    assert_eq!(Detail::max31865_status(0x84).word(), Word::Max31865Status(0x84));
+    assert_eq!(Detail::max31865_status(0).word(), Word::Max31865Status(0));
+    for code in [0u16, 1, 4095, 0x7FFF] {
+        assert_eq!(Detail::code(code).word(), Word::Code(code));
+    }
+    assert_eq!(
+        SensorFault::OpenCircuit(Detail::code(4095)).detail(),
+        Detail::code(4095)
+    );
+    assert_eq!(SensorFault::Stale.detail(), Detail::NONE);
+    assert_eq!(
+        SensorFault::Wiring(Detail::max31865_status(fault::REFIN_LOW)).to_string(),
+        "a force or reference line of the element is open or shorted (MAX31865 fault status 0x10)"
+    );
+    // The estimator's tick takes the reading by value: as small as it was
+    // with fieldless faults.
+    assert_eq!(core::mem::size_of::<Result<Option<f32>, SensorFault>>(), 8);
 }

@@ -160,7 +160,7 @@ fn a_hold_adds_no_bias_and_no_more_noise_than_the_low_pass() {
         };
         let ((mx, sx), (_, sl)) = (stats(&xs), stats(&ls));
         let truth = reference::equilibrium(&raw.core, t).x;
-        let code = compensator::sensor::max31865::resolution(&raw.estimator, t);
+        let code = raw.estimator.resolution(t);
         let slope = (reference::equilibrium(&raw.core, t + 0.5).x - reference::equilibrium(&raw.core, t - 0.5).x).abs();
         eprintln!(
             "{t} C: bias {:e} m (one code {:e} m), noise {sx:e} m, the low-pass's {sl:e} m",

@@ -400,7 +400,7 @@ mod tests {
     fn the_interpolated_band_is_the_band_computed_there() {
         let raw = device();
         let e = &raw.estimator;
-        let res = |t: f64| crate::sensor::max31865::resolution(e, t);
+        let res = |t: f64| e.resolution(t);
         let a = UncertaintyTable::new(&raw, e.oil_min, e.oil_max, res).unwrap();
         let half = f64::from(a.step) / 2.0;
         let b = UncertaintyTable::new(&raw, e.oil_min + half, e.oil_max + half, res).unwrap();

@@ -29,6 +29,14 @@ pub enum LoadError {
         /// The TOML type found instead (`"string"`, `"array"`, ...).
         found: &'static str,
     },
+    /// A key whose value must be one of a few names (a TOML string, such
+    /// as `sensor = "ntc"`) and is not.
+    NotAName {
+        /// `section.key` of the field.
+        field: &'static str,
+        /// The names it accepts.
+        names: &'static [&'static str],
+    },
     /// A value that breaks a physical rule (names the field).
     Param(ParamError),
     /// A `[[correlation]]` table that cannot be read (says which and why).
@@ -40,7 +48,7 @@ impl LoadError {
     /// about one: a value that is not a number or breaks a rule.
     pub fn field(&self) -> Option<&'static str> {
         match self {
-            LoadError::NotANumber { field, .. } => Some(field),
+            LoadError::NotANumber { field, .. } | LoadError::NotAName { field, .. } => Some(field),
             LoadError::Param(e) => Some(e.field),
             _ => None,
         }
@@ -55,6 +63,18 @@ impl fmt::Display for LoadError {
             LoadError::UnknownKey(k) => write!(f, "{}: unknown key{}", Echo::head(k), did_you_mean(k)),
             LoadError::NotASection(k) => write!(f, "{}: expected a section [{0}], not a value", Echo::head(k)),
             LoadError::NotANumber { field, found } => write!(f, "{field}: expected a number, found a TOML {found}"),
+            LoadError::NotAName { field, names } => {
+                write!(f, "{field}: expected ")?;
+                for (i, n) in names.iter().enumerate() {
+                    match i {
+                        0 => {}
+                        i if i + 1 == names.len() => f.write_str(" or ")?,
+                        _ => f.write_str(", ")?,
+                    }
+                    write!(f, "\"{n}\"")?;
+                }
+                Ok(())
+            }
             LoadError::Param(e) => write!(f, "{e}"),
             LoadError::Correlation(msg) => write!(f, "{}", Echo::head(msg).max(240)),
         }
@@ -318,7 +338,8 @@ fn syntax_error(text: &str, e: &toml::de::Error) -> LoadError {
 ///
 /// [`LoadError::Syntax`] for text that is not TOML, [`LoadError::UnknownKey`]
 /// or [`LoadError::NotASection`] for what the format does not have,
-/// [`LoadError::NotANumber`] for a field whose value is not a number, and
+/// [`LoadError::NotANumber`] for a field whose value is not a number,
+/// [`LoadError::NotAName`] for one whose value is not one of its names, and
 /// [`LoadError::Param`] for the first field that is missing or breaks its
 /// rule ([`RawParams::validate`]).
 pub fn parse(text: &str) -> Result<RawParams, LoadError> {
@@ -345,6 +366,18 @@ pub fn parse(text: &str) -> Result<RawParams, LoadError> {
             let Some(field) = field(section, key) else {
                 return Err(LoadError::UnknownKey(format!("{section}.{key}")));
             };
+            if let crate::Kind::Named(names) = field.kind {
+                // A name: its place in the list.
+                let place = v.as_str().and_then(|name| names.iter().position(|n| *n == name));
+                let Some(i) = place else {
+                    return Err(LoadError::NotAName {
+                        field: field.path,
+                        names,
+                    });
+                };
+                numbers.push((field, i as f64));
+                continue;
+            }
             let x = match v {
                 toml::Value::Float(x) => *x,
                 toml::Value::Integer(i) => *i as f64,
@@ -394,7 +427,13 @@ pub fn to_toml(raw: &RawParams) -> String {
             out.push_str(&format!("[{}]\n", field.section));
             section = field.section;
         }
-        out.push_str(&format!("{} = {}    # {}\n", field.key, fmt_float(v), field.unit));
+        match field.kind {
+            crate::Kind::Named(names) => {
+                let name = names.get(v as usize).copied().unwrap_or("?");
+                out.push_str(&format!("{} = \"{name}\"\n", field.key));
+            }
+            _ => out.push_str(&format!("{} = {}    # {}\n", field.key, fmt_float(v), field.unit)),
+        }
     };
     // Each field's description paired with its value by name, in file order.
     for (f, n) in RawCore::FIELD.zip(raw.core.named()).into_array() {

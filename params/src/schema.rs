@@ -51,6 +51,9 @@ pub enum Kind {
     Whole,
     /// One of these values.
     OneOf(&'static [f64]),
+    /// One of these names, written as a TOML string in the file; the value
+    /// is the name's place in the list (0, 1, ...).
+    Named(&'static [&'static str]),
     /// Zero (none: no damping, no preload, no telemetry), or a value in the
     /// range: a subnormal damping is no damping, and would not survive `f32`.
     OrZero,
@@ -136,6 +139,8 @@ impl Rule {
             Kind::Whole => Err(err(n, Problem::NotWhole)),
             Kind::OneOf(values) if values.contains(&v) => Ok(v),
             Kind::OneOf(values) => Err(err(n, Problem::NotOneOf(values))),
+            Kind::Named(names) if v as usize as f64 == v && (v as usize) < names.len() => Ok(v),
+            Kind::Named(names) => Err(err(n, Problem::NotNamed(names))),
         }
     }
 }
@@ -435,7 +440,32 @@ schema! {
     rtd_a: "estimator"."rtd_a" ["1/C", 1.0e-3 ..= 1.0e-2] = Some(3.9083e-3), "Callendar-Van Dusen A of the RTD (IEC 60751 by default; a calibrated probe's own).";
     rtd_b: "estimator"."rtd_b" ["1/C^2", -1.0e-5 ..= 1.0e-5] = Some(-5.775e-7), "Callendar-Van Dusen B (IEC 60751 by default).";
     rtd_c: "estimator"."rtd_c" ["1/C^4", -1.0e-9 ..= 1.0e-9] = Some(-4.183e-12), "Callendar-Van Dusen C, below 0 C only (IEC 60751 by default).";
+    // The sensor kind; the rtd_* fields above serve "rtd", the ntc_* and
+    // adc_* fields below "ntc" (docs/firmware.md, "NTC thermistor").
+    sensor: "estimator"."sensor" ["-", 0.0 ..= 1.0, Kind::Named(&SENSOR_KINDS)] = Some(0.0), "Temperature sensor: \"rtd\" (a platinum RTD through a MAX31865 over SPI) or \"ntc\" (an NTC thermistor in a divider read by the STM32F405's ADC).";
+    // 100 ohm to 1 Mohm NTCs at 25 C (Vishay NTCLE100E3, TDK B57861S).
+    ntc_r25: "estimator"."ntc_r25" ["ohm", 10.0 ..= 1.0e7] = Some(10_000.0), "NTC resistance at 25 C, R25 (datasheet; default Vishay NTCLE100E3103: 10 kohm).";
+    ntc_beta: "estimator"."ntc_beta" ["K", 1000.0 ..= 10_000.0] = Some(3977.0), "NTC beta B25/85 of 1/T = 1/T25 + ln(R/R25)/B (datasheet; default NTCLE100E3103: 3977 K). Unused when ntc_sh_a, ntc_sh_b, ntc_sh_c are given.";
+    // A 10 kohm NTC: a ~ 1.1e-3, b ~ 2.4e-4, c ~ 8.6e-8 (R in ohm).
+    ntc_sh_a: "estimator"."ntc_sh_a" ["1/K", 1.0e-5 ..= 1.0e-2, Kind::OrZero] = Some(0.0), "Steinhart-Hart a of 1/T = a + b ln R + c (ln R)^3, R in ohm, T in K (a calibration's or the datasheet's; 0 for all three: the beta equation).";
+    ntc_sh_b: "estimator"."ntc_sh_b" ["1/K", 1.0e-6 ..= 1.0e-2, Kind::OrZero] = Some(0.0), "Steinhart-Hart b (given with ntc_sh_a and ntc_sh_c, or all three 0).";
+    ntc_sh_c: "estimator"."ntc_sh_c" ["1/K", 1.0e-10 ..= 1.0e-4, Kind::OrZero] = Some(0.0), "Steinhart-Hart c (given with ntc_sh_a and ntc_sh_b, or all three 0).";
+    ntc_series: "estimator"."ntc_series" ["ohm", 10.0 ..= 1.0e7] = Some(10_000.0), "Series resistor of the NTC's divider, from V_REF+ to the ADC input (the NTC from the input to ground; the ADC's reference is the divider's supply, so V_REF+ cancels).";
+    // The STM32F4's ADC resolutions (ADC_CR1 RES).
+    adc_bits: "estimator"."adc_bits" ["-", 6.0 ..= 12.0, Kind::OneOf(&[6.0, 8.0, 10.0, 12.0])] = Some(12.0), "ADC resolution in bits: 12, 10, 8 or 6 (STM32F4 ADC_CR1 RES).";
+    ntc_oversampling: "estimator"."ntc_oversampling" ["-", 1.0 ..= 64.0, Kind::Whole] = Some(4.0), "ADC conversions averaged into one NTC reading (a whole number).";
 }
+
+/// The names of `estimator.sensor`, in the order of its values.
+pub const SENSOR_KINDS: [&str; 2] = ["rtd", "ntc"];
+
+/// ADC codes at either end of the NTC divider's range that are taken for
+/// an open (near full scale) or shorted (near 0) NTC: the divider must keep
+/// the oil range inside them (`estimator.ntc_series`).
+pub const NTC_FAULT_CODES: f64 = 8.0;
+
+/// Absolute temperature of 0 C \[K\].
+pub const KELVIN: f64 = 273.15;
 
 schema! {
     /// The temperature probe in its well (optional section `[probe]`; every
@@ -803,6 +833,8 @@ pub enum Problem {
     },
     /// Not one of the accepted values.
     NotOneOf(&'static [f64]),
+    /// Not the place of one of the accepted names.
+    NotNamed(&'static [&'static str]),
     /// Representable in `f64` but not in the scalar type asked for.
     NotRepresentable(&'static str),
     /// A fraction where a count is needed.
@@ -864,6 +896,18 @@ impl fmt::Display for ParamError {
                         _ => f.write_str(", ")?,
                     }
                     write!(f, "{}", Compact(*x))?;
+                }
+                Ok(())
+            }
+            Problem::NotNamed(names) => {
+                write!(f, "{field} = {v}: must be ")?;
+                for (i, x) in names.iter().enumerate() {
+                    match i {
+                        0 => {}
+                        i if i + 1 == names.len() => f.write_str(" or ")?,
+                        _ => f.write_str(", ")?,
+                    }
+                    write!(f, "\"{x}\"")?;
                 }
                 Ok(())
             }
@@ -1002,7 +1046,12 @@ impl RawEstimator {
     /// * `estimator.rtd_b`, [`Problem::Inconsistent`]: the RTD's resistance
     ///   does not rise over the oil range;
     /// * `estimator.rtd_reference`, [`Problem::NotAbove`]: not above the
-    ///   RTD's resistance at `oil_max` (the converter would saturate).
+    ///   RTD's resistance at `oil_max` (the converter would saturate);
+    /// * with `estimator.sensor = "ntc"`: `estimator.ntc_sh_a`, `ntc_sh_b`
+    ///   or `ntc_sh_c`, [`Problem::Inconsistent`], zero while another is
+    ///   given; `estimator.ntc_series`, [`Problem::Inconsistent`]: the
+    ///   divider's codes over `oil_min..oil_max` reach the open or short
+    ///   band ([`NTC_FAULT_CODES`] at either end of the ADC's range).
     pub fn validate(&self) -> Result<(), ParamError> {
         self.check_fields()?;
         self.check_rules()
@@ -1069,6 +1118,92 @@ impl RawEstimator {
                     bound,
                     why: "the resistance of the RTD (estimator.rtd_r0, estimator.rtd_a, estimator.rtd_b) at estimator.oil_max: the converter would saturate",
                 },
+            ));
+        }
+        if self.is_ntc() {
+            self.check_ntc()?;
+        }
+        Ok(())
+    }
+
+    /// Whether `estimator.sensor` is `"ntc"` (else `"rtd"`).
+    pub fn is_ntc(&self) -> bool {
+        self.sensor == 1.0
+    }
+
+    /// Whether the NTC is described by Steinhart-Hart (`ntc_sh_a`, `ntc_sh_b`,
+    /// `ntc_sh_c` given) rather than by its beta.
+    pub fn ntc_steinhart_hart(&self) -> bool {
+        self.ntc_sh_a != 0.0 || self.ntc_sh_b != 0.0 || self.ntc_sh_c != 0.0
+    }
+
+    /// Resistance \[ohm\] of the NTC at `t` \[C\]: the beta equation
+    /// `R = R25 exp(B (1/T - 1/T25))`, or Steinhart-Hart's
+    /// `1/T = a + b ln R + c (ln R)^3` solved for `ln R` (Cardano: with
+    /// `x = (a - 1/T) / c`, `y = sqrt((b / 3c)^3 + x^2 / 4)`,
+    /// `ln R = cbrt(y - x/2) - cbrt(y + x/2)`); T in K.
+    pub fn ntc_resistance(&self, t: f64) -> f64 {
+        let inv_t = 1.0 / (t + KELVIN);
+        if self.ntc_steinhart_hart() {
+            let (a, b, c) = (self.ntc_sh_a, self.ntc_sh_b, self.ntc_sh_c);
+            let x = (a - inv_t) / c;
+            let b3c = b / (3.0 * c);
+            let y = libm::sqrt(b3c * b3c * b3c + x * x / 4.0);
+            libm::exp(libm::cbrt(y - x / 2.0) - libm::cbrt(y + x / 2.0))
+        } else {
+            self.ntc_r25 * libm::exp(self.ntc_beta * (inv_t - 1.0 / (25.0 + KELVIN)))
+        }
+    }
+
+    /// The NTC divider's ideal ADC code at `t` \[C\] (not rounded):
+    /// `2^bits R / (R + R_series)`, the NTC from the input to ground, the
+    /// series resistor to `V_REF+`.
+    pub fn ntc_code(&self, t: f64) -> f64 {
+        let r = self.ntc_resistance(t);
+        libm::exp2(self.adc_bits) * r / (r + self.ntc_series)
+    }
+
+    /// The sensor's resolution at `t` \[C per code\]: for the RTD one
+    /// MAX31865 code, `R_ref / 2^15` ohm, over the RTD's slope `dR/dt` there
+    /// (0.033 C at 40 C for a PT100 with 430 ohm); for the NTC one ADC code
+    /// over the divider's `|d code / dt|` (central difference over 0.01 C;
+    /// 0.035 C at 52 C for the default 10 kohm NTC and resistor, 12 bits).
+    pub fn resolution(&self, t: f64) -> f64 {
+        if self.is_ntc() {
+            let h = 0.005;
+            2.0 * h / (self.ntc_code(t - h) - self.ntc_code(t + h)).abs()
+        } else {
+            self.rtd_reference / 32768.0 / self.rtd_slope(t)
+        }
+    }
+
+    /// The NTC rules ([`RawEstimator::validate`]).
+    fn check_ntc(&self) -> Result<(), ParamError> {
+        let n = self.named();
+        // Steinhart-Hart: all three coefficients, or none (the beta).
+        if self.ntc_steinhart_hart() {
+            for c in [n.ntc_sh_a, n.ntc_sh_b, n.ntc_sh_c] {
+                if c.value == 0.0 {
+                    return Err(err(
+                        c,
+                        Problem::Inconsistent(
+                            "estimator.ntc_sh_a, estimator.ntc_sh_b and estimator.ntc_sh_c are given together (or all 0: the beta equation)",
+                        ),
+                    ));
+                }
+            }
+        }
+        // The divider must keep the oil range's codes away from both ends,
+        // where a code reads as an open (full scale) or a shorted (0) NTC.
+        let full = libm::exp2(self.adc_bits);
+        let (cold, hot) = (self.ntc_code(self.oil_min), self.ntc_code(self.oil_max));
+        let inside = |c: f64| c.is_finite() && c > NTC_FAULT_CODES && c < full - NTC_FAULT_CODES;
+        if !(inside(cold) && inside(hot) && cold > hot) {
+            return Err(err(
+                n.ntc_series,
+                Problem::Inconsistent(
+                    "the NTC divider (estimator.ntc_r25, ntc_beta or ntc_sh_*, ntc_series, adc_bits) saturates the ADC within estimator.oil_min..oil_max: the codes there must lie inside the open and short bands (8 codes at either end)",
+                ),
             ));
         }
         Ok(())

@@ -1,6 +1,7 @@
 //! Firmware for a real STM32F405 board: an RTD in the oil read by a
-//! MAX31865 over SPI1, the estimator every tick, telemetry over RTT.
-//! `docs/firmware.md` walks from a blank board to live telemetry.
+//! MAX31865 over SPI1 (or, with `estimator.sensor = "ntc"`, an NTC
+//! thermistor in a divider on ADC1), the estimator every tick, telemetry
+//! over RTT. `docs/firmware.md` walks from a blank board to live telemetry.
 //!
 //! Wiring (MAX31865 breakout; PT100 with a 430 ohm reference by default,
 //! wire count, mains filter and the probe's Callendar-Van Dusen
@@ -13,6 +14,16 @@
 //! | SDI  | PA7 (SPI1_MOSI) |
 //! | CS   | PA4 (GPIO, active low) |
 //! | VIN, GND | 3V3, GND |
+//!
+//! NTC (`estimator.sensor = "ntc"`: `build.rs` sets `cfg(sensor_ntc)`):
+//! the series resistor `estimator.ntc_series` from VDDA (V_REF+) to PA1
+//! (ADC1_IN1), the NTC from PA1 to GND, 100 nF from PA1 to GND beside the
+//! pin. The HAL (`stm32f4xx_hal::adc::Adc`) enables, resets and calibrates
+//! ADC1 (ADCCLK 21 MHz) and sets the channel's sampling time (84 cycles);
+//! conversions are then
+//! started and read through the register driver the simulator shares
+//! (`compensator::sensor::ntc::RegisterAdc`: SWSTART, a bounded EOC poll,
+//! DR), since the HAL's `convert` waits for EOC without a bound.
 //!
 //! Deadlines: a tick that starts after the next one was due is counted,
 //! flagged `DEADLINE_MISSED` and caught up (`Estimator::tick_after`). The
@@ -44,7 +55,11 @@
 use compensator::Params;
 use compensator::estimator::{Estimator, EstimatorConfig, Flags, MAX_CATCH_UP};
 use compensator::sensor::TemperatureSource;
+use compensator::sensor::device::sample_period;
+#[cfg(not(sensor_ntc))]
 use compensator::sensor::max31865::{Max31865, Settings};
+#[cfg(sensor_ntc)]
+use compensator::sensor::ntc::{self, AdcRegisters, Ntc, RegisterAdc, reg};
 use compensator_firmware::clock::TickClock;
 use compensator_firmware::deadline::TickPace;
 use core::sync::atomic::{AtomicU32, Ordering};
@@ -52,13 +67,17 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{ExceptionFrame, entry, exception};
 use defmt::{error, info, warn};
 use defmt_rtt as _;
+#[cfg(not(sensor_ntc))]
 use embedded_hal::spi::MODE_1;
+#[cfg(not(sensor_ntc))]
 use embedded_hal_bus::spi::ExclusiveDevice;
 use panic_probe as _;
+#[cfg(not(sensor_ntc))]
 use stm32f4xx_hal::gpio::{PinState, Speed};
 use stm32f4xx_hal::pac;
 use stm32f4xx_hal::prelude::*;
 use stm32f4xx_hal::rcc::Config;
+#[cfg(not(sensor_ntc))]
 use stm32f4xx_hal::spi::Spi;
 use stm32f4xx_hal::watchdog::IndependentWatchdog;
 
@@ -169,27 +188,53 @@ fn main() -> ! {
     let sysclk = rcc.clocks.sysclk().raw();
 
     let gpioa = dp.GPIOA.split(&mut rcc);
-    let sck = gpioa.pa5.into_alternate().speed(Speed::VeryHigh);
-    let miso = gpioa.pa6.into_alternate();
-    let mosi = gpioa.pa7.into_alternate().speed(Speed::VeryHigh);
-    let spi = Spi::new(dp.SPI1, (Some(sck), Some(miso), Some(mosi)), MODE_1, 1.MHz(), &mut rcc);
-    let cs = gpioa.pa4.into_push_pull_output_in_state(PinState::High);
-    let delay = dp.TIM5.delay_us(&mut rcc);
-    // The chip-select pin cannot fail (its error type is `Infallible`).
-    let Ok(device) = ExclusiveDevice::new(spi, cs, delay);
-    // Wire count, mains filter and the probe's curve from the parameter
-    // file; the converter flags readings outside the oil's range.
-    let settings = Settings::from_params(&RAW_PARAMS.estimator);
-    let mut sensor = Max31865::new(device, settings);
-    if sensor.configure().is_err() {
-        error!("MAX31865 not configured (SPI error); it is retried at every reading, samples are flagged");
-    }
+    #[cfg(not(sensor_ntc))]
+    let mut sensor = {
+        let sck = gpioa.pa5.into_alternate().speed(Speed::VeryHigh);
+        let miso = gpioa.pa6.into_alternate();
+        let mosi = gpioa.pa7.into_alternate().speed(Speed::VeryHigh);
+        let spi = Spi::new(dp.SPI1, (Some(sck), Some(miso), Some(mosi)), MODE_1, 1.MHz(), &mut rcc);
+        let cs = gpioa.pa4.into_push_pull_output_in_state(PinState::High);
+        let delay = dp.TIM5.delay_us(&mut rcc);
+        // The chip-select pin cannot fail (its error type is `Infallible`).
+        let Ok(device) = ExclusiveDevice::new(spi, cs, delay);
+        // Wire count, mains filter and the probe's curve from the parameter
+        // file; the converter flags readings outside the oil's range.
+        let settings = Settings::from_params(&RAW_PARAMS.estimator);
+        let mut sensor = Max31865::new(device, settings);
+        if sensor.configure().is_err() {
+            error!("MAX31865 not configured (SPI error); it is retried at every reading, samples are flagged");
+        }
+        sensor
+    };
+    #[cfg(sensor_ntc)]
+    let mut sensor = {
+        use stm32f4xx_hal::adc::Adc;
+        use stm32f4xx_hal::adc::config::{AdcConfig, Clock, SampleTime, Sequence};
+        // The divider, the NTC's curve, the ADC's bits and oversampling
+        // from the parameter file; readings outside the oil's range are
+        // out of range.
+        let settings = ntc::Settings::from_params(&RAW_PARAMS.estimator);
+        let pa1 = gpioa.pa1.into_analog();
+        // Clock, reset, calibration (VREFINT) and the channel's sampling
+        // time by the HAL; the resolution and the conversions by the
+        // register driver.
+        // ADCCLK = PCLK2 / 4 = 21 MHz (at most 36 MHz, DS8626); 84 cycles
+        // of sampling: the 100 nF at the pin charges the sampling capacitor.
+        let config = AdcConfig::default().clock(Clock::Pclk2_div_4);
+        let mut adc = Adc::new(dp.ADC1, true, config, &mut rcc);
+        adc.configure_channel(&pa1, Sequence::One, SampleTime::Cycles_84);
+        // ADC1 stays configured; its registers are driven from here on.
+        core::mem::forget(adc);
+        Ntc::new(RegisterAdc::new(Adc1, settings.bits), settings)
+    };
 
     // The start-up fault-detection cycle, then the first good sample starts
     // the estimator at its equilibrium (a reading every conversion period,
     // one second at most).
     let mut initial = None;
-    let period_cycles = (sysclk as f32 * settings.mains.conversion_period()) as u32;
+    let period = sample_period(&RAW_PARAMS.estimator);
+    let period_cycles = (sysclk as f32 * period) as u32;
     for _ in 0..60 {
         cortex_m::asm::delay(period_cycles);
         match sensor.read() {
@@ -219,6 +264,17 @@ fn main() -> ! {
         defmt::panic!("estimator.tick_hz: below what SysTick can time at {=u32} Hz", sysclk);
     }
     CYCLES_PER_TICK.store(reload + 1, Ordering::Relaxed);
+    #[cfg(sensor_ntc)]
+    info!(
+        "compensator estimator: parameters {=str}, start {=f32} C, tick {=u32} us, sensor NTC on PA1, {=u8} bits, {=u8} conversions every {=f32} ms",
+        PARAMS_SOURCE,
+        start,
+        clock().map_or(0, |c| c.micros(1) as u32),
+        sensor.settings().bits,
+        sensor.settings().oversampling,
+        period * 1e3
+    );
+    #[cfg(not(sensor_ntc))]
     info!(
         "compensator estimator: parameters {=str}, start {=f32} C, tick {=u32} us, sensor {}-wire {=u32} Hz",
         PARAMS_SOURCE,
@@ -247,7 +303,7 @@ fn main() -> ! {
         MAX_CATCH_UP
     );
 
-    let sensor_every = config.ticks_per(settings.mains.conversion_period());
+    let sensor_every = config.ticks_per(period);
     let mut pace = TickPace::new(TICKS.load(Ordering::Relaxed));
     let mut first_record = true;
     loop {
@@ -279,14 +335,14 @@ fn main() -> ! {
 
 /// One tick: the sensor read when due (`read`), the estimator, the
 /// telemetry record when due. Not inlined, so that `cargo xtask test` can
-/// check that nothing reachable from it panics (the HAL's SPI and the
-/// RTT logger included).
+/// check that nothing reachable from it panics (the HAL's SPI or the ADC's
+/// registers, and the RTT logger included).
 /// `elapsed`: the tick periods since the last tick (more than one: this
 /// tick is late); `extra`: flags the firmware adds to the record published
 /// (the watchdog's reset on the first). Returns whether a record went out.
 #[inline(never)]
-fn tick_path<S: embedded_hal::spi::SpiDevice>(
-    sensor: &mut Max31865<S>,
+fn tick_path<S: TemperatureSource>(
+    sensor: &mut S,
     estimator: &mut compensator_firmware::BuiltEstimator,
     now: u32,
     elapsed: u32,
@@ -303,4 +359,41 @@ fn tick_path<S: embedded_hal::spi::SpiDevice>(
         return true;
     }
     false
+}
+
+/// ADC1's registers (RM0090 section 13.13), as the NTC's register driver
+/// drives them after the HAL set the ADC up.
+#[cfg(sensor_ntc)]
+struct Adc1;
+
+#[cfg(sensor_ntc)]
+impl AdcRegisters for Adc1 {
+    fn read(&mut self, offset: u32) -> u32 {
+        // SAFETY: ADC1's register block, always mapped; the HAL's driver
+        // was forgotten after the set-up, this is its only user.
+        let adc = unsafe { &*pac::ADC1::ptr() };
+        match offset {
+            reg::SR => adc.sr().read().bits(),
+            reg::CR1 => adc.cr1().read().bits(),
+            reg::CR2 => adc.cr2().read().bits(),
+            reg::DR => adc.dr().read().bits(),
+            _ => 0,
+        }
+    }
+
+    fn write(&mut self, offset: u32, value: u32) {
+        // SAFETY: as in `read`; every value the driver writes is a valid
+        // setting of these registers (RES, ADON, SWSTART; SR's rc_w0 bits).
+        let adc = unsafe { &*pac::ADC1::ptr() };
+        #[allow(
+            unused_unsafe,
+            reason = "bits() is unsafe on some registers of the PAC, safe on others"
+        )]
+        match offset {
+            reg::SR => adc.sr().write(|w| unsafe { w.bits(value) }),
+            reg::CR1 => adc.cr1().write(|w| unsafe { w.bits(value) }),
+            reg::CR2 => adc.cr2().write(|w| unsafe { w.bits(value) }),
+            _ => return,
+        };
+    }
 }

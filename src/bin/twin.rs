@@ -6,10 +6,12 @@
 //! 2. Replays an oil temperature profile (holds, a 0.5 C/s warm-up, moves
 //!    between levels at the file's `max_oil_rate`, a trip outside the
 //!    validated range, a cold excursion 80 -> 10 -> 30 C) through the
-//!    file's probe (its lag and noise, `compensator_testbench::probe`) and a
-//!    simulated MAX31865 read by the real driver, with injected sensor
-//!    faults, and runs the estimator every 1 ms tick, printing its
-//!    telemetry.
+//!    file's probe (its lag and noise, `compensator_testbench::probe`) and
+//!    the file's sensor, simulated at register level and read by its real
+//!    driver (a MAX31865 by default; with `estimator.sensor = "ntc"` the
+//!    NTC on the STM32F4's ADC: `build.rs` sets `cfg(sensor_ntc)`), with
+//!    injected sensor faults, and runs the estimator every 1 ms tick,
+//!    printing its telemetry.
 //! 3. Checks itself against the f64 reference computed on the host at build
 //!    time: at the end of every hold and along every ramp, the estimate's
 //!    oil temperature, displacement and chamber pressures within their
@@ -27,8 +29,7 @@ use compensator::dynamics::linear::linearise;
 use compensator::equilibrium::{balance_temperature, equilibrium};
 use compensator::estimator::{Estimator, Flags, StateEstimate};
 use compensator::sensor::TemperatureSource;
-use compensator::sensor::max31865::{Max31865, Settings, fault};
-use compensator::sensor::simulated::SimulatedMax31865;
+use compensator::sensor::simulated::SimulatedSource;
 use compensator::{Params, asymptotic};
 use compensator_firmware::qemu::{CORE, TwinScalar, exit};
 use compensator_firmware::{BuiltConfig, BuiltEstimator};
@@ -40,6 +41,18 @@ use defmt::{error, info};
 
 include!(concat!(env!("OUT_DIR"), "/params.rs"));
 include!(concat!(env!("OUT_DIR"), "/replay.rs"));
+
+/// The parameter file's sensor behind its real driver, simulated at
+/// register level: the MAX31865 ...
+#[cfg(not(sensor_ntc))]
+type Sensor = compensator::sensor::simulated::SimulatedRtd;
+/// ... or the NTC on the STM32F4's ADC (`estimator.sensor = "ntc"`).
+#[cfg(sensor_ntc)]
+type Sensor = compensator::sensor::simulated::SimulatedNtc;
+
+/// The simulated element's fault band \[C\]: wide, so that the
+/// estimator's oil range is what rejects samples.
+const SENSOR_BAND: (f32, f32) = (-60.0, 250.0);
 
 // A fault reports its registers and exits 1 (not a spin until the deadline).
 compensator_firmware::qemu_hard_fault_handler!();
@@ -186,13 +199,6 @@ fn static_characteristic(params: &Params<f32>) {
 /// check passed.
 #[inline(never)]
 fn replay(params: &Params<f32>, config: BuiltConfig) -> bool {
-    let raw = &RAW_PARAMS.estimator;
-    // The device's sensor settings; the converter's own fault band stays
-    // wide, so that the estimator's oil range is what rejects samples.
-    let settings = Settings {
-        fault_band: (-60.0, 250.0),
-        ..Settings::from_params(raw)
-    };
     let start = temperature_at(0.0);
     let probe_settings = &RAW_PARAMS.probe;
     let tick = config.tick();
@@ -204,13 +210,20 @@ fn replay(params: &Params<f32>, config: BuiltConfig) -> bool {
         tick,
         compensator_testbench::probe::REPLAY_SEED,
     );
-    let mut sensor = Max31865::new(SimulatedMax31865::new(settings, start), settings);
+    // The device's sensor settings, with the wide fault band.
+    let mut sensor = Sensor::simulated(&RAW_PARAMS.estimator, SENSOR_BAND, start);
+    #[cfg(sensor_ntc)]
+    info!(
+        "sensor: NTC on the STM32F4 ADC, {=u8} bits, {=u8} conversions a reading",
+        sensor.settings().bits,
+        sensor.settings().oversampling
+    );
     let mut checks = Checks {
         passed: 0,
         failed: heapless::Vec::new(),
         overflow: 0,
     };
-    checks.check(sensor.configure().is_ok(), "sensor configuration", 0.0);
+    checks.check(sensor.start().is_ok(), "sensor configuration", 0.0);
     let mut estimator = match Estimator::<TwinScalar, _, _>::with_scalar(params, config, start) {
         Ok(e) => e,
         Err(e) => {
@@ -220,7 +233,7 @@ fn replay(params: &Params<f32>, config: BuiltConfig) -> bool {
     };
     let end = REPLAY_PIECES[REPLAY_PIECES.len() - 1].1;
     let ticks = (end / tick) as u32;
-    let sensor_every = config.ticks_per(settings.mains.conversion_period());
+    let sensor_every = config.ticks_per(sensor.sample_period());
     let mut seen = [Flags::empty(); FAULTS.len()];
     let mut next_checkpoint = 0;
     let mut out_of_range_seen = false;
@@ -243,22 +256,15 @@ fn replay(params: &Params<f32>, config: BuiltConfig) -> bool {
         let fault_now = fault_at(time);
         let oil = temperature_at(time);
         let reading = probe.advance(oil);
-        {
-            // Drive the simulated converter.
-            let sim = sensor_device(&mut sensor);
-            sim.temperature = reading;
-            sim.bus_error = false;
-            sim.fault = 0;
-            sim.forced_code = None;
-            if let Some(i) = fault_now {
-                match FAULTS[i].injected {
-                    Injected::Spike => sim.temperature += SPIKE_DELTA,
-                    Injected::BusError => sim.bus_error = true,
-                    Injected::OpenRtd => sim.fault = fault::RTD_HIGH,
-                    Injected::SaturatedCode => sim.forced_code = Some(0x7FFF),
-                }
-            }
-        }
+        // Drive the simulated sensor.
+        let injected = fault_now.map(|i| FAULTS[i].injected);
+        let delta = if injected == Some(Injected::Spike) {
+            SPIKE_DELTA
+        } else {
+            0.0
+        };
+        sensor.set_temperature(reading + delta);
+        sensor.inject(injected.and_then(Injected::injection));
         let e = tick_path(&mut sensor, &mut estimator, k % sensor_every == 0);
         if let Some(i) = fault_now {
             seen[i].insert(e.flags);
@@ -345,16 +351,11 @@ fn replay(params: &Params<f32>, config: BuiltConfig) -> bool {
     checks.failures() == 0
 }
 
-/// The simulated converter behind the driver (the driver owns it).
 /// One controller tick as the board runs it: the sensor read when due
 /// (`read`), then the estimator (filter, twin, job). Not inlined, so that
 /// `cargo xtask test` can check that nothing reachable from it panics.
 #[inline(never)]
-fn tick_path(
-    sensor: &mut Max31865<SimulatedMax31865>,
-    estimator: &mut BuiltEstimator<TwinScalar>,
-    read: bool,
-) -> StateEstimate {
+fn tick_path(sensor: &mut Sensor, estimator: &mut BuiltEstimator<TwinScalar>, read: bool) -> StateEstimate {
     let sample = if read { sensor.read() } else { Ok(None) };
     estimator.tick(sample)
 }
@@ -364,10 +365,6 @@ fn tick_path(
 #[inline(never)]
 fn telemetry_path(ms: u32, e: &StateEstimate) {
     info!("{=u32} ms {}", ms, e);
-}
-
-fn sensor_device(sensor: &mut Max31865<SimulatedMax31865>) -> &mut SimulatedMax31865 {
-    sensor.device_mut()
 }
 
 /// Peak stack use [bytes]: cortex-m-rt painted the stack with

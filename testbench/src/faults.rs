@@ -4,18 +4,35 @@
 //! host-side replica of the replay (`xtask/src/replica.rs`): renaming a
 //! fault or its flag fails to compile where the rename is made, in all.
 
-/// What the replay does to the simulated MAX31865.
+/// What the replay does to the simulated sensor (either kind: each maps
+/// to a [`compensator::sensor::simulated::Injection`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Injected {
     /// [`Fault::spike`]'s delta added to one sample.
     Spike,
-    /// The SPI transaction fails.
+    /// The bus fails (MAX31865: every SPI transaction; NTC: no ADC
+    /// conversion ends).
     BusError,
-    /// The converter's RTD-high fault (an open RTD).
-    OpenRtd,
+    /// The element open (MAX31865: its RTD-high fault; NTC: the divider's
+    /// input at full scale).
+    Open,
     /// A full-scale code.
     SaturatedCode,
+}
+
+impl Injected {
+    /// What the simulated sensor is given (`None` for the spike, which is
+    /// a temperature, not a fault of the sensor).
+    pub fn injection(self) -> Option<compensator::sensor::simulated::Injection> {
+        use compensator::sensor::simulated::Injection;
+        match self {
+            Injected::Spike => None,
+            Injected::BusError => Some(Injection::Bus),
+            Injected::Open => Some(Injection::Open),
+            Injected::SaturatedCode => Some(Injection::Saturated),
+        }
+    }
 }
 
 /// The estimator flag an injected fault must raise (the twin maps each to
@@ -61,7 +78,7 @@ pub const FAULTS: [Fault; 5] = [
     Fault {
         start: 30.0,
         end: 30.1,
-        injected: Injected::OpenRtd,
+        injected: Injected::Open,
         expected: Expected::SensorFault,
     },
     Fault {

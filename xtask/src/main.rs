@@ -509,6 +509,87 @@ fn wide_device_file(root: &Path) -> Result<PathBuf, String> {
     Ok(path)
 }
 
+/// The twin's peak stack on QEMU must stay within this \[bytes\] (as the
+/// bench's budget for the RTD device).
+const TWIN_STACK_BUDGET: u64 = 6 << 10;
+
+/// The twin built for the NTC preset (`presets/paper-ntc.toml`: the NTC
+/// on the STM32F4's ADC, simulated at register level), run on QEMU: its
+/// self-checks pass, its peak stack is within [`TWIN_STACK_BUDGET`], and
+/// its telemetry is the host replica's, row by row; nothing reachable from
+/// its tick paths, nor from the NTC board image's, panics.
+fn ntc_twin(tc: &toolchain::Toolchain, root: &Path, timeout: Duration) -> Result<(), String> {
+    let file = root.join("presets/paper-ntc.toml");
+    let built = firmware::build_with(
+        tc,
+        root,
+        &firmware::Image::TWIN,
+        firmware::Options {
+            params: Some(&file),
+            debug: false,
+        },
+    )?;
+    let run = qemu::run(&built.elf, qemu::NETDUINO, true, timeout, qemu::Show::Quiet).map_err(|e| e.to_string())?;
+    if run.code != 0 {
+        for l in &run.lines {
+            eprintln!("{}", telemetry::humanize(l));
+        }
+        return Err(format!(
+            "the twin built for {} exited with {}",
+            file.display(),
+            run.code
+        ));
+    }
+    let stack = run
+        .lines
+        .iter()
+        .find_map(|l| {
+            l.split("[measure] peak stack ")
+                .nth(1)?
+                .split_whitespace()
+                .next()?
+                .parse::<u64>()
+                .ok()
+        })
+        .ok_or("the NTC twin reported no peak stack")?;
+    if stack > TWIN_STACK_BUDGET {
+        return Err(format!(
+            "the NTC twin's peak stack {stack} bytes exceeds {TWIN_STACK_BUDGET}"
+        ));
+    }
+    let csv_path = root.join("target/xtask/twin-ntc-telemetry.csv");
+    let mut csv = telemetry::CsvFile::create(&csv_path)?;
+    for line in &run.lines {
+        csv.line(line)?;
+    }
+    drop(csv);
+    let decoded = telemetry::read_csv(&csv_path)?;
+    let schedule = replica::read_schedule(built.out_dir.as_deref().ok_or("no build script output directory")?)?;
+    let raw = compensator_params::file::load(&file).map_err(|e| e.to_string())?;
+    let host = replica::run(&raw, &schedule)?;
+    eprintln!(
+        "xtask: the NTC twin passed: {}; peak stack {stack} bytes; {}",
+        run.lines
+            .iter()
+            .rev()
+            .find(|l| l.contains("checks:"))
+            .map_or("", String::as_str),
+        replica::compare(&decoded, &host)?
+    );
+    // The NTC's tick paths, on QEMU and on the board (its ADC registers),
+    // link no panic either.
+    eprintln!(
+        "xtask: NTC twin: {}",
+        panic_free::check(&built.elf, &["tick_path", "telemetry_path"], &[])?
+    );
+    let board = firmware::build(tc, root, &firmware::Image::BOARD, Some(&file))?;
+    eprintln!(
+        "xtask: NTC board: {}",
+        panic_free::check(&board, &["tick_path"], &["_defmt_acquire", "_defmt_release"])?
+    );
+    Ok(())
+}
+
 /// Everything CI checks; `bless` rewrites the twin's QEMU snapshot.
 fn cmd_test(bless: bool) -> Outcome {
     let root = root();
@@ -600,6 +681,10 @@ fn cmd_test(bless: bool) -> Outcome {
             .find(|l| l.contains("checks:"))
             .map_or("", String::as_str)
     );
+    step(
+        "an NTC device file (presets/paper-ntc.toml) builds the twin and the board; on QEMU the twin passes its checks within the stack budget and matches the host replica; neither tick links a panic",
+    );
+    ntc_twin(&tc, &root, minutes(5))?;
     step("a parameter file the CLI refuses fails the firmware build in one line naming the field");
     firmware::check_refused_file(&tc, &root)?;
     step("firmware images");

@@ -1,5 +1,6 @@
 //! The QEMU twin's replay run again on the host: the same core (estimator,
-//! MAX31865 driver, simulated converter) compiled for x86-64, fed the same
+//! the file's sensor driver over its simulator: the MAX31865's or the NTC's
+//! on the STM32F4 ADC) compiled for x86-64, fed the same
 //! profile, through the same simulated probe (its lag and noise,
 //! `compensator_testbench::probe`), and faults (the schedule `build.rs` wrote for the firmware,
 //! `replay.txt`, and the faults of `compensator_testbench::faults`), driven the way `src/bin/twin.rs` drives it. `cargo xtask
@@ -15,9 +16,8 @@ use compensator::Params;
 use compensator::estimator::telemetry::{self as wire, FIELDS};
 use compensator::estimator::{Estimator, EstimatorConfig};
 use compensator::params::RawParams;
-use compensator::sensor::TemperatureSource;
-use compensator::sensor::max31865::{Max31865, Settings, fault};
-use compensator::sensor::simulated::SimulatedMax31865;
+use compensator::sensor::device::SensorKind;
+use compensator::sensor::simulated::{SimulatedNtc, SimulatedRtd, SimulatedSource};
 use compensator_testbench::faults::{FAULTS, Injected, fault_at};
 use compensator_testbench::probe::{REPLAY_SEED, SimulatedProbe};
 use compensator_testbench::temperature_at;
@@ -35,18 +35,27 @@ pub fn read_schedule(out_dir: &Path) -> Result<Schedule, String> {
     Schedule::parse(&text)
 }
 
-/// Runs the replay on the host; returns its telemetry records.
+/// The simulated element's fault band in the replay \[C\]: wide, so that
+/// the estimator's oil range is what rejects samples (as `src/bin/twin.rs`).
+pub const REPLAY_BAND: (f32, f32) = (-60.0, 250.0);
+
+/// Runs the replay on the host with the file's sensor; returns its
+/// telemetry records.
 pub fn run(raw: &RawParams, schedule: &Schedule) -> Result<Vec<Record>, String> {
+    match SensorKind::of(&raw.estimator) {
+        SensorKind::Rtd => run_with::<SimulatedRtd>(raw, schedule),
+        SensorKind::Ntc => run_with::<SimulatedNtc>(raw, schedule),
+    }
+}
+
+/// [`run`] with the simulated sensor `S`.
+fn run_with<S: SimulatedSource>(raw: &RawParams, schedule: &Schedule) -> Result<Vec<Record>, String> {
     let params = Params::<f32>::new(raw).map_err(|e| e.to_string())?;
     let config = EstimatorConfig::new(raw).map_err(|e| e.to_string())?;
-    let settings = Settings {
-        fault_band: (-60.0, 250.0),
-        ..Settings::from_params(&raw.estimator)
-    };
     let (pieces, spike) = (&schedule.pieces, schedule.spike);
     let start = temperature_at(pieces, 0.0);
-    let mut sensor = Max31865::new(SimulatedMax31865::new(settings, start), settings);
-    sensor.configure().map_err(|e| format!("sensor: {e:?}"))?;
+    let mut sensor = S::simulated(&raw.estimator, REPLAY_BAND, start);
+    sensor.start().map_err(|e| format!("sensor: {e}"))?;
     let mut estimator = Estimator::new(&params, config, start).map_err(|e| e.to_string())?;
     let tick = config.tick();
     // The probe the twin image reads the oil through (its lag and noise).
@@ -61,22 +70,15 @@ pub fn run(raw: &RawParams, schedule: &Schedule) -> Result<Vec<Record>, String> 
     );
     let end = pieces[pieces.len() - 1].1;
     let ticks = (end / tick) as u32;
-    let sensor_every = config.ticks_per(settings.mains.conversion_period());
+    let sensor_every = config.ticks_per(sensor.sample_period());
     let mut out = Vec::new();
     for k in 0..ticks {
         let time = k as f32 * tick;
-        let sim = sensor.device_mut();
-        sim.temperature = probe.advance(temperature_at(pieces, time));
-        sim.bus_error = false;
-        sim.fault = 0;
-        sim.forced_code = None;
-        match fault_at(time).map(|i| FAULTS[i].injected) {
-            Some(Injected::Spike) => sim.temperature += spike,
-            Some(Injected::BusError) => sim.bus_error = true,
-            Some(Injected::OpenRtd) => sim.fault = fault::RTD_HIGH,
-            Some(Injected::SaturatedCode) => sim.forced_code = Some(0x7FFF),
-            None => {}
-        }
+        let reading = probe.advance(temperature_at(pieces, time));
+        let injected = fault_at(time).map(|i| FAULTS[i].injected);
+        let delta = if injected == Some(Injected::Spike) { spike } else { 0.0 };
+        sensor.set_temperature(reading + delta);
+        sensor.inject(injected.and_then(Injected::injection));
         let sample = if k % sensor_every == 0 { sensor.read() } else { Ok(None) };
         let e = estimator.tick(sample);
         if estimator.telemetry_due() {

@@ -6,7 +6,6 @@ use super::observer::{DesignError, ObserverDesign, ObserverSettings};
 use super::spike::SpikeSettings;
 use crate::dynamics::TwinConfig;
 use crate::params::{ParamError, RawEstimator, RawParams};
-use crate::sensor::max31865::{Mains, resolution};
 use crate::uncertainty::{UncertaintyError, UncertaintyTable};
 use core::borrow::Borrow;
 
@@ -90,8 +89,8 @@ pub struct EstimatorConfig<U = UncertaintyTable, O = ObserverDesign> {
 }
 
 impl EstimatorConfig<UncertaintyTable> {
-    /// The settings for the parameter set `raw`, the probe read through a
-    /// MAX31865 (its conversion period and resolution): the observer
+    /// The settings for the parameter set `raw`, the probe read through the
+    /// file's sensor (its sample period and resolution): the observer
     /// designed and the uncertainty table built here, in `f64` (a few
     /// milliseconds on a host; the firmware gets both from its build
     /// script and calls [`EstimatorConfig::from_parts`]).
@@ -116,7 +115,7 @@ impl EstimatorConfig<UncertaintyTable> {
         let e = &raw.estimator;
         let observer = ObserverDesign::new(&observer_settings(raw, sample_period)).map_err(ConfigError::Observer)?;
         let uncertainty =
-            UncertaintyTable::new(raw, e.oil_min, e.oil_max, |t| resolution(e, t)).map_err(ConfigError::Uncertainty)?;
+            UncertaintyTable::new(raw, e.oil_min, e.oil_max, |t| e.resolution(t)).map_err(ConfigError::Uncertainty)?;
         Ok(Self::from_parts(e, observer, uncertainty)?)
     }
 }
@@ -207,18 +206,18 @@ impl<U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Copy> Estim
     }
 }
 
-/// The period of the MAX31865's readings at the estimator's tick \[s\]: its
+/// The period of the sensor's readings at the estimator's tick \[s\]: its
 /// conversion period for the mains filter, rounded to a whole number of
 /// ticks (at least one; the converter is read on the tick its reading is
 /// due).
 pub fn reading_period(e: &RawEstimator) -> f64 {
-    let period = Mains::from_hz(e.mains_hz).unwrap_or(Mains::Hz50).conversion_period() as f64;
+    let period = crate::sensor::device::sample_period(e) as f64;
     let ticks = libm::round(period * e.tick_hz).max(1.0);
     ticks / e.tick_hz
 }
 
 /// The observer's settings for the parameter set `raw` with readings every
-/// `sample_period` \[s\] through a MAX31865 (its resolution at the middle of
+/// `sample_period` \[s\] through the file's sensor (its resolution at the middle of
 /// the validated range).
 pub fn observer_settings(raw: &RawParams, sample_period: f64) -> ObserverSettings {
     let e = &raw.estimator;
@@ -227,7 +226,7 @@ pub fn observer_settings(raw: &RawParams, sample_period: f64) -> ObserverSetting
         time_constant: raw.probe.time_constant,
         well_time_constant: raw.probe.well_time_constant,
         noise: raw.probe.noise,
-        resolution: resolution(e, mid),
+        resolution: e.resolution(mid),
         max_rate: e.max_oil_rate,
         tick: 1.0 / e.tick_hz,
         sample_period,

@@ -10,9 +10,10 @@
 //! function of the core may divide by its positive fields.
 
 pub use compensator_params::{
-    CORE_FIELDS, Compact, CoreFields, Correlation, ECHO_MAX, ESTIMATOR_FIELDS, Echo, EstimatorFields, Field, Kind,
-    MACHINE_FIELDS, MAX_CORRELATIONS, MachineFields, Named, PROBE_FIELDS, ParamError, ProbeFields, Problem, Range,
-    RawCore, RawEstimator, RawMachine, RawParams, RawProbe, RawTolerances, VISCOSITY_40C_CST,
+    CORE_FIELDS, Compact, CoreFields, Correlation, ECHO_MAX, ESTIMATOR_FIELDS, Echo, EstimatorFields, Field, KELVIN,
+    Kind, MACHINE_FIELDS, MAX_CORRELATIONS, MachineFields, NTC_FAULT_CODES, Named, PROBE_FIELDS, ParamError,
+    ProbeFields, Problem, Range, RawCore, RawEstimator, RawMachine, RawParams, RawProbe, RawTolerances, SENSOR_KINDS,
+    VISCOSITY_40C_CST,
 };
 
 use crate::fluid::Oil;
