@@ -286,7 +286,16 @@ impl Sim {
         let at_t = |e| model_error(&format!("T_oil = {t_oil} degC"), e);
         // The twin at rest at the oil temperature, the input's uncertainty
         // none (the temperature is given, not measured).
-        let mut plant = Plant::new(&params, &EstimatorConfig { twin: config, ..estimator }, t, 0.0).map_err(at_t)?;
+        let mut plant = Plant::new(
+            &params,
+            &EstimatorConfig {
+                twin: config,
+                ..estimator
+            },
+            t,
+            0.0,
+        )
+        .map_err(at_t)?;
         let designed = (params.pressure_drop + params.outlet_pressure, params.outlet_pressure);
         if pressures != designed {
             plant
@@ -380,15 +389,14 @@ impl Sim {
         for _ in 0..n {
             // As the estimator: a failed tick (never seen with valid
             // parameters) restarts the twin at rest in the equilibrium.
-            self.plant.advance(&mut flags).map_err(|e| {
-                model_error(&format!("restarting the twin at {} degC", self.applied.t), e)
-            })?;
+            self.plant
+                .advance(&mut flags)
+                .map_err(|e| model_error(&format!("restarting the twin at {} degC", self.applied.t), e))?;
         }
         self.publish(flags);
         Ok(())
     }
 }
-
 
 /// One FMU instance.
 #[derive(Clone, Debug)]

@@ -50,7 +50,10 @@ fn at_other_ports_the_plant_settles_on_the_reference_there() {
         assert!(!flags.contains(Flags::DEGRADED), "{t} C: {flags:?}");
         let e = plant.estimate(t, plant.flags_at(&cfg, t));
         let (dx, dp) = off_reference(&at_ports, t, &e);
-        assert!(dx <= 1e-5 && dp <= 1e-5, "{t} C: {dx:e} of the stroke, {dp:e} of the drop");
+        assert!(
+            dx <= 1e-5 && dp <= 1e-5,
+            "{t} C: {dx:e} of the stroke, {dp:e} of the drop"
+        );
         let r = reference::equilibrium(&at_ports.core, f64::from(t));
         let dq = (f64::from(e.q_total) - r.q_total).abs() / r.q_total;
         assert!(dq <= 1e-3, "{t} C: total flow {} against {}", e.q_total, r.q_total);
@@ -85,7 +88,11 @@ fn the_estimator_publishes_its_plants_estimate() {
     let mut est = Estimator::new(&p, cfg, 45.0).unwrap();
     let mut last = None;
     for k in 0..3000 {
-        let sample = if k % 20 == 0 { Ok(Some(45.0 + 0.002 * k as f32)) } else { Ok(None) };
+        let sample = if k % 20 == 0 {
+            Ok(Some(45.0 + 0.002 * k as f32))
+        } else {
+            Ok(None)
+        };
         last = Some(est.tick(sample));
     }
     let e = last.unwrap();

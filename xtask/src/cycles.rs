@@ -133,7 +133,11 @@ impl Timing {
 /// Registers in a register list (`{r4, r5, r7, lr}`, `{r4-r7}`,
 /// `{d8-d15}`: a `d` register is two words); 1 without a list.
 fn registers(operands: &str) -> u32 {
-    let Some(list) = operands.split_once('{').and_then(|(_, r)| r.split_once('}')).map(|(l, _)| l) else {
+    let Some(list) = operands
+        .split_once('{')
+        .and_then(|(_, r)| r.split_once('}'))
+        .map(|(l, _)| l)
+    else {
         return 1;
     };
     list.split(',')
@@ -142,7 +146,11 @@ fn registers(operands: &str) -> u32 {
             let words = if r.starts_with('d') { 2 } else { 1 };
             let n = match r.split_once('-') {
                 Some((a, b)) => {
-                    let num = |s: &str| s.trim().trim_start_matches(|c: char| c.is_ascii_alphabetic()).parse::<u32>();
+                    let num = |s: &str| {
+                        s.trim()
+                            .trim_start_matches(|c: char| c.is_ascii_alphabetic())
+                            .parse::<u32>()
+                    };
                     match (num(a), num(b)) {
                         (Ok(a), Ok(b)) if b >= a => b - a + 1,
                         _ => 1,

@@ -622,7 +622,15 @@ mod tests {
             Core::M4F,
         );
         let mut trace = line(0x0800_0100);
-        for pc in [0x0800_0300, 0x0800_0302, 0x0800_0306, 0x0800_0300, 0x0800_0302, 0x0800_0304, 0x0800_0306] {
+        for pc in [
+            0x0800_0300,
+            0x0800_0302,
+            0x0800_0306,
+            0x0800_0300,
+            0x0800_0302,
+            0x0800_0304,
+            0x0800_0306,
+        ] {
             trace += &line(pc);
         }
         // The return's target: back in the (uncounted) caller.
@@ -630,7 +638,16 @@ mod tests {
         trace += &line(0x0800_0100);
         trace += &line(0x0800_0100);
         let s = symbols();
-        let out = attribute(trace.as_bytes(), &s, 0x0800_0100, None, 2, Some(&timing), &mut Vec::new()).unwrap();
+        let out = attribute(
+            trace.as_bytes(),
+            &s,
+            0x0800_0100,
+            None,
+            2,
+            Some(&timing),
+            &mut Vec::new(),
+        )
+        .unwrap();
         // ldr 1-2 twice, beq taken 2-4 and untaken 1, nop 1, bx taken
         // twice (the second time into the mark) 2-4 each.
         assert_eq!(out[0].total, 7);
@@ -729,7 +746,16 @@ mod tests {
             }
             trace += &line(0x0800_0100);
         }
-        let out = attribute(trace.as_bytes(), &s, 0x0800_0100, Some(0x0800_0400), 2, None, &mut Vec::new()).unwrap();
+        let out = attribute(
+            trace.as_bytes(),
+            &s,
+            0x0800_0100,
+            Some(0x0800_0400),
+            2,
+            None,
+            &mut Vec::new(),
+        )
+        .unwrap();
         assert_eq!(out[0].total, 6);
         assert_eq!(out[0].worst, Some((1, HashMap::from([("tick".to_string(), 3)]))));
         assert_eq!(out[1].worst_total(), 4);

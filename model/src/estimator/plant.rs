@@ -104,7 +104,16 @@ impl<T: Real> Plant<T> {
         let mut statics = Statics::new(point, config.tick());
         let table = config.table();
         for job in Job::ALL {
-            jobs::run(job, params, table, &mut twin, design, initial, || variance, &mut statics)?;
+            jobs::run(
+                job,
+                params,
+                table,
+                &mut twin,
+                design,
+                initial,
+                || variance,
+                &mut statics,
+            )?;
         }
         Ok(Plant {
             params: *params,
@@ -217,7 +226,16 @@ impl<T: Real> Plant<T> {
         let outcome = jobs::set_oil(&self.params, &mut self.twin, self.design, &mut statics, t).and_then(|()| {
             for job in [Job::Equilibrium, Job::Stability, Job::Losses, Job::Uncertainty] {
                 if drop_positive || !matches!(job, Job::Equilibrium | Job::Stability) {
-                    jobs::run(job, &self.params, table, &mut self.twin, self.design, t, || variance, &mut statics)?;
+                    jobs::run(
+                        job,
+                        &self.params,
+                        table,
+                        &mut self.twin,
+                        self.design,
+                        t,
+                        || variance,
+                        &mut statics,
+                    )?;
                 }
             }
             Ok(())

@@ -129,7 +129,10 @@ pub fn cmd(root: &Path, params: Option<&Path>, write: bool) -> Result<i32, Strin
     let elfs = crate::firmware::build_all_params(&tc, root, params)?;
     let mut fw = measure_firmware(&elfs, &[])?;
     let mut cpi = [(f64::NAN, f64::NAN); 3];
-    for (c, target) in cpi.iter_mut().zip([crate::firmware::M4, crate::firmware::M3, crate::firmware::M0]) {
+    for (c, target) in cpi
+        .iter_mut()
+        .zip([crate::firmware::M4, crate::firmware::M3, crate::firmware::M0])
+    {
         *c = crate::profile::cycles_per_instruction(&tc, root, params, target)?;
     }
     fw.cpi = Some(cpi);

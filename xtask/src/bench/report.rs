@@ -187,7 +187,10 @@ pub fn cores_section(fw: &Firmware) -> String {
         ("Cortex-M3", &fw.m3, "q12.20"),
         ("Cortex-M0", &fw.m0, "q12.20"),
     ] {
-        let i = ["Cortex-M4F", "Cortex-M3", "Cortex-M0"].iter().position(|c| *c == core).unwrap_or(0);
+        let i = ["Cortex-M4F", "Cortex-M3", "Cortex-M0"]
+            .iter()
+            .position(|c| *c == core)
+            .unwrap_or(0);
         let (low, cpi) = fw.cpi.map_or((f64::NAN, f64::NAN), |c| c[i]);
         let worst = costs.estimator(scalar, true).map_or(f64::NAN, |(_, w)| w);
         let _ = write!(t, "| {core} | {scalar} | {worst:.0} | {low:.2}-{cpi:.2} |");
