@@ -252,27 +252,21 @@ impl<T: Real> Plant<T> {
 
     /// One twin tick: `Ok(true)` when the twin had an event in it (an
     /// impact, a release: a few steps more). A failed step (never seen
-    /// with valid parameters) restarts the twin at rest in the equilibrium
-    /// of its oil at the applied pressures and tick, raises `DEGRADED` in
-    /// `flags` and counts as an event, rather than continuing from garbage.
+    /// with valid parameters) puts the twin at rest in the closed-form
+    /// equilibrium of its oil at the applied pressures ([`Plant::rest`]),
+    /// raises `DEGRADED` in `flags` and counts as an event, rather than
+    /// continuing from garbage (its coefficients are the oil's, not
+    /// garbage: only its state is replaced).
     ///
     /// # Errors
     ///
-    /// The restart itself fails ([`Twin::new`], [`Twin::set_pressures`]).
+    /// The equilibrium cannot be computed ([`Plant::rest`]).
     pub fn advance(&mut self, flags: &mut Flags) -> Result<bool, ModelError> {
         match self.twin.tick() {
             Ok(report) => Ok(report.eventful()),
             Err(_) => {
-                let design = self.twin.model().params();
-                let mut twin = Twin::new(design, self.twin.config(), self.statics.point.state.temperature)?;
-                if (self.params.pressure_drop, self.params.outlet_pressure)
-                    != (design.pressure_drop, design.outlet_pressure)
-                {
-                    let outlet = self.params.outlet_pressure;
-                    twin.set_pressures(self.params.pressure_drop + outlet, outlet)?;
-                }
-                self.twin = twin;
                 flags.insert(Flags::DEGRADED);
+                self.rest()?;
                 Ok(true)
             }
         }
