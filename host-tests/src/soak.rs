@@ -16,14 +16,15 @@
 //! is the long run.
 
 pub use compensator_testbench::soak::{
-    CHECKS, Fault, HOLD_TOLERANCE, Kind, Limits, SETTLE, Segment, Soak, Stats, Walk, XorShift64,
+    CHECKS, Fault, HOLD_TOLERANCE, Kind, Limits, SENSOR_BAND, SETTLE, Segment, Soak, Stats, Walk, XorShift64,
 };
 
 use compensator::dynamics::config::choose;
 use compensator::dynamics::{Twin, TwinConfig};
 use compensator::estimator::EstimatorConfig;
 use compensator::estimator::{ObserverDesign, observer_settings};
-use compensator::sensor::max31865::Settings;
+use compensator::sensor::device::SensorKind;
+use compensator::sensor::simulated::{SimulatedNtc, SimulatedRtd, SimulatedSource};
 use compensator::{Params, RawParams};
 use std::fmt::Write as _;
 use std::time::{Duration, Instant};
@@ -38,6 +39,12 @@ pub const DRIFT_TOLERANCE: f64 = 1e-3;
 /// The preset `presets/paper.toml`.
 pub fn paper() -> RawParams {
     compensator_cli::load(&crate::repo_root().join("presets/paper.toml")).expect("the paper preset loads")
+}
+
+/// The preset `presets/paper-ntc.toml` (the paper preset read through an
+/// NTC on the STM32F4's ADC).
+pub fn paper_ntc() -> RawParams {
+    compensator_cli::load(&crate::repo_root().join("presets/paper-ntc.toml")).expect("the NTC paper preset loads")
 }
 
 /// The first `count` of `crate::survey::designs` (from `seed`) whose plunger
@@ -70,6 +77,8 @@ pub fn twin_config(raw: &RawParams) -> Result<TwinConfig, String> {
 /// A soak run of the estimator.
 #[derive(Clone, Debug)]
 pub struct Run {
+    /// The simulated sensor (the device file's).
+    pub sensor: SensorKind,
     /// What the shared checks counted.
     pub stats: Stats,
     /// The bounds they used.
@@ -201,8 +210,17 @@ impl Run {
 /// readings are the oil's temperature: the observer is designed for a
 /// probe without lag
 /// ([`ObserverSettings::without_lag`](compensator::estimator::ObserverSettings::without_lag)), as in the QEMU
-/// soak image.
+/// soak image. The sensor is the file's (`estimator.sensor`: the MAX31865
+/// or the NTC), simulated at register level behind its real driver.
 pub fn run(raw: &RawParams, ticks: u32, seed: u64) -> Result<Run, String> {
+    match SensorKind::of(&raw.estimator) {
+        SensorKind::Rtd => run_with::<SimulatedRtd>(raw, ticks, seed),
+        SensorKind::Ntc => run_with::<SimulatedNtc>(raw, ticks, seed),
+    }
+}
+
+/// [`run`] with the simulated sensor `S`.
+fn run_with<S: SimulatedSource>(raw: &RawParams, ticks: u32, seed: u64) -> Result<Run, String> {
     let p = Params::<f32>::new(raw).map_err(|e| e.to_string())?;
     let p64 = Params::<f64>::new(raw).map_err(|e| e.to_string())?;
     let mut config = EstimatorConfig::new(raw).map_err(|e| e.to_string())?;
@@ -212,8 +230,7 @@ pub fn run(raw: &RawParams, ticks: u32, seed: u64) -> Result<Run, String> {
         tick: config.twin.tick,
         ..twin_config(raw)?
     };
-    let settings = Settings::from_params(&raw.estimator);
-    let mut soak = Soak::new(&p, &p64, config, &settings, seed)?;
+    let mut soak = Soak::<S, _, _>::new(&p, &p64, config, &raw.estimator, seed)?;
     let mut misses = Vec::new();
     let mut worst = (0.0f64, 0.0f64);
     let started = Instant::now();
@@ -231,12 +248,29 @@ pub fn run(raw: &RawParams, ticks: u32, seed: u64) -> Result<Run, String> {
         }
     }
     Ok(Run {
+        sensor: SensorKind::of(&raw.estimator),
         stats: soak.stats,
         limits: soak.limits,
         reference_misses: misses,
         reference_worst: worst,
         elapsed: started.elapsed(),
     })
+}
+
+/// The soak's [`Limits`] for `raw` with its sensor (`estimator.sensor`).
+pub fn limits(raw: &RawParams, params: &Params<f32>, config: &EstimatorConfig) -> Result<Limits, String> {
+    fn with<S: SimulatedSource>(
+        raw: &RawParams,
+        params: &Params<f32>,
+        config: &EstimatorConfig,
+    ) -> Result<Limits, String> {
+        let source = S::simulated(&raw.estimator, SENSOR_BAND, config.oil.min);
+        Ok(Limits::new(params, config, &source)?)
+    }
+    match SensorKind::of(&raw.estimator) {
+        SensorKind::Rtd => with::<SimulatedRtd>(raw, params, config),
+        SensorKind::Ntc => with::<SimulatedNtc>(raw, params, config),
+    }
 }
 
 /// The gap between the `f32` and the `f64` twin over a run.
@@ -360,8 +394,7 @@ pub fn drift(raw: &RawParams, ticks: u32, seed: u64) -> Result<Drift, String> {
         tick: estimator.twin.tick,
         ..twin_config(raw)?
     };
-    let settings = Settings::from_params(&raw.estimator);
-    let limits = Limits::new(&p32, &estimator, &settings)?;
+    let limits = limits(raw, &p32, &estimator)?;
     let mut walk = Walk::new(limits, seed);
     let mut t = walk.at(0).temperature(0);
     let mut a = Twin::<f32, f32>::new(&p32, config, t).map_err(|e| e.to_string())?;

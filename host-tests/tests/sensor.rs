@@ -720,6 +720,46 @@ impl AdcChannel for Codes {
     }
 }
 
+/// The first sample a simulated source returns (the MAX31865's start-up
+/// diagnosis leaves a few reads without one).
+fn first_sample<S: SimulatedSource>(s: &mut S) -> Result<f32, SensorFault> {
+    for _ in 0..50 {
+        if let Some(t) = s.read()? {
+            return Ok(t);
+        }
+    }
+    panic!("no sample in 50 reads");
+}
+
+#[test]
+fn a_forced_code_reads_as_its_temperature_on_either_sensor() {
+    use compensator::sensor::simulated::SimulatedRtd;
+    let band = (-60.0, 250.0);
+    // The NTC: no diagnosis cycle, the divider's code.
+    let mut ntc = SimulatedNtc::simulated(&RawEstimator::DEFAULT, band, 40.0);
+    assert!(ntc.start().is_ok());
+    assert_eq!(ntc.restart_readings(), 0);
+    assert_eq!(ntc.code_of(60.0), NTC.code_of(60.0));
+    ntc.inject(Some(Injection::Code(ntc.code_of(60.0))));
+    assert!((first_sample(&mut ntc).unwrap() - 60.0).abs() < 0.05);
+    ntc.inject(Some(Injection::Code(0)));
+    assert_eq!(ntc.read(), Err(SensorFault::ShortCircuit(Detail::code(0))));
+    // The MAX31865: its stale reads after a diagnosis cycle, the RTD's code.
+    let mut rtd = SimulatedRtd::simulated(&RawEstimator::DEFAULT, band, 40.0);
+    assert!(rtd.start().is_ok());
+    let settings = Settings::from_params(&RawEstimator::DEFAULT);
+    assert_eq!(rtd.restart_readings(), settings.restart_readings());
+    assert!(rtd.restart_readings() > 0);
+    assert_eq!(
+        rtd.code_of(60.0),
+        code_of(&settings, settings.cvd.resistance(settings.r0, 60.0))
+    );
+    rtd.inject(Some(Injection::Code(rtd.code_of(60.0))));
+    assert!((first_sample(&mut rtd).unwrap() - 60.0).abs() < 0.05);
+    rtd.inject(Some(Injection::Code(0)));
+    assert!(first_sample(&mut rtd).is_err());
+}
+
 #[test]
 fn oversampling_averages_the_codes_and_an_adc_error_is_a_bus_fault() {
     let mut adc = Codes(vec![2003, 2002, 2001, 2000]);

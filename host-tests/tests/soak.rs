@@ -1,12 +1,14 @@
 //! The soak with faults, bounded for CI: the estimator on the
 //! paper preset through the QEMU soak image's walk (same seed, same ticks:
 //! the host twin of `cargo xtask test`'s QEMU soak step), and the `f32` twin
-//! against the `f64` twin on the paper preset and random designs.
+//! against the `f64` twin on the paper preset and random designs; the same
+//! soak with the NTC preset's sensor (`presets/paper-ntc.toml`).
 //! `COMPENSATOR_SOAK_TICKS` runs longer; the long run is
 //! `cargo run --release -p host-tests --example soak -- --ticks 10000000`
 //! (`docs/soak.md`).
 
-use host_tests::soak::{Kind, SEED, drift, moving_designs, paper, run};
+use compensator::sensor::device::SensorKind;
+use host_tests::soak::{Kind, Run, SEED, drift, moving_designs, paper, paper_ntc, run};
 
 /// Ticks of the estimator soak: the QEMU image's 1e6, or
 /// `COMPENSATOR_SOAK_TICKS`.
@@ -20,7 +22,29 @@ fn ticks() -> u32 {
 #[test]
 fn the_estimator_survives_a_faulty_sensor_and_recovers() {
     let r = run(&paper(), ticks(), SEED).unwrap();
-    eprintln!("{}", r.table());
+    assert_eq!(r.sensor, SensorKind::Rtd);
+    survives(&r);
+}
+
+/// The same soak through the NTC on the STM32F4's ADC (no diagnosis
+/// cycle: no read after a fault's start hides it).
+#[test]
+fn the_estimator_survives_a_faulty_ntc_and_recovers() {
+    let r = run(&paper_ntc(), ticks(), SEED).unwrap();
+    assert_eq!(r.sensor, SensorKind::Ntc);
+    assert_eq!(r.limits.restart, 0);
+    survives(&r);
+    // Every fault of a kind that must be flagged was read, and flagged
+    // within one sample period.
+    assert_eq!(r.stats.unread, [0; 11]);
+    for kind in Kind::ALL {
+        assert!(r.stats.detection[kind.index()] < r.limits.sensor_every, "{}", r.table());
+    }
+}
+
+/// The checks of a soak run, whatever its sensor.
+fn survives(r: &Run) {
+    eprintln!("{:?} sensor\n{}", r.sensor, r.table());
     assert_eq!(r.violations(), 0, "\n{}", r.table());
     let st = &r.stats;
     assert_eq!(st.reseats, 0);
@@ -46,11 +70,13 @@ fn the_estimator_survives_a_faulty_sensor_and_recovers() {
 
 #[test]
 fn the_same_seed_gives_the_same_soak() {
-    let a = run(&paper(), 100_000, 7).unwrap();
-    let b = run(&paper(), 100_000, 7).unwrap();
-    assert_eq!(a.stats, b.stats);
-    let c = run(&paper(), 100_000, 8).unwrap();
-    assert_ne!(a.stats.injected, c.stats.injected);
+    for raw in [paper(), paper_ntc()] {
+        let a = run(&raw, 100_000, 7).unwrap();
+        let b = run(&raw, 100_000, 7).unwrap();
+        assert_eq!(a.stats, b.stats);
+        let c = run(&raw, 100_000, 8).unwrap();
+        assert_ne!(a.stats.injected, c.stats.injected);
+    }
 }
 
 #[test]

@@ -5,9 +5,12 @@
 //! [`TICKS`] ticks (1,000 s of oil at 1 kHz) of a seeded temperature walk
 //! (abrupt steps, holds, ramps, cold excursions to the oil range's bottom)
 //! with injected sensor faults (spikes, bus errors, dropouts, stuck codes,
-//! MISO stuck high, open and shorted RTD, out-of-range codes), through the
-//! simulated MAX31865 read by the real driver, and the estimator every
-//! tick, built for the parameter file as the twin image is. Every tick is
+//! a stuck converter, open and shorted element, out-of-range codes),
+//! through the parameter file's sensor simulated at register level and read
+//! by its real driver (the MAX31865 by default; with `estimator.sensor =
+//! "ntc"` the NTC on the STM32F4's ADC: `build.rs` sets `cfg(sensor_ntc)`),
+//! and the estimator every tick, built for the parameter file as the twin
+//! image is. Every tick is
 //! checked (`compensator_testbench::soak`, shared with the host soak of
 //! `host-tests/src/soak.rs`, which runs the same walk for the same seed):
 //! no NaN, no re-seat of the twin, `SENSOR_FAULT` exactly on the unusable
@@ -22,7 +25,6 @@
 #![no_main]
 
 use compensator::Params;
-use compensator::sensor::max31865::Settings;
 use compensator_firmware::qemu::exit;
 use cortex_m as _; // links the critical-section implementation defmt needs
 use cortex_m_rt::entry;
@@ -31,6 +33,14 @@ use defmt::{error, info};
 use compensator_testbench::soak::{CHECKS, Kind, Soak};
 
 include!(concat!(env!("OUT_DIR"), "/params.rs"));
+
+/// The parameter file's sensor behind its real driver, simulated at
+/// register level: the MAX31865 ...
+#[cfg(not(sensor_ntc))]
+type Sensor = compensator::sensor::simulated::SimulatedRtd;
+/// ... or the NTC on the STM32F4's ADC (`estimator.sensor = "ntc"`).
+#[cfg(sensor_ntc)]
+type Sensor = compensator::sensor::simulated::SimulatedNtc;
 
 // A fault reports its registers and exits 1 (not a spin until the deadline).
 compensator_firmware::qemu_hard_fault_handler!();
@@ -68,8 +78,7 @@ fn main() -> ! {
         TWIN_SCHEME,
         TWIN_SUBSTEPS,
     );
-    let settings = Settings::from_params(&RAW_PARAMS.estimator);
-    let mut soak = match Soak::new(&params, &params64, config, &settings, SEED) {
+    let mut soak = match Soak::<Sensor, _, _>::new(&params, &params64, config, &RAW_PARAMS.estimator, SEED) {
         Ok(s) => s,
         Err(what) => {
             error!("soak: {=str}", what);
@@ -82,7 +91,8 @@ fn main() -> ! {
         TICKS, SEED, PARAMS_SOURCE, TWIN_SCHEME, TWIN_SUBSTEPS, TWIN_ESTIMATED_ERROR_PCT
     );
     info!(
-        "walk {=f32}..{=f32} C, cold excursions {=f32}..{=f32} C; a read every {=u32} ticks; bounds: flag {=u32}, DEGRADED {=u32}, recovery {=u32} ticks",
+        "sensor {=str}; walk {=f32}..{=f32} C, cold excursions {=f32}..{=f32} C; a read every {=u32} ticks; bounds: flag {=u32}, DEGRADED {=u32}, recovery {=u32} ticks",
+        compensator::sensor::device::SensorKind::of(&RAW_PARAMS.estimator).name(),
         lim.range.0,
         lim.range.1,
         lim.cold.0,

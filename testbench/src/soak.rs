@@ -11,16 +11,18 @@
 //! (a step down to the bottom of the oil range, held). A segment may carry
 //! one fault, placed after the recovery room of the step that began it and
 //! ending at least that room before the segment ends, so that no two
-//! events overlap. The sensor is the simulated MAX31865 read through the
-//! real driver every `sensor_every` ticks (its diagnosis cycle included);
-//! the estimator ticks every tick.
+//! events overlap. The sensor is the device file's, simulated at register
+//! level behind its real driver ([`SimulatedSource`]: the MAX31865 with its
+//! diagnosis cycle, or the NTC on the STM32F4's ADC), read every
+//! `sensor_every` ticks; the estimator ticks every tick. The walk and the
+//! fault kinds are the sensor's neither: each kind is an [`Injection`]
+//! (or a missing read), which the source maps onto its chip.
 
 use compensator::Params;
 use compensator::equilibrium::equilibrium;
 use compensator::estimator::{Estimator, EstimatorConfig, Flags, ObserverDesign, StateEstimate};
-use compensator::sensor::TemperatureSource;
-use compensator::sensor::max31865::{Max31865, Settings, code_of, fault};
-use compensator::sensor::simulated::SimulatedMax31865;
+use compensator::params::RawEstimator;
+use compensator::sensor::simulated::{Injection, SimulatedSource};
 use compensator::uncertainty::UncertaintyTable;
 use core::borrow::Borrow;
 
@@ -34,6 +36,10 @@ pub const HOLD_TOLERANCE: f64 = 1e-3;
 /// approach to a small step (10 time constants of 0.2 s) and the twin's
 /// slewed oil (at most ~0.6 s for a step to the coldest oil).
 pub const SETTLE: f32 = 2.0;
+
+/// The simulated element's fault band \[C\]: wide, as the QEMU twin's, so
+/// that the estimator's oil range is what rejects samples.
+pub const SENSOR_BAND: (f32, f32) = (-60.0, 250.0);
 
 fn abs32(x: f32) -> f32 {
     if x < 0.0 { -x } else { x }
@@ -86,13 +92,17 @@ impl XorShift64 {
     }
 }
 
-/// What a fault does to the sensor path.
+/// What a fault does to the sensor path, whatever the sensor: each kind
+/// is an [`Injection`] the source maps onto its chip ([`Kind::injection`]),
+/// or a read left out (a dropout), or the oil's temperature moved (a
+/// spike).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
     /// 1..=`spike_limit` consecutive samples off by more than the spike
     /// threshold (inside the oil range): `SPIKE` on each.
     Spike,
-    /// Every SPI transaction fails: `SENSOR_FAULT`.
+    /// The bus fails ([`Injection::Bus`]: MAX31865, every SPI transaction;
+    /// NTC, no conversion ends): `SENSOR_FAULT`.
     BusError,
     /// No read at all (the sample is not delivered): `DEGRADED` after
     /// `stale_after` ticks.
@@ -101,15 +111,20 @@ pub enum Kind {
     /// (a frozen reading): indistinguishable from a constant temperature,
     /// so no flag is expected; the estimate follows the frozen value.
     StuckCode,
-    /// MISO stuck high (every byte 0xFF): `SENSOR_FAULT`.
-    StuckMiso,
-    /// The converter's RTD-high status (an open RTD): `SENSOR_FAULT`.
-    OpenRtd,
-    /// The converter's RTD-low status (a shorted RTD): `SENSOR_FAULT`.
-    ShortedRtd,
-    /// Code 0: `SENSOR_FAULT` (the driver's implausible code).
+    /// The converter stuck ([`Injection::Stuck`]: MAX31865, MISO stuck
+    /// high, every byte 0xFF; NTC, no conversion ends): `SENSOR_FAULT`.
+    StuckConverter,
+    /// The element open ([`Injection::Open`]: MAX31865, its RTD-high
+    /// status; NTC, the input at `V_REF+`): `SENSOR_FAULT`.
+    OpenElement,
+    /// The element shorted ([`Injection::Short`]: MAX31865, RTD-low; NTC,
+    /// the input at ground): `SENSOR_FAULT`.
+    ShortedElement,
+    /// Code 0: `SENSOR_FAULT` (MAX31865: the driver's implausible code;
+    /// NTC: a shorted divider's code).
     ZeroCode,
-    /// Code 0x7FFF (full scale): `SENSOR_FAULT`.
+    /// The full-scale code ([`Injection::Saturated`]: MAX31865 0x7FFF,
+    /// NTC `2^bits - 1`): `SENSOR_FAULT`.
     FullScaleCode,
     /// The code of a temperature 1-20 C below the oil range: `SENSOR_FAULT`
     /// (the estimator's oil range).
@@ -125,9 +140,9 @@ impl Kind {
         Kind::BusError,
         Kind::Dropout,
         Kind::StuckCode,
-        Kind::StuckMiso,
-        Kind::OpenRtd,
-        Kind::ShortedRtd,
+        Kind::StuckConverter,
+        Kind::OpenElement,
+        Kind::ShortedElement,
         Kind::ZeroCode,
         Kind::FullScaleCode,
         Kind::ColdCode,
@@ -146,11 +161,11 @@ impl Kind {
             Kind::BusError => "bus error",
             Kind::Dropout => "dropout",
             Kind::StuckCode => "stuck code",
-            Kind::StuckMiso => "stuck MISO",
-            Kind::OpenRtd => "open RTD",
-            Kind::ShortedRtd => "shorted RTD",
+            Kind::StuckConverter => "stuck converter",
+            Kind::OpenElement => "open element",
+            Kind::ShortedElement => "shorted element",
             Kind::ZeroCode => "code 0",
-            Kind::FullScaleCode => "code 0x7FFF",
+            Kind::FullScaleCode => "code full scale",
             Kind::ColdCode => "code below oil range",
             Kind::HotCode => "code above oil range",
         }
@@ -163,6 +178,23 @@ impl Kind {
             Kind::Spike => Some(Flags::SPIKE),
             Kind::Dropout | Kind::StuckCode => None,
             _ => Some(Flags::SENSOR_FAULT),
+        }
+    }
+
+    /// What the fault injects into the simulated converter, `code` being
+    /// the source's code of the fault's [`Fault::level`] (`None`: nothing,
+    /// the healthy converter: a spike moves the temperature, a dropout
+    /// leaves the read out).
+    pub fn injection(self, code: u16) -> Option<Injection> {
+        match self {
+            Kind::Spike | Kind::Dropout => None,
+            Kind::BusError => Some(Injection::Bus),
+            Kind::StuckConverter => Some(Injection::Stuck),
+            Kind::OpenElement => Some(Injection::Open),
+            Kind::ShortedElement => Some(Injection::Short),
+            Kind::ZeroCode => Some(Injection::Code(0)),
+            Kind::FullScaleCode => Some(Injection::Saturated),
+            Kind::StuckCode | Kind::ColdCode | Kind::HotCode => Some(Injection::Code(code)),
         }
     }
 }
@@ -178,8 +210,10 @@ pub struct Fault {
     pub end: u32,
     /// What a spike adds to the temperature [C].
     pub delta: f32,
-    /// The forced code (stuck and out-of-range codes).
-    pub code: u16,
+    /// The temperature whose code the converter is forced to (stuck and
+    /// out-of-range codes) \[C\]: the source's [`SimulatedSource::code_of`]
+    /// turns it into the chip's code when the fault starts.
+    pub level: f32,
 }
 
 /// One piece of the walk, ticks `start..end`.
@@ -218,14 +252,13 @@ impl Segment {
 /// bounds of the checks, from the device's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Limits {
-    /// The converter's settings (the oil range's thresholds widened, as
-    /// the QEMU twin does, so that the estimator's range rejects samples).
-    pub settings: Settings,
     /// Tick [s].
     pub tick: f32,
-    /// Ticks between two reads of the converter.
+    /// Ticks between two reads of the converter (the source's sample
+    /// period).
     pub sensor_every: u32,
-    /// Reads after a diagnosis cycle that return no sample.
+    /// Reads after a diagnosis cycle that return no sample (the source's
+    /// [`SimulatedSource::restart_readings`]: 0 for the NTC).
     pub restart: u32,
     /// `EstimatorConfig::spike_limit`.
     pub spike_limit: u32,
@@ -244,22 +277,20 @@ pub struct Limits {
 }
 
 impl Limits {
-    /// From the estimator's configuration and the converter's settings;
-    /// the model `params` bounds the walk to temperatures it accepts.
+    /// From the estimator's configuration and what the simulated `source`
+    /// says of itself (its sample period, its reads without a sample after
+    /// a diagnosis cycle); the model `params` bounds the walk to
+    /// temperatures it accepts.
     ///
     /// # Errors
     ///
     /// The oil model leaves no room for a walk (less than 10 C accepted
     /// above the cold levels).
-    pub fn new<U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Copy>(
+    pub fn new<S: SimulatedSource, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Copy>(
         params: &Params<f32>,
         config: &EstimatorConfig<U, O>,
-        settings: &Settings,
+        source: &S,
     ) -> Result<Limits, &'static str> {
-        let settings = Settings {
-            fault_band: (-60.0, 250.0),
-            ..*settings
-        };
         let accepts = |t: f32| params.oil.state(t).is_ok() && equilibrium(params, t).is_ok();
         let (oil_lo, oil_hi) = (config.oil.min, config.oil.max);
         // The coldest oil the model accepts, in whole degrees from the
@@ -278,10 +309,9 @@ impl Limits {
             return Err("the oil model accepts too narrow a range for the walk");
         }
         Ok(Limits {
-            settings,
             tick: config.tick(),
-            sensor_every: config.ticks_per(settings.mains.conversion_period()),
-            restart: settings.restart_readings(),
+            sensor_every: config.ticks_per(source.sample_period()),
+            restart: source.restart_readings(),
             spike_limit: config.spikes.limit,
             spike_threshold: config.spikes.threshold,
             stale_after: config.stale_after,
@@ -325,12 +355,6 @@ impl Limits {
     /// of margin on top.
     pub fn recovery_bound(&self) -> u32 {
         (self.restart + self.spike_limit + 4) * self.sensor_every
-    }
-
-    /// The code of temperature `t` [C].
-    fn code(&self, t: f32) -> u16 {
-        let s = &self.settings;
-        code_of(s, s.cvd.resistance(s.r0, t))
     }
 }
 
@@ -457,12 +481,10 @@ impl Walk {
                 } else {
                     -magnitude
                 };
-                let code = match kind {
-                    Kind::ZeroCode => 0,
-                    Kind::FullScaleCode => 0x7FFF,
-                    Kind::ColdCode => lim.code(lim.oil.0 - rng.uniform(1.0, 20.0)),
-                    Kind::HotCode => lim.code(lim.oil.1 + rng.uniform(1.0, 40.0)),
-                    _ => lim.code(at),
+                let level = match kind {
+                    Kind::ColdCode => lim.oil.0 - rng.uniform(1.0, 20.0),
+                    Kind::HotCode => lim.oil.1 + rng.uniform(1.0, 40.0),
+                    _ => at,
                 };
                 let end = if kind == Kind::Spike {
                     begin + length - every + 1
@@ -474,7 +496,7 @@ impl Walk {
                     start: begin,
                     end,
                     delta,
-                    code,
+                    level,
                 });
             }
         }
@@ -615,6 +637,8 @@ impl Stats {
 #[derive(Clone, Copy, Debug)]
 struct Watch {
     fault: Fault,
+    /// What the converter is given meanwhile.
+    injection: Option<Injection>,
     /// Reads in its window that returned a sample or a fault.
     reads: u32,
     flagged: Option<u32>,
@@ -638,14 +662,15 @@ pub struct HoldEnd {
     pub estimate: StateEstimate,
 }
 
-/// The soak: walk, simulated converter behind the real driver, estimator
-/// (its uncertainty table held as `U`: by value on the host, a reference
-/// to flash in the QEMU image), checks.
-pub struct Soak<U = UncertaintyTable, O = ObserverDesign> {
+/// The soak: walk, the simulated sensor `S` behind its real driver
+/// ([`SimulatedSource`]: the device file's), estimator (its uncertainty
+/// table held as `U`: by value on the host, a reference to flash in the
+/// QEMU image), checks.
+pub struct Soak<S, U = UncertaintyTable, O = ObserverDesign> {
     /// Timing, ranges, bounds.
     pub limits: Limits,
     walk: Walk,
-    sensor: Max31865<SimulatedMax31865>,
+    sensor: S,
     estimator: Estimator<f32, U, O>,
     params64: Params<f64>,
     machine: bool,
@@ -664,10 +689,12 @@ pub struct Soak<U = UncertaintyTable, O = ObserverDesign> {
     pub stats: Stats,
 }
 
-impl<U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Copy> Soak<U, O> {
+impl<S: SimulatedSource, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Copy> Soak<S, U, O> {
     /// A soak of `seed` for the device of `params` (`params64`: the same
     /// parameters in `f64`, for the closed form the holds are checked
-    /// against), the estimator `config` and the converter `settings`.
+    /// against), the estimator `config` and the sensor `S` built from the
+    /// file's `[estimator]` section `sensor` (its fault band widened to
+    /// [`SENSOR_BAND`]).
     ///
     /// # Errors
     ///
@@ -677,14 +704,15 @@ impl<U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Copy> Soak<
         params: &Params<f32>,
         params64: &Params<f64>,
         config: EstimatorConfig<U, O>,
-        settings: &Settings,
+        sensor: &RawEstimator,
         seed: u64,
-    ) -> Result<Soak<U, O>, &'static str> {
-        let limits = Limits::new(params, &config, settings)?;
+    ) -> Result<Soak<S, U, O>, &'static str> {
+        let mut sensor = S::simulated(sensor, SENSOR_BAND, config.oil.min);
+        let limits = Limits::new(params, &config, &sensor)?;
         let walk = Walk::new(limits, seed);
         let start = walk.segment.to;
-        let mut sensor = Max31865::new(SimulatedMax31865::new(limits.settings, start), limits.settings);
-        sensor.configure().map_err(|_| "the converter's configuration failed")?;
+        sensor.set_temperature(start);
+        sensor.start().map_err(|_| "the converter's configuration failed")?;
         let estimator = Estimator::new(params, config, start).map_err(|_| "the estimator refused the start")?;
         let mut stats = Stats::new();
         stats.segments = 1;
@@ -748,35 +776,28 @@ impl<U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Copy> Soak<
             }
             self.watch = Some(Watch {
                 fault: f,
+                injection: f.kind.injection(self.sensor.code_of(f.level)),
                 reads: 0,
                 flagged: None,
                 degraded: None,
             });
         }
-        let active = self.watch.map(|w| w.fault);
+        let active = self.watch.map(|w| (w.fault, w.injection));
         // Drive the converter.
         let t = seg.temperature(k);
         st.span = (st.span.0.min(t), st.span.1.max(t));
-        let sim = self.sensor.device_mut();
-        sim.temperature = t;
-        sim.bus_error = false;
-        sim.miso_stuck_high = false;
-        sim.fault = 0;
-        sim.forced_code = None;
         let mut read = k.is_multiple_of(lim.sensor_every);
-        if let Some(f) = active {
+        let mut at = t;
+        let mut injection = None;
+        if let Some((f, i)) = active {
             match f.kind {
-                Kind::Spike => sim.temperature = t + f.delta,
-                Kind::BusError => sim.bus_error = true,
+                Kind::Spike => at = t + f.delta,
                 Kind::Dropout => read = false,
-                Kind::StuckMiso => sim.miso_stuck_high = true,
-                Kind::OpenRtd => sim.fault = fault::RTD_HIGH,
-                Kind::ShortedRtd => sim.fault = fault::RTD_LOW,
-                Kind::StuckCode | Kind::ZeroCode | Kind::FullScaleCode | Kind::ColdCode | Kind::HotCode => {
-                    sim.forced_code = Some(f.code)
-                }
+                _ => injection = i,
             }
         }
+        self.sensor.set_temperature(at);
+        self.sensor.inject(injection);
         let sample = if read { self.sensor.read() } else { Ok(None) };
         let e = self.estimator.tick(sample);
         let n = k + 1;

@@ -513,6 +513,37 @@ fn wide_device_file(root: &Path) -> Result<PathBuf, String> {
 /// bench's budget for the RTD device).
 const TWIN_STACK_BUDGET: u64 = 6 << 10;
 
+/// The soak image built for the NTC preset (`presets/paper-ntc.toml`: the
+/// NTC on the STM32F4's ADC, simulated at register level), run on QEMU: it
+/// exits 0 (no check violated; the host soak of `host-tests/tests/soak.rs`
+/// runs the same walk).
+fn ntc_soak(tc: &toolchain::Toolchain, root: &Path, timeout: Duration) -> Result<(), String> {
+    let file = root.join("presets/paper-ntc.toml");
+    let elf = firmware::build(tc, root, &firmware::Image::SOAK, Some(&file))?;
+    let started = std::time::Instant::now();
+    let run = qemu::run(&elf, qemu::NETDUINO, false, timeout, qemu::Show::Quiet).map_err(|e| e.to_string())?;
+    if run.code != 0 {
+        for l in &run.lines {
+            eprintln!("{l}");
+        }
+        return Err(format!(
+            "the soak built for {} exited with {} (124: past its deadline)",
+            file.display(),
+            run.code
+        ));
+    }
+    eprintln!(
+        "xtask: NTC {} ({:.0} s)",
+        run.lines
+            .iter()
+            .rev()
+            .find(|l| l.contains("soak:"))
+            .map_or("", String::as_str),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
 /// The twin built for the NTC preset (`presets/paper-ntc.toml`: the NTC
 /// on the STM32F4's ADC, simulated at register level), run on QEMU: its
 /// self-checks pass, its peak stack is within [`TWIN_STACK_BUDGET`], and
@@ -685,6 +716,10 @@ fn cmd_test(bless: bool) -> Outcome {
         "an NTC device file (presets/paper-ntc.toml) builds the twin and the board; on QEMU the twin passes its checks within the stack budget and matches the host replica; neither tick links a panic",
     );
     ntc_twin(&tc, &root, minutes(5))?;
+    step(
+        "QEMU: the soak built for the NTC device file (presets/paper-ntc.toml: its sensor behind its driver, every tick checked)",
+    );
+    ntc_soak(&tc, &root, minutes(3))?;
     step("a parameter file the CLI refuses fails the firmware build in one line naming the field");
     firmware::check_refused_file(&tc, &root)?;
     step("firmware images");

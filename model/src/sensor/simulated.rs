@@ -34,6 +34,10 @@ pub enum Injection {
     /// The converter stuck (MAX31865: MISO stuck high, every byte 0xFF;
     /// NTC: no conversion ends).
     Stuck,
+    /// The converter reports this raw code whatever the element reads (a
+    /// frozen or broken converter; the codes of
+    /// [`SimulatedSource::code_of`]).
+    Code(u16),
 }
 
 /// A driver over its simulator, as a replay drives it.
@@ -62,6 +66,16 @@ pub trait SimulatedSource: TemperatureSource {
 
     /// The fault present from now on (`None`: healthy).
     fn inject(&mut self, fault: Option<Injection>);
+
+    /// Readings after a diagnosis cycle that return no sample (the
+    /// MAX31865's stale registers after its fault-detection cycle,
+    /// [`max31865::Settings::restart_readings`]; 0 for the NTC, which has
+    /// no such cycle).
+    fn restart_readings(&self) -> u32;
+
+    /// The converter's raw code at `temperature` \[C\], as its simulator
+    /// converts it (for [`Injection::Code`]).
+    fn code_of(&self, temperature: f32) -> u16;
 }
 
 impl SimulatedSource for SimulatedRtd {
@@ -98,7 +112,17 @@ impl SimulatedSource for SimulatedRtd {
             Some(Injection::Bus) => sim.bus_error = true,
             Some(Injection::Saturated) => sim.forced_code = Some(0x7FFF),
             Some(Injection::Stuck) => sim.miso_stuck_high = true,
+            Some(Injection::Code(code)) => sim.forced_code = Some(code),
         }
+    }
+
+    fn restart_readings(&self) -> u32 {
+        self.settings().restart_readings()
+    }
+
+    fn code_of(&self, temperature: f32) -> u16 {
+        let s = self.settings();
+        max31865::code_of(s, s.cvd.resistance(s.r0, temperature))
     }
 }
 
@@ -136,6 +160,15 @@ impl SimulatedSource for SimulatedNtc {
             Some(Injection::Short) => sim.short = true,
             Some(Injection::Bus | Injection::Stuck) => sim.stuck = true,
             Some(Injection::Saturated) => sim.forced_code = Some(u16::MAX),
+            Some(Injection::Code(code)) => sim.forced_code = Some(code),
         }
+    }
+
+    fn restart_readings(&self) -> u32 {
+        0
+    }
+
+    fn code_of(&self, temperature: f32) -> u16 {
+        self.settings().code_of(temperature)
     }
 }
