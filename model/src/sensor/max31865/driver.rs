@@ -215,7 +215,7 @@ impl<SPI: SpiDevice> Max31865<SPI> {
     ///
     /// As [`Max31865::read_code`], and [`Error::OutOfRange`] for a code
     /// of zero or full scale, or one whose resistance no RTD temperature
-    /// has ([`super::rtd::Cvd::temperature`]).
+    /// has ([`crate::sensor::rtd::Cvd::temperature`]).
     pub fn read_temperature(&mut self) -> Result<f32, Error<SPI::Error>> {
         let code = self.read_code()?;
         let r = code as f32 * self.settings.reference / 32768.0;

@@ -1,5 +1,5 @@
 //! MAX31865 RTD-to-digital converter (Maxim/Analog Devices datasheet
-//! 19-6478), over an `embedded-hal` 1.0 [`SpiDevice`] (SPI mode 1 or 3,
+//! 19-6478), over an `embedded-hal` 1.0 [`SpiDevice`](embedded_hal::spi::SpiDevice) (SPI mode 1 or 3,
 //! up to 5 MHz; the device handles chip select).
 //!
 //! Register map (read address; write address = read | 0x80):
@@ -23,7 +23,7 @@
 //! by the fault-detection cycle, which the driver runs at start-up
 //! ([`Max31865::configure`]) and then every [`Settings::diagnosis_every`]
 //! readings ([`DIAGNOSIS_INTERVAL`], 10 s, on the boards of this project),
-//! spread over [`TemperatureSource::read`] calls so that no call makes more
+//! spread over [`TemperatureSource::read`](crate::sensor::TemperatureSource::read) calls so that no call makes more
 //! than three short SPI transactions (tick budget):
 //!
 //! 1. after a reading, write `100X010Xb` (V_BIAS on, normally-off, D3:D2 =

@@ -96,7 +96,7 @@ impl<ADC: AdcChannel> Ntc<ADC> {
     }
 
     /// The mean of [`Settings::oversampling`] conversions (at least one)
-    /// [codes].
+    /// \[codes\].
     ///
     /// # Errors
     ///
