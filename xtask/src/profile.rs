@@ -540,15 +540,8 @@ pub fn cmd(
 ) -> Result<(), String> {
     let mut results = Vec::new();
     for &target in targets {
-        let image = image(target);
-        let elf = firmware::build(tc, root, &image, params)?;
-        let core = core_name(target);
-        eprintln!("xtask: profiling {core} ({target}, QEMU {})", image.machine().name);
-        let bytes = std::fs::read(&elf).map_err(|e| format!("{}: {e}", elf.display()))?;
-        let symbols = Symbols::of_elf(&bytes).map_err(|e| format!("{}: {e}", elf.display()))?;
-        let timing = Timing::of_elf(&elf, Core::of_target(target))?;
-        let sections = run(&elf, &symbols, Some(&timing), image.machine(), TIMEOUT)?;
-        results.push((core, sections, Lines::new(&elf, root, symbols)));
+        let (elf, symbols, sections) = profile_target(tc, root, params, target)?;
+        results.push((core_name(target), sections, Lines::new(&elf, root, symbols)));
     }
     let file = params.map_or_else(|| "presets/paper.toml".to_string(), |p| p.display().to_string());
     println!(
@@ -574,14 +567,31 @@ pub fn cycles_per_instruction(
     params: Option<&Path>,
     target: &'static str,
 ) -> Result<(f64, f64), String> {
+    let (_, _, sections) = profile_target(tc, root, params, target)?;
+    let estimator = sections.get(1).ok_or("the profile has no estimator section")?;
+    Ok(estimator.cycles_per_instruction())
+}
+
+/// The profile image for `target` built with `tc` for `params`, its
+/// symbols, and its sections traced on QEMU and timed ([`run`]).
+fn profile_target(
+    tc: &Toolchain,
+    root: &Path,
+    params: Option<&Path>,
+    target: &'static str,
+) -> Result<(std::path::PathBuf, Symbols, Vec<Section>), String> {
     let image = image(target);
     let elf = firmware::build(tc, root, &image, params)?;
+    eprintln!(
+        "xtask: profiling {} ({target}, QEMU {})",
+        core_name(target),
+        image.machine().name
+    );
     let bytes = std::fs::read(&elf).map_err(|e| format!("{}: {e}", elf.display()))?;
     let symbols = Symbols::of_elf(&bytes).map_err(|e| format!("{}: {e}", elf.display()))?;
     let timing = Timing::of_elf(&elf, Core::of_target(target))?;
     let sections = run(&elf, &symbols, Some(&timing), image.machine(), TIMEOUT)?;
-    let estimator = sections.get(1).ok_or("the profile has no estimator section")?;
-    Ok(estimator.cycles_per_instruction())
+    Ok((elf, symbols, sections))
 }
 
 /// The core a target is profiled on.
