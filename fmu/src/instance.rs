@@ -847,7 +847,7 @@ impl Instance {
                 }
                 let xi_carry = r.f32().ok_or_else(bad)?;
                 let abrupt = r.u8().ok_or_else(bad)? != 0;
-                let flags = Flags(r.u16().ok_or_else(bad)?);
+                let flags = Flags(r.u32().ok_or_else(bad)?);
                 let mut outputs = [0.0; 10];
                 for v in &mut outputs {
                     *v = r.f64().ok_or_else(bad)?;
@@ -926,9 +926,6 @@ impl Reader<'_> {
     }
     fn u8(&mut self) -> Option<u8> {
         Some(self.take(1)?[0])
-    }
-    fn u16(&mut self) -> Option<u16> {
-        Some(u16::from_le_bytes(self.take(2)?.try_into().ok()?))
     }
     fn u32(&mut self) -> Option<u32> {
         Some(u32::from_le_bytes(self.take(4)?.try_into().ok()?))

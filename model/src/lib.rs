@@ -43,6 +43,7 @@ pub mod estimator;
 pub mod fluid;
 pub mod linalg;
 pub mod mathf;
+pub mod monitor;
 pub mod params;
 pub mod scalar;
 pub mod sensor;

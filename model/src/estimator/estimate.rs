@@ -2,6 +2,7 @@
 //! telemetry record's `defmt` format.
 
 use super::flags::Flags;
+use crate::monitor::HealthEstimate;
 use crate::uncertainty::Uncertainty;
 
 /// The estimator's output for one tick (SI units, `f32`).
@@ -51,6 +52,9 @@ pub struct StateEstimate {
     /// Standard uncertainties of the estimate (`k = 1`), refreshed in the
     /// job rotation.
     pub uncertainty: Uncertainty,
+    /// The condition monitor's health parameters at its last reading
+    /// ([`HealthEstimate::NONE`] without a second sensor).
+    pub health: HealthEstimate,
     /// Conditions.
     pub flags: Flags,
 }
@@ -79,6 +83,7 @@ impl StateEstimate {
             deadline_misses: 0,
             lost_ticks: 0,
             uncertainty: Uncertainty::UNKNOWN,
+            health: HealthEstimate::NONE,
             flags,
         }
     }

@@ -10,7 +10,7 @@
 
 /// Condition flags of an estimate (a bit set).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Flags(pub u16);
+pub struct Flags(pub u32);
 
 impl Flags {
     /// No flag set.
@@ -24,6 +24,10 @@ impl Flags {
     /// Sets `other`'s flags.
     pub fn insert(&mut self, other: Flags) {
         self.0 |= other.0;
+    }
+    /// Clears `other`'s flags.
+    pub fn remove(&mut self, other: Flags) {
+        self.0 &= !other.0;
     }
     /// No flag set.
     pub const fn is_empty(self) -> bool {
@@ -136,6 +140,35 @@ flag_table! {
     /// reset-cause register read at start): raised by the firmware on the
     /// first telemetry record after the restart, never by the estimator.
     9 WATCHDOG_RESET "WATCHDOG_RESET";
+    /// The condition monitor's CUSUM found the device behaving unlike the
+    /// device its health parameters describe, and no single fault explains
+    /// the change yet (`crate::monitor`).
+    10 DEVICE_CHANGED "DEVICE_CHANGED";
+    /// The monitor isolated a rise of the divider parameter `A`: the
+    /// capillary restricted (silting) or the orifice worn; no steady
+    /// reading tells the two apart (latched).
+    11 CAPILLARY_RESTRICTED "CAPILLARY_RESTRICTED";
+    /// The monitor isolated a fall of `A`: the orifice clogged, or the
+    /// capillary eroded (latched).
+    12 ORIFICE_CLOGGED "ORIFICE_CLOGGED";
+    /// The monitor isolated a loss of spring rate (a displacement sensor
+    /// only; latched).
+    13 SPRING_RELAXED "SPRING_RELAXED";
+    /// The monitor isolated a displacement offset upwards: the spring's
+    /// preload lost, or the displacement sensor's zero moved (latched).
+    14 PRELOAD_LOST "PRELOAD_LOST";
+    /// The monitor isolated a plunger held by friction: it lags the
+    /// temperature's changes (a displacement sensor only; latched).
+    15 PLUNGER_STICKING "PLUNGER_STICKING";
+    /// The monitor isolated an offset of the second sensor's reading that
+    /// no device fault explains (latched).
+    16 SENSOR_OFFSET "SENSOR_OFFSET";
+    /// This tick's reading of the second sensor was refused by its own
+    /// checks (open loop, out of range, stuck, noisy): the monitor skipped it.
+    17 SECOND_SENSOR_FAULT "SECOND_SENSOR_FAULT";
+    /// This tick's reading of the second sensor lay beyond the monitor's
+    /// gate, or was not finite: counted, not applied.
+    18 INNOVATION_REJECTED "INNOVATION_REJECTED";
 }
 
 #[cfg(test)]
@@ -144,7 +177,7 @@ mod tests {
 
     #[test]
     fn names_follow_the_bits() {
-        assert_eq!(Flags::NAMES.len(), 10);
+        assert_eq!(Flags::NAMES.len(), 19);
         let mut all = Flags::empty();
         for (i, name) in Flags::NAMES.iter().enumerate() {
             all.insert(Flags(1 << i));

@@ -90,6 +90,7 @@ pub use stability::{quartic_hurwitz, slowest_decay_rate};
 
 use crate::dynamics::Twin;
 use crate::error::ModelError;
+use crate::monitor::{HealthEstimate, Monitor, MonitorError, MonitorSettings, PlantView};
 use crate::params::Params;
 use crate::scalar::Real;
 use crate::sensor::SensorFault;
@@ -199,6 +200,15 @@ pub struct Estimator<T = f32, U = UncertaintyTable, O = ObserverDesign> {
     late: bool,
     /// Consecutive ticks the twin had an event on (saturating).
     deferred: u32,
+    /// The condition monitor, with a second sensor ([`Estimator::with_monitor`]).
+    monitor: Option<Monitor>,
+    /// The second sensor's reading not yet given to the monitor (it runs
+    /// in a job's place: [`Estimator::offer_second`]).
+    second: Option<Result<f32, SensorFault>>,
+    /// The monitor's estimate at its last reading.
+    health: HealthEstimate,
+    /// Flags of the monitor's last reading, for the next estimate only.
+    health_flags: Flags,
 }
 
 impl<U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Copy> Estimator<f32, U, O> {
@@ -243,7 +253,47 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
             lost_ticks: 0,
             late: false,
             deferred: 0,
+            monitor: None,
+            second: None,
+            health: HealthEstimate::NONE,
+            health_flags: Flags::empty(),
         })
+    }
+
+    /// This estimator with a condition monitor of a second sensor
+    /// (`crate::monitor`): its readings, given by
+    /// [`Estimator::offer_second`], correct nothing of the temperature
+    /// estimate; they estimate the device's health parameters and raise the
+    /// monitor's flags.
+    ///
+    /// # Errors
+    ///
+    /// As [`Monitor::new`]: a setting not finite and positive, named.
+    pub fn with_monitor(mut self, settings: MonitorSettings) -> Result<Self, MonitorError> {
+        self.monitor = Some(Monitor::new(self.plant.params(), settings)?);
+        Ok(self)
+    }
+
+    /// The condition monitor, if one is fitted.
+    pub fn monitor(&self) -> Option<&Monitor> {
+        self.monitor.as_ref()
+    }
+
+    /// A reading of the second sensor \[Pa or m\] (`Err`: refused by its
+    /// own checks). The monitor takes it on the next tick that would run a
+    /// job (in the job's place: the worst tick stays the twin's plus one
+    /// job, the monitor or the telemetry); a newer reading replaces one not
+    /// yet taken. Without a monitor it is ignored.
+    pub fn offer_second(&mut self, reading: Result<f32, SensorFault>) {
+        if self.monitor.is_some() {
+            self.second = Some(reading);
+        }
+    }
+
+    /// The monitor's estimate at its last reading ([`HealthEstimate::NONE`]
+    /// without one).
+    pub fn health(&self) -> &HealthEstimate {
+        &self.health
     }
 
     /// The time constant of the twin's slowest mode at the last Stability
@@ -355,11 +405,30 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
         self.telemetry_pending = due && eventful;
         if !due && !eventful {
             // A job tick (a telemetry tick only publishes: the costliest
-            // tick is spared).
-            let (observer, design) = (&self.observer, self.config.observer_design());
-            self.plant.run_job(self.config.table(), t, || observer.variance(design));
+            // tick is spared); a waiting reading of the second sensor takes
+            // the job's place.
+            if let (Some(monitor), Some(reading)) = (self.monitor.as_mut(), self.second.take()) {
+                let s = self.plant.twin().state();
+                let view = PlantView {
+                    oil: *self.plant.oil(),
+                    x: s.x,
+                    p_a: s.p_a,
+                    p_b: s.p_b,
+                    var_t: self.observer.variance(self.config.observer_design()),
+                };
+                self.health = monitor.update(self.plant.params(), &view, reading);
+                self.health_flags = self.health.flags;
+            } else {
+                let (observer, design) = (&self.observer, self.config.observer_design());
+                self.plant.run_job(self.config.table(), t, || observer.variance(design));
+            }
         }
+        flags.insert(core::mem::replace(
+            &mut self.health_flags,
+            Flags(self.health.flags.0 & !crate::monitor::PER_READING.0),
+        ));
         let mut e = self.plant.estimate(t, flags);
+        e.health = self.health;
         e.tick = self.tick;
         e.t_probe = self.observer.last_reading();
         e.deadline_misses = self.deadline_misses;

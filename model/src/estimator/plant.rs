@@ -143,6 +143,12 @@ impl<T: Real> Plant<T> {
         &mut self.twin
     }
 
+    /// The twin's oil (its temperature, viscosity and density with their
+    /// temperature derivatives) at the last Fluid job.
+    pub fn oil(&self) -> &crate::fluid::FluidPoint<f32> {
+        &self.statics.point
+    }
+
     /// The design at the applied port pressures.
     pub fn params(&self) -> &Params<f32> {
         &self.params
@@ -410,6 +416,7 @@ impl<T: Real> Plant<T> {
             deadline_misses: 0,
             lost_ticks: 0,
             uncertainty: st.uncertainty,
+            health: crate::monitor::HealthEstimate::NONE,
             flags,
         }
     }

@@ -23,7 +23,7 @@
 //! # Wire format
 //!
 //! Little-endian: [`LAYOUT`] (`u16`), then each field in table order in its
-//! [`Encoding`], then the [`Flags`] bits (`u16`); [`SIZE`] bytes in all.
+//! [`Encoding`], then the [`Flags`] bits (`u32`); [`SIZE`] bytes in all.
 //! Packing costs a store per field (plus a scale and a saturation for the
 //! 16-bit encodings), where defmt's per-argument formatting cost about 66
 //! instructions per field; the figures per encoding are in the project's
@@ -452,7 +452,7 @@ macro_rules! telemetry_table {
         pub const LAYOUT: u16 = layout_of(&FIELDS);
 
         /// Bytes in a record: the layout tag, the fields, the flags.
-        pub const SIZE: usize = 2 $(+ encoding!($wire $($step)?).size())* + 2;
+        pub const SIZE: usize = 2 $(+ encoding!($wire $($step)?).size())* + 4;
 
         /// The bytes of `e`'s telemetry record (see the module docs). A
         /// store per field, no branch but the 16-bit encodings' saturation:
@@ -489,7 +489,7 @@ macro_rules! telemetry_table {
                 // Struct fields are evaluated in the order written: wire order.
                 Ok(Record {
                     $( $column: get!(r, $wire $($step)?), )*
-                    flags: Flags(u16::from_le_bytes(r.take())),
+                    flags: Flags(u32::from_le_bytes(r.take())),
                 })
             }
 
@@ -637,7 +637,8 @@ mod tests {
 
     #[test]
     fn the_table_is_consistent() {
-        let mut size = 4;
+        // The layout tag (2 bytes), the fields, the flags (4 bytes).
+        let mut size = 6;
         for (i, f) in FIELDS.iter().enumerate() {
             size += f.encoding.size();
             assert!(!f.doc.trim().is_empty(), "{}: a description", f.column);
@@ -669,7 +670,7 @@ mod tests {
     #[test]
     fn every_encoding_packs_and_decodes_as_the_estimate_carries_it() {
         use every_encoding::{FIELDS, Record, SIZE, encode};
-        assert_eq!(SIZE, 2 + 2 + 2 + 4 + 4 + 2);
+        assert_eq!(SIZE, 2 + 2 + 2 + 4 + 4 + 4);
         let mut e = estimate();
         for (x, p_a) in [
             (12.86e-6, 196205.72),
