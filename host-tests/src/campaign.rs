@@ -75,7 +75,7 @@ use compensator::estimator::{Estimator, EstimatorConfig, StateEstimate, reading_
 use compensator::params::{RawCore, RawEstimator, RawParams, RawProbe};
 use compensator::sensor::device::SensorKind;
 use compensator::sensor::{max31865, ntc};
-use std::f64::consts::FRAC_PI_4;
+use std::f64::consts::PI;
 use std::fmt;
 
 /// A device fault and its severity.
@@ -309,7 +309,9 @@ impl Truth {
 /// `point`, not clamped to the stops: `A (p_b - p_a) / c - x0` [m] (the
 /// reference's spring force is `c (x0 + x)`).
 pub fn free_displacement(core: &RawCore, point: &Point) -> f64 {
-    let area = FRAC_PI_4 * core.plunger_diameter * core.plunger_diameter;
+    // As the reference writes it (the same rounding: `x_free` clamped is
+    // `equilibrium`'s `x` to the bit).
+    let area = PI * core.plunger_diameter.powi(2) / 4.0;
     (point.p_b - point.p_a) * area / core.spring_rate - core.preload
 }
 
@@ -749,7 +751,8 @@ impl Profile {
             let end = t + rng.uniform(120.0, 900.0);
             loop {
                 let dt = rng.uniform(20.0, 60.0);
-                if t + dt >= end {
+                // The last wander knot 20 s or more before the hold's end.
+                if t + dt + 20.0 > end {
                     break;
                 }
                 t += dt;
