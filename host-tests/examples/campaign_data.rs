@@ -110,7 +110,7 @@ fn main() -> Result<(), String> {
     let mut next_row = 0.0;
     for o in s.estimated()? {
         let r = o.second - twin(&o.estimate);
-        let near_onset = (o.t - onset).abs() <= 2.0 && (o.t * 2.0).fract() == 0.0;
+        let near_onset = fault != Fault::None && (o.t - onset).abs() <= 2.0 && (o.t * 2.0).fract() == 0.0;
         if o.t >= next_row || near_onset {
             println!(
                 "{:>9.2} {:>8.3} {:>8.3} {:>8.3} {:>13.6e} {:>13.6e} {:>+11.3e} {:>6}",
