@@ -37,11 +37,10 @@
 //!   spring force is `c (x0 + x)`), and then sits at the edge of the band:
 //!   the play (backlash) operator [`play`], clamped to the stops. Applied at
 //!   every sample: exact for a displacement monotone between samples (the
-//!   play operator is rate-independent).
-//!   Not checked against the reference dynamics: the reference solver has
-//!   no friction (its phases are free motion and the two stops; a stuck
-//!   phase anywhere in the stroke with a stick/slip event would be a new
-//!   mode of `compensator_reference::dynamics`), and is left unchanged.
+//!   play operator is rate-independent). Checked against the reference's
+//!   stiff solver with the same friction
+//!   ([`compensator_reference::dynamics::simulate_with_friction`]: stick
+//!   and slip as events) on slow ramps each way: within 1e-4 of the stroke.
 //! * **A fault is a step** at its onset time: the healthy device before, the
 //!   degraded one from then on.
 //! * **The probe** is the device file's `[probe]`: first-order lag with its

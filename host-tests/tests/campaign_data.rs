@@ -346,8 +346,7 @@ fn the_sticking_plunger_follows_the_play_operator() {
 
 #[test]
 fn the_quasi_static_truth_matches_the_reference_dynamics_on_a_slow_ramp() {
-    // The frictionless faults only: the reference's solver has no Coulomb
-    // friction (see host_tests::campaign's module docs).
+    // The frictionless faults (sticking: the next test).
     let raw = paper();
     let (from, to, rate) = (40.0, 60.0, 0.2);
     let dt = 0.1;
@@ -370,6 +369,64 @@ fn the_quasi_static_truth_matches_the_reference_dynamics_on_a_slow_ramp() {
         // 0.2 C/s is a few 1e-4 of the stroke.
         assert!(worst.0 < 1e-3 && worst.1 < 1e-3, "{fault}: {worst:?}");
     }
+}
+
+#[test]
+fn the_play_operator_matches_the_reference_dynamics_with_coulomb_friction() {
+    // The stiff solver with Coulomb friction (stick and slip as events) on
+    // a slow ramp each way: the plunger sticks until the force imbalance
+    // reaches the friction, then slides F / c behind the frictionless
+    // equilibrium, and sticks where the ramp ends.
+    let raw = paper();
+    let c = raw.core;
+    for frac in [0.02, 0.05] {
+        let fault = Fault::Sticking(frac);
+        let friction = fault.friction(&c);
+        let band = friction / c.spring_rate;
+        for (from, to) in [(40.0, 50.0), (50.0, 40.0)] {
+            let rate = 0.2;
+            let profile = dynamics::Profile::Ramp { from, to, rate };
+            let t_end = (to - from).abs() / rate + 5.0;
+            let run =
+                dynamics::simulate_with_friction(&c, profile, friction, t_end, 0.05, Method::Radau5, 1e-8).unwrap();
+            let ours = Profile::ramp(from, to, rate, 0.0);
+            let mut device = Device::new(&c, Injection { fault, onset: 0.0 }).unwrap();
+            let mut worst = 0.0f64;
+            for (t, y) in run.time.iter().zip(&run.state) {
+                let truth = device.at(*t, ours.temperature(*t));
+                worst = worst.max((truth.x - y[0]).abs() / c.stroke);
+            }
+            let end = device.at(t_end, to);
+            let x_eq = equilibrium(&c, to).x;
+            // It ends stuck a band short of the equilibrium, in the
+            // direction it came from.
+            assert!((end.x - (x_eq - band * (to - from).signum())).abs() < 1e-9 * c.stroke);
+            assert!(
+                (run.state.last().unwrap()[0] - end.x).abs() < 1e-3 * c.stroke,
+                "{fault}, {from} -> {to} C: ends at {} vs {}",
+                run.state.last().unwrap()[0],
+                end.x
+            );
+            // 5e-5 of the stroke seen (the band is 1-2.5e-2): the plunger's
+            // own lag behind the ramp.
+            assert!(worst < 2e-4, "{fault}, {from} -> {to} C: worst {worst} of the stroke");
+            assert!(
+                run.events.iter().any(|e| e.1 == dynamics::Mode::Free),
+                "{fault}: the plunger never slid"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_reference_without_friction_is_unchanged_by_the_friction_option() {
+    let raw = paper();
+    let profile = dynamics::Profile::Step { from: 30.0, to: 70.0 };
+    let a = dynamics::simulate(&raw.core, profile, 0.2, 1e-3, Method::Radau5, 1e-8).unwrap();
+    let b = dynamics::simulate_with_friction(&raw.core, profile, 0.0, 0.2, 1e-3, Method::Radau5, 1e-8).unwrap();
+    assert_eq!(a.state, b.state);
+    assert_eq!(a.events, b.events);
+    assert!(dynamics::simulate_with_friction(&raw.core, profile, -1.0, 0.2, 1e-3, Method::Radau5, 1e-8).is_err());
 }
 
 #[test]
