@@ -95,7 +95,7 @@ pub enum Fault {
     /// The preload times the factor (< 1: lost, e.g. a settled spring seat).
     PreloadLost(f64),
     /// Coulomb friction on the plunger, as a fraction of the spring force
-    /// at mid-stroke: `F = frac c (x0 + stroke / 2)` [N] (the as-built
+    /// at mid-stroke: `F = frac c (x0 + stroke / 2)` \[N\] (the as-built
     /// device's `c`, `x0`).
     Sticking(f64),
     /// The second sensor's reading offset by this fraction of its span (a
@@ -221,7 +221,7 @@ impl Fault {
         c
     }
 
-    /// The Coulomb friction force on the plunger of `core` [N]: `frac c (x0
+    /// The Coulomb friction force on the plunger of `core` \[N\]: `frac c (x0
     /// + stroke / 2)` for [`Fault::Sticking`], 0 otherwise.
     pub fn friction(&self, core: &RawCore) -> f64 {
         match *self {
@@ -230,7 +230,7 @@ impl Fault {
         }
     }
 
-    /// The offset of `sensor`'s reading [its unit]: `frac (max - min)` for
+    /// The offset of `sensor`'s reading \[its unit\]: `frac (max - min)` for
     /// [`Fault::SensorOffset`], 0 otherwise.
     pub fn offset(&self, sensor: &SecondSensor) -> f64 {
         match *self {
@@ -256,12 +256,12 @@ impl fmt::Display for Fault {
 }
 
 /// A fault and when it starts: the healthy device before `onset`, the
-/// degraded one from `onset` on [s].
+/// degraded one from `onset` on \[s\].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Injection {
     /// The fault.
     pub fault: Fault,
-    /// Its onset `t_fault` [s].
+    /// Its onset `t_fault` \[s\].
     pub onset: f64,
 }
 
@@ -272,7 +272,7 @@ impl Injection {
         onset: f64::INFINITY,
     };
 
-    /// Whether the fault is present at `t` [s] (never for [`Fault::None`]).
+    /// Whether the fault is present at `t` \[s\] (never for [`Fault::None`]).
     pub fn active(&self, t: f64) -> bool {
         self.fault != Fault::None && t >= self.onset
     }
@@ -281,19 +281,19 @@ impl Injection {
 /// The true state of the device at a sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Truth {
-    /// Chamber (a) pressure [Pa].
+    /// Chamber (a) pressure \[Pa\].
     pub p_a: f64,
-    /// Chamber (b) pressure [Pa].
+    /// Chamber (b) pressure \[Pa\].
     pub p_b: f64,
-    /// Plunger displacement, within the stops [m].
+    /// Plunger displacement, within the stops \[m\].
     pub x: f64,
     /// The frictionless displacement `A (p_b - p_a) / c - x0`, not clamped
-    /// to the stops [m].
+    /// to the stops \[m\].
     pub x_free: f64,
 }
 
 impl Truth {
-    /// The value `quantity` measures [Pa or m].
+    /// The value `quantity` measures \[Pa or m\].
     pub fn value(&self, quantity: Quantity) -> f64 {
         match quantity {
             Quantity::PA => self.p_a,
@@ -305,7 +305,7 @@ impl Truth {
 }
 
 /// The frictionless displacement of `core` at the equilibrium pressures of
-/// `point`, not clamped to the stops: `A (p_b - p_a) / c - x0` [m] (the
+/// `point`, not clamped to the stops: `A (p_b - p_a) / c - x0` \[m\] (the
 /// reference's spring force is `c (x0 + x)`).
 pub fn free_displacement(core: &RawCore, point: &Point) -> f64 {
     // As the reference writes it (the same rounding: `x_free` clamped is
@@ -315,8 +315,8 @@ pub fn free_displacement(core: &RawCore, point: &Point) -> f64 {
 }
 
 /// The quasi-static Coulomb friction law: the play (backlash) operator of
-/// half-width `band = F / c` [m] on the frictionless displacement `x_free`
-/// [m], from the plunger's last position `x_prev` [m], clamped to the
+/// half-width `band = F / c` \[m\] on the frictionless displacement `x_free`
+/// \[m\], from the plunger's last position `x_prev` \[m\], clamped to the
 /// stops `[0, stroke]`.
 pub fn play(x_prev: f64, x_free: f64, band: f64, stroke: f64) -> f64 {
     x_prev.clamp(x_free - band, x_free + band).clamp(0.0, stroke)
@@ -333,7 +333,7 @@ pub struct Device {
     pub faulty: RawCore,
     /// The injection.
     pub injection: Injection,
-    /// The Coulomb friction with the fault [N].
+    /// The Coulomb friction with the fault \[N\].
     pub friction: f64,
     x: Option<f64>,
 }
@@ -360,7 +360,7 @@ impl Device {
         })
     }
 
-    /// The device's fields at `t` [s].
+    /// The device's fields at `t` \[s\].
     pub fn core_at(&self, t: f64) -> &RawCore {
         if self.injection.active(t) {
             &self.faulty
@@ -369,7 +369,7 @@ impl Device {
         }
     }
 
-    /// The state at `t` [s] with the oil at `t_oil` [C]: the reference
+    /// The state at `t` \[s\] with the oil at `t_oil` \[C\]: the reference
     /// equilibrium of the device at `t`, the displacement through the
     /// friction law from the last call's (calls in time order).
     pub fn at(&mut self, t: f64, t_oil: f64) -> Truth {
@@ -441,13 +441,13 @@ pub fn as_built(nominal: &RawCore, rng: &mut Rng) -> RawCore {
 /// What the second sensor measures.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Quantity {
-    /// Chamber (a) pressure [Pa].
+    /// Chamber (a) pressure \[Pa\].
     PA,
-    /// Chamber (b) pressure [Pa].
+    /// Chamber (b) pressure \[Pa\].
     PB,
-    /// `p_b - p_a` [Pa] (a differential transducer).
+    /// `p_b - p_a` \[Pa\] (a differential transducer).
     DPAB,
-    /// Plunger displacement [m] (an LVDT or an eddy-current sensor).
+    /// Plunger displacement \[m\] (an LVDT or an eddy-current sensor).
     X,
 }
 
@@ -484,14 +484,14 @@ impl Quantity {
 pub struct SecondSensor {
     /// What it measures.
     pub quantity: Quantity,
-    /// Standard deviation of one reading's white noise [Pa or m].
+    /// Standard deviation of one reading's white noise \[Pa or m\].
     pub noise_sd: f64,
     /// Accuracy class: the fixed error's limit, as a fraction of the span
     /// (0.001: class 0.1); each device's offset is uniform within it.
     pub accuracy: f64,
-    /// Measuring range `(min, max)` [Pa or m]: the ADC's span.
+    /// Measuring range `(min, max)` \[Pa or m\]: the ADC's span.
     pub span: (f64, f64),
-    /// Readings per second [Hz] (rounded to a whole number of estimator
+    /// Readings per second \[Hz\] (rounded to a whole number of estimator
     /// ticks between readings).
     pub rate_hz: f64,
 }
@@ -520,17 +520,17 @@ impl SecondSensor {
         }
     }
 
-    /// `max - min` [Pa or m].
+    /// `max - min` \[Pa or m\].
     pub fn width(&self) -> f64 {
         self.span.1 - self.span.0
     }
 
-    /// One ADC step [Pa or m]: the span over `2^12 - 1` steps.
+    /// One ADC step \[Pa or m\]: the span over `2^12 - 1` steps.
     pub fn lsb(&self) -> f64 {
         self.width() / f64::from((1u32 << Self::ADC_BITS) - 1)
     }
 
-    /// `v` [Pa or m] as the ADC reports it: rounded to the nearest code,
+    /// `v` \[Pa or m\] as the ADC reports it: rounded to the nearest code,
     /// saturated at the span's ends.
     pub fn quantise(&self, v: f64) -> f64 {
         let full = f64::from((1u32 << Self::ADC_BITS) - 1);
@@ -559,7 +559,7 @@ impl Converter {
         }
     }
 
-    /// The reading [C] of an element at `t` [C] (NaN where the curve has
+    /// The reading \[C\] of an element at `t` \[C\] (NaN where the curve has
     /// none).
     pub fn quantise(&self, t: f64) -> f64 {
         let r = match self {
@@ -584,14 +584,14 @@ pub struct Probe {
     pub class: f64,
     /// The converter.
     pub converter: Converter,
-    /// The well's temperature [C] (the oil's without a well).
+    /// The well's temperature \[C\] (the oil's without a well).
     pub well: f64,
-    /// The element's temperature [C].
+    /// The element's temperature \[C\].
     pub element: f64,
 }
 
 impl Probe {
-    /// A probe settled at `t` [C].
+    /// A probe settled at `t` \[C\].
     pub fn new(raw: &RawParams, class: f64, t: f64) -> Probe {
         Probe {
             spec: raw.probe,
@@ -602,8 +602,8 @@ impl Probe {
         }
     }
 
-    /// Advances the lags by `dt` [s] with the oil linear over it, `oil0 +
-    /// slope t` [C, C/s]: exact without a well; with one, the well's output
+    /// Advances the lags by `dt` \[s\] with the oil linear over it, `oil0 +
+    /// slope t` \[C, C/s\]: exact without a well; with one, the well's output
     /// is taken linear over steps of at most a hundredth of the shorter
     /// time constant.
     pub fn advance(&mut self, oil0: f64, slope: f64, dt: f64) {
@@ -626,7 +626,7 @@ impl Probe {
         }
     }
 
-    /// Advances the lags from `t0` to `t1` [s] through `profile`, piece by
+    /// Advances the lags from `t0` to `t1` \[s\] through `profile`, piece by
     /// piece of its piecewise-linear history.
     pub fn advance_through(&mut self, profile: &Profile, t0: f64, t1: f64) {
         let mut s = t0;
@@ -638,12 +638,12 @@ impl Probe {
         }
     }
 
-    /// The element's temperature with this probe's fixed error [C].
+    /// The element's temperature with this probe's fixed error \[C\].
     pub fn biased(&self) -> f64 {
         self.element + self.class * self.spec.tolerance_at(self.element)
     }
 
-    /// One reading [C]: the element, its fixed error, noise, the converter.
+    /// One reading \[C\]: the element, its fixed error, noise, the converter.
     pub fn read(&self, rng: &mut Rng) -> f64 {
         self.converter.quantise(self.biased() + self.spec.noise * normal(rng))
     }
@@ -658,7 +658,7 @@ pub struct Profile {
     warmed_up: f64,
 }
 
-/// Amplitude of the wander of a hold around its level [C].
+/// Amplitude of the wander of a hold around its level \[C\].
 pub const WANDER: f64 = 0.5;
 
 impl Profile {
@@ -680,7 +680,7 @@ impl Profile {
         Ok(Profile { knots, warmed_up: 0.0 })
     }
 
-    /// The oil held at `t` [C].
+    /// The oil held at `t` \[C\].
     pub fn hold(t: f64) -> Profile {
         Profile {
             knots: vec![(0.0, t)],
@@ -688,7 +688,7 @@ impl Profile {
         }
     }
 
-    /// At `from` until `t0`, then at `to` [C, s].
+    /// At `from` until `t0`, then at `to` \[C, s\].
     pub fn step(from: f64, to: f64, t0: f64) -> Profile {
         Profile {
             knots: vec![(0.0, from), (t0, from), (t0, to)],
@@ -696,7 +696,7 @@ impl Profile {
         }
     }
 
-    /// At `from` until `t0`, then ramping at `rate` [C/s] to `to`.
+    /// At `from` until `t0`, then ramping at `rate` \[C/s\] to `to`.
     pub fn ramp(from: f64, to: f64, rate: f64, t0: f64) -> Profile {
         Profile {
             knots: vec![(0.0, from), (t0, from), (t0 + (to - from).abs() / rate, to)],
@@ -705,7 +705,7 @@ impl Profile {
     }
 
     /// Seeded "ordinary operation" within `range` = (`valid_min`,
-    /// `valid_max`) [C] for `duration` [s]:
+    /// `valid_max`) \[C\] for `duration` \[s\]:
     ///
     /// * a cold start at 20-30 C (raised to the range's bottom, uniform in
     ///   `max(20, lo) .. max(30, lo + 4)`), held 10-60 s, warming at
@@ -792,7 +792,7 @@ impl Profile {
         Profile::ordinary(range, 86_400.0, seed)
     }
 
-    /// Cuts the history at `t_end` [s] (a knot there).
+    /// Cuts the history at `t_end` \[s\] (a knot there).
     fn truncate(&mut self, t_end: f64) {
         let v = self.temperature(t_end);
         self.knots.retain(|k| k.0 < t_end);
@@ -804,25 +804,25 @@ impl Profile {
         &self.knots
     }
 
-    /// When the first warm-up reaches the working temperature [s] (0 for a
+    /// When the first warm-up reaches the working temperature \[s\] (0 for a
     /// history without one); a campaign's onsets come after it.
     pub fn warmed_up(&self) -> f64 {
         self.warmed_up
     }
 
-    /// The last knot's time [s].
+    /// The last knot's time \[s\].
     pub fn end(&self) -> f64 {
         self.knots.last().map_or(0.0, |k| k.0)
     }
 
-    /// The lowest and highest temperature [C].
+    /// The lowest and highest temperature \[C\].
     pub fn extent(&self) -> (f64, f64) {
         self.knots
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), k| (l.min(k.1), h.max(k.1)))
     }
 
-    /// The largest rate of change [C/s] (jumps left out).
+    /// The largest rate of change \[C/s\] (jumps left out).
     pub fn max_rate(&self) -> f64 {
         self.knots
             .windows(2)
@@ -831,13 +831,13 @@ impl Profile {
             .fold(0.0, f64::max)
     }
 
-    /// The temperature at `t` [s] [C] (after a jump at `t`: the new value).
+    /// The temperature at `t` \[s\] \[C\] (after a jump at `t`: the new value).
     pub fn temperature(&self, t: f64) -> f64 {
         self.piece(t).0
     }
 
-    /// The piece in force at `t` [s]: the temperature there [C], its slope
-    /// [C/s], and the time the piece ends [s] (infinite after the last knot).
+    /// The piece in force at `t` \[s\]: the temperature there \[C\], its slope
+    /// \[C/s\], and the time the piece ends \[s\] (infinite after the last knot).
     pub fn piece(&self, t: f64) -> (f64, f64, f64) {
         let k = &self.knots;
         let i = k.partition_point(|q| q.0 <= t);
@@ -858,14 +858,14 @@ impl Profile {
 pub struct Sample {
     /// The estimator tick it falls on (`t = tick / estimator.tick_hz`).
     pub tick: u64,
-    /// Time [s].
+    /// Time \[s\].
     pub t: f64,
-    /// The oil's true temperature [C].
+    /// The oil's true temperature \[C\].
     pub t_true: f64,
-    /// The probe's reading [C], on the ticks it is due (NaN: a value the
+    /// The probe's reading \[C\], on the ticks it is due (NaN: a value the
     /// converter cannot report).
     pub probe: Option<f64>,
-    /// The second sensor's reading [Pa or m], on the ticks it is due.
+    /// The second sensor's reading \[Pa or m\], on the ticks it is due.
     pub second: Option<f64>,
     /// The device's true state.
     pub truth: Truth,
@@ -887,21 +887,21 @@ pub struct Scenario {
     pub injection: Injection,
     /// The oil temperature history.
     pub profile: Profile,
-    /// How long the records run [s].
+    /// How long the records run \[s\].
     pub duration: f64,
     /// The second sensor.
     pub sensor: SecondSensor,
     /// The probe within its tolerance, `[-1, 1]` ([`Probe::class`]).
     pub probe_class: f64,
-    /// The second sensor's fixed offset [Pa or m], within its accuracy.
+    /// The second sensor's fixed offset \[Pa or m\], within its accuracy.
     pub sensor_offset: f64,
-    /// The seed of the noises.
+    /// The seeds of the probe's and the second sensor's noise.
     pub noise_seed: (u64, u64),
 }
 
 impl Scenario {
     /// The run of `nominal` with the second sensor `sensor`, `injection`,
-    /// the history `profile` for `duration` [s], from `seed`: the device
+    /// the history `profile` for `duration` \[s\], from `seed`: the device
     /// drawn as built, the probe's place within its tolerance, the sensor's
     /// offset within its class, the seeds of the two noises, each from its
     /// own stream of `seed`.
@@ -933,7 +933,7 @@ impl Scenario {
 
     /// [`Scenario::new`] with the default sensor for `quantity` and
     /// ordinary operation ([`Profile::ordinary`] over the nominal's
-    /// validated range) for `duration` [s], from `seed`.
+    /// validated range) for `duration` \[s\], from `seed`.
     pub fn ordinary(
         nominal: &RawParams,
         quantity: Quantity,
@@ -1016,7 +1016,7 @@ pub struct Records {
 }
 
 impl Records {
-    /// The estimator's tick [s].
+    /// The estimator's tick \[s\].
     pub fn tick(&self) -> f64 {
         self.tick
     }
@@ -1027,7 +1027,7 @@ impl Records {
         (self.probe_every, self.second_every)
     }
 
-    /// The second sensor's reading of `truth` at `t` [s].
+    /// The second sensor's reading of `truth` at `t` \[s\].
     fn read_second(&mut self, truth: &Truth, t: f64) -> f64 {
         let fault = if self.device.injection.active(t) {
             self.fault_offset
@@ -1076,13 +1076,13 @@ impl Iterator for Records {
 /// What the monitor consumes per second-sensor reading.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Observation {
-    /// Time [s].
+    /// Time \[s\].
     pub t: f64,
-    /// The oil's true temperature [C].
+    /// The oil's true temperature \[C\].
     pub t_true: f64,
-    /// The estimator's oil temperature after this tick [C].
+    /// The estimator's oil temperature after this tick \[C\].
     pub t_estimated: f64,
-    /// The second sensor's reading [Pa or m].
+    /// The second sensor's reading \[Pa or m\].
     pub second: f64,
     /// The device's true state.
     pub truth: Truth,
