@@ -479,6 +479,20 @@ fn the_probe_lags_as_exp_minus_t_over_tau() {
     }
     // Every 20 ms (50 Hz mains).
     assert_eq!(readings, 1501);
+
+    // An NTC on the ADC: its readings within its own resolution.
+    let mut raw = host_tests::soak::paper_ntc();
+    raw.probe.noise = 0.0;
+    let mut s = Scenario::ordinary(&raw, Quantity::X, Injection::HEALTHY, 5.0, 2);
+    s.profile = Profile::hold(50.0);
+    s.probe_class = 0.0;
+    let resolution = raw.estimator.resolution(50.0);
+    let mut readings = 0;
+    for y in s.records().unwrap().filter_map(|r| r.probe) {
+        assert!((y - 50.0).abs() <= 0.6 * resolution, "{y} for 50 C");
+        readings += 1;
+    }
+    assert!(readings > 100);
 }
 
 #[test]
