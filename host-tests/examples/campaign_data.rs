@@ -26,7 +26,7 @@
 //! fault is present. At the end, the residual's statistics before and
 //! after the onset.
 
-use host_tests::campaign::{Fault, Injection, Quantity, Scenario, design};
+use host_tests::campaign::{Fault, Injection, Quantity, Scenario, design, onset_after_warm_up};
 use std::time::Instant;
 
 fn main() -> Result<(), String> {
@@ -50,14 +50,10 @@ fn main() -> Result<(), String> {
     let duration = hours * 3600.0;
 
     // The history first, for the onset after its warm-up.
-    let probe_run = Scenario::ordinary(&raw, quantity, Injection::HEALTHY, duration, seed);
-    let warm = probe_run.profile.warmed_up();
-    let onset = if warm + 600.0 < duration {
-        warm + 600.0
-    } else {
-        0.5 * duration
-    };
-    let s = Scenario::ordinary(&raw, quantity, Injection { fault, onset }, duration, seed);
+    let mut s = Scenario::ordinary(&raw, quantity, Injection::HEALTHY, duration, seed);
+    let warm = s.profile.warmed_up();
+    let onset = onset_after_warm_up(&s.profile, duration);
+    s.injection = Injection { fault, onset };
 
     let (lo, hi) = s.profile.extent();
     let c = &s.nominal.core;

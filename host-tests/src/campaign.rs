@@ -987,6 +987,30 @@ impl Scenario {
     }
 }
 
+/// An onset after the history's warm-up: ten minutes after it reaches the
+/// working temperature, or half-way through a run too short for that \[s\].
+pub fn onset_after_warm_up(profile: &Profile, duration: f64) -> f64 {
+    let t = profile.warmed_up() + 600.0;
+    if t < duration { t } else { 0.5 * duration }
+}
+
+/// One scenario per fault of [`Fault::CATALOGUE`] for `nominal` with the
+/// default second sensor for `quantity`, ordinary operation for `duration`
+/// \[s\], the onset [`onset_after_warm_up`], all from `seed`: the same
+/// device, history, offsets and noises in each, only the fault differs (a
+/// paired comparison; [`Fault::None`] first, the false-alarm baseline).
+pub fn catalogue(nominal: &RawParams, quantity: Quantity, duration: f64, seed: u64) -> Vec<Scenario> {
+    let base = Scenario::ordinary(nominal, quantity, Injection::HEALTHY, duration, seed);
+    let onset = onset_after_warm_up(&base.profile, duration);
+    Fault::CATALOGUE
+        .iter()
+        .map(|&fault| Scenario {
+            injection: Injection { fault, onset },
+            ..base.clone()
+        })
+        .collect()
+}
+
 /// Independent seeds of a scenario's parts, from `seed`: device, history,
 /// per-device draws, probe noise, sensor noise.
 fn streams(seed: u64) -> [u64; 5] {

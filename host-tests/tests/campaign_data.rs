@@ -8,8 +8,8 @@
 use compensator::params::{RawCore, RawParams};
 use compensator_reference::dynamics::{self, Method};
 use host_tests::campaign::{
-    Device, Fault, Injection, Probe, Profile, Quantity, SPREAD, Scenario, SecondSensor, Truth, as_built, design,
-    free_displacement, play,
+    Device, Fault, Injection, Probe, Profile, Quantity, SPREAD, Scenario, SecondSensor, Truth, as_built, catalogue,
+    design, free_displacement, play,
 };
 use host_tests::random::Rng;
 use host_tests::reference::equilibrium;
@@ -589,6 +589,32 @@ fn the_records_are_deterministic_per_seed() {
     assert_ne!(a.0, c.0);
     assert_ne!(a.1, c.1);
     assert_ne!(a.2, c.2);
+}
+
+#[test]
+fn a_catalogue_pairs_every_fault_on_one_device_and_history() {
+    let raw = design(4);
+    let runs = catalogue(&raw, Quantity::X, 3600.0, 12);
+    assert_eq!(runs.len(), Fault::CATALOGUE.len());
+    assert_eq!(runs[0].injection.fault, Fault::None);
+    let onset = runs[0].injection.onset;
+    assert!(onset > runs[0].profile.warmed_up() && onset < 3600.0);
+    for r in &runs {
+        assert_eq!(r.device, runs[0].device);
+        assert_eq!(r.profile, runs[0].profile);
+        assert_eq!(
+            (r.probe_class, r.sensor_offset, r.noise_seed),
+            (runs[0].probe_class, runs[0].sensor_offset, runs[0].noise_seed)
+        );
+        assert_eq!(r.injection.onset, onset);
+    }
+    // Before the onset the records of every fault are the healthy ones (the
+    // first five minutes compared).
+    let before = |s: &Scenario| -> Vec<_> { s.records().unwrap().take_while(|r| r.t < onset.min(300.0)).collect() };
+    let healthy = before(&runs[0]);
+    for r in &runs[1..] {
+        assert_eq!(before(r), healthy, "{}", r.injection.fault);
+    }
 }
 
 #[test]
