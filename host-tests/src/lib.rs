@@ -9,6 +9,7 @@ pub mod accuracy;
 pub mod band;
 pub mod bench;
 pub mod board;
+pub mod campaign;
 pub mod coverage;
 pub mod fixed_audit;
 pub mod identify_study;

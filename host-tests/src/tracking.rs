@@ -49,6 +49,14 @@ pub struct Run {
     pub reading_lag: f64,
 }
 
+/// A first-order lag `tc dy/dt = u - y` advanced by `dt` [s] exactly for
+/// an input linear over the step, `u(t) = u0 + slope t`: the probe's
+/// (and its well's) response, as the host runs simulate it.
+pub fn lag_step(y: f64, u0: f64, slope: f64, tc: f64, dt: f64) -> f64 {
+    let e = (-dt / tc).exp();
+    u0 + slope * dt - slope * tc + (y - u0 + slope * tc) * e
+}
+
 /// One run of `raw` (its `[probe]`) from `from` to `to` [C] at `rate`
 /// [C/s], noise and quantization from the file, from `seed`.
 pub fn run(raw: &RawParams, from: f64, to: f64, rate: f64, seed: u64) -> Result<Run, String> {
@@ -110,16 +118,13 @@ fn run_traced(raw: &RawParams, from: f64, to: f64, rate: f64, seed: u64, trace: 
         let t0 = k as f64 * tick;
         let (oil0, oil1) = (profile.temperature(t0), profile.temperature(t0 + tick));
         let slope = (oil1 - oil0) / tick;
-        let lag_step = |y: f64, u0: f64, s: f64, tc: f64| {
-            let e = (-tick / tc).exp();
-            u0 + s * tick - s * tc + (y - u0 + s * tc) * e
-        };
+        let advance = |y: f64, u0: f64, s: f64, tc: f64| lag_step(y, u0, s, tc, tick);
         if tau_w > 0.0 {
             let w0 = well;
-            well = lag_step(well, oil0, slope, tau_w);
-            probe = lag_step(probe, w0, (well - w0) / tick, tau);
+            well = advance(well, oil0, slope, tau_w);
+            probe = advance(probe, w0, (well - w0) / tick, tau);
         } else {
-            probe = lag_step(probe, oil0, slope, tau);
+            probe = advance(probe, oil0, slope, tau);
         }
         let r = if (settle + k).is_multiple_of(u64::from(every)) {
             Ok(Some(read(probe, &mut rng)?))

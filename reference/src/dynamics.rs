@@ -22,6 +22,10 @@
 //!
 //! integrated with the compensator as one stiff system.
 //!
+//! With Coulomb friction ([`simulate_with_friction`]) the plunger's
+//! equation gains `- F sign(v)`; a plunger at rest stays while `|force| <=
+//! F` ([`Mode::Stuck`]), each reversal of its speed is an event.
+//!
 //! The end stops are events: in free motion the solver stops exactly where
 //! `x` reaches a stop (inelastic: `v = 0`, then held if the static force
 //! pushes into the stop); while held it stops where the force changes sign
@@ -241,6 +245,9 @@ pub enum Mode {
     Closed,
     /// Held at `x = x_max`.
     Open,
+    /// Held where it is by Coulomb friction (only with friction,
+    /// [`simulate_with_friction`]).
+    Stuck,
 }
 
 /// The model at a fixed mode, over one piece of the port pressures. The
@@ -254,6 +261,11 @@ pub struct Fsi {
     mode: Mode,
     segment: Segment,
     load: Option<Load>,
+    /// Coulomb friction on the plunger [N] (0: none).
+    friction: f64,
+    /// The direction of sliding in free motion with friction (+1 towards
+    /// `x_max`, -1 back; the friction force is `-friction slide`).
+    slide: f64,
 }
 
 /// State `(x [m], v [m/s], p_a [Pa], p_b [Pa])`, and `p_c` [Pa] fifth in
@@ -313,6 +325,7 @@ impl<const N: usize> ODE<f64, State<N>> for Fsi {
             Mode::Free => (y[0], y[1]),
             Mode::Closed => (0.0, 0.0),
             Mode::Open => (p.stroke, 0.0),
+            Mode::Stuck => (y[0], 0.0),
         };
         let c_a = (p.volume_a - area * x) / p.bulk_modulus;
         let c_b = (p.volume_b + area * x) / p.bulk_modulus;
@@ -320,7 +333,7 @@ impl<const N: usize> ODE<f64, State<N>> for Fsi {
         d[3] = ((pp - y[3]) / r_l - self.orifice(y[3] - pc, rho) - area * v) / c_b;
         if self.mode == Mode::Free {
             d[0] = v;
-            d[1] = (self.force(y) - p.damping * v) / p.mass;
+            d[1] = (self.force(y) - p.damping * v - self.friction * self.slide) / p.mass;
         } else {
             d[0] = 0.0;
             d[1] = 0.0;
@@ -333,6 +346,19 @@ impl<const N: usize> ODE<f64, State<N>> for Fsi {
         }
     }
 }
+
+/// Time that turns the plunger's speed into a length for the event
+/// function of free motion with friction (its reversal, beside the stops)
+/// [s]: only the sign matters.
+const SPEED_SCALE: f64 = 1e-3;
+
+/// Hysteresis of the friction law, relative to the friction: a plunger at
+/// rest is released when the force exceeds the friction by twice this,
+/// one whose speed reverses sticks when the force is within once this.
+/// A plunger that slid to rest sits exactly at the threshold; without the
+/// margin a rounding of the force releases it and it sticks again at
+/// once, over and over.
+const STICTION_MARGIN: f64 = 1e-6;
 
 /// Output handler of one phase: records samples on the output grid from
 /// the dense output, and stops exactly at the phase's event.
@@ -350,10 +376,17 @@ struct Phase<'a, const N: usize> {
 impl<const N: usize> Phase<'_, N> {
     /// Event function and the crossing direction that ends the phase.
     fn g(&self, y: &State<N>) -> (f64, f64) {
+        let f = self.sys.friction * (1.0 + 2.0 * STICTION_MARGIN);
         match self.sys.mode {
+            Mode::Free if f > 0.0 => (
+                y[0].min(self.sys.p.stroke - y[0])
+                    .min(self.sys.slide * y[1] * SPEED_SCALE),
+                -1.0,
+            ),
             Mode::Free => (y[0].min(self.sys.p.stroke - y[0]), -1.0),
-            Mode::Closed => (self.sys.force(y), 1.0),
-            Mode::Open => (self.sys.force(y), -1.0),
+            Mode::Closed => (self.sys.force(y) - f, 1.0),
+            Mode::Open => (self.sys.force(y) + f, -1.0),
+            Mode::Stuck => (self.sys.force(y).abs() - f, 1.0),
         }
     }
 }
@@ -490,13 +523,15 @@ pub struct Trajectory {
 
 /// The equilibrium state `(x, 0, p_a, p_b)` at temperature `t` [C] and its mode.
 pub fn equilibrium(p: &RawCore, t: f64) -> ([f64; 4], Mode) {
-    let (y, mode) = equilibrium_at(p, t, p.outlet_pressure + p.pressure_drop, p.outlet_pressure);
+    let (y, mode) = equilibrium_at(p, t, p.outlet_pressure + p.pressure_drop, p.outlet_pressure, 0.0);
     ([y[0], y[1], y[2], y[3]], mode)
 }
 
 /// The equilibrium state `(x, 0, p_a, p_b, p_c)` at temperature `t` [C]
 /// with supply and outlet pressures `pp`, `pc` [Pa] (`pp > pc`), and its mode.
-fn equilibrium_at(p: &RawCore, t: f64, pp: f64, pc: f64) -> ([f64; 5], Mode) {
+/// With Coulomb friction `friction` [N] a plunger at rest inside the stroke
+/// is [`Mode::Stuck`].
+fn equilibrium_at(p: &RawCore, t: f64, pp: f64, pc: f64, friction: f64) -> ([f64; 5], Mode) {
     let at = RawCore {
         pressure_drop: pp - pc,
         outlet_pressure: pc,
@@ -510,12 +545,16 @@ fn equilibrium_at(p: &RawCore, t: f64, pp: f64, pc: f64) -> ([f64; 5], Mode) {
         mode: Mode::Free,
         segment: Ports::Fixed.segment(p, 0.0),
         load: None,
+        friction: 0.0,
+        slide: 0.0,
     };
     let f = sys.force(&y);
     let mode = if e.x <= 0.0 && f <= 0.0 {
         Mode::Closed
     } else if e.x >= p.stroke && f >= 0.0 {
         Mode::Open
+    } else if friction > 0.0 {
+        Mode::Stuck
     } else {
         Mode::Free
     };
@@ -581,16 +620,45 @@ pub fn simulate_with(
     rtol: f64,
 ) -> Result<Trajectory, String> {
     if ports.load().is_some() {
-        run::<5>(p, profile, ports, t_end, dt, method, rtol)
+        run::<5>(p, profile, ports, 0.0, t_end, dt, method, rtol)
     } else {
-        run::<4>(p, profile, ports, t_end, dt, method, rtol)
+        run::<4>(p, profile, ports, 0.0, t_end, dt, method, rtol)
     }
 }
 
+/// As [`simulate`], with Coulomb friction `friction` [N] on the plunger
+/// (equal static and kinetic): at rest it stays ([`Mode::Stuck`]) while the
+/// net static force's magnitude is at most `friction`; sliding, the
+/// friction opposes the motion, and each reversal of the speed is an event
+/// (a phase ends there, the plunger sticks or slides back). A stop holds
+/// it until the force away from the stop exceeds the friction. From the
+/// equilibrium at the profile's start (stuck where it is, inside the
+/// stroke).
+///
+/// # Errors
+///
+/// As [`simulate`]; a negative or non-finite friction.
+pub fn simulate_with_friction(
+    p: &RawCore,
+    profile: Profile,
+    friction: f64,
+    t_end: f64,
+    dt: f64,
+    method: Method,
+    rtol: f64,
+) -> Result<Trajectory, String> {
+    if !(friction >= 0.0 && friction.is_finite()) {
+        return Err(format!("friction {friction} N: not a force"));
+    }
+    run::<4>(p, profile, &Ports::Fixed, friction, t_end, dt, method, rtol)
+}
+
+#[allow(clippy::too_many_arguments, reason = "the public entry points fix the arguments")]
 fn run<const N: usize>(
     p: &RawCore,
     profile: Profile,
     ports: &Ports,
+    friction: f64,
     t_end: f64,
     dt: f64,
     method: Method,
@@ -623,7 +691,8 @@ fn run<const N: usize>(
             start.0
         ));
     }
-    let (y5, mut mode) = equilibrium_at(p, profile.start(), start.0, outlet0);
+    let (y5, mut mode) = equilibrium_at(p, profile.start(), start.0, outlet0, friction);
+    let mut slide = 0.0;
     let mut y: State<N> = [0.0; N];
     for (a, b) in y.iter_mut().zip(y5) {
         *a = b;
@@ -635,6 +704,8 @@ fn run<const N: usize>(
         mode,
         segment: ports.segment(p, 0.0),
         load: ports.load(),
+        friction,
+        slide,
     };
     let (ports0, q0) = sample(&first, 0.0, &y);
     let mut out = Trajectory {
@@ -668,6 +739,8 @@ fn run<const N: usize>(
             mode,
             segment: ports.segment(p, t),
             load: ports.load(),
+            friction,
+            slide,
         };
         let mut phase = Phase {
             sys: &sys,
@@ -725,20 +798,44 @@ fn run<const N: usize>(
         if let Some((te, mut ye)) = phase.event {
             t = te;
             mode = match mode {
+                // With friction: the speed reversed inside the stroke
+                // (nearer its zero than either stop).
+                Mode::Free if friction > 0.0 && (ye[1] * SPEED_SCALE).abs() <= ye[0].min(p.stroke - ye[0]).abs() => {
+                    ye[1] = 0.0;
+                    let f = sys.force(&ye);
+                    if f.abs() <= friction * (1.0 + STICTION_MARGIN) {
+                        Mode::Stuck
+                    } else {
+                        slide = f.signum();
+                        Mode::Free
+                    }
+                }
                 Mode::Free => {
                     let low = ye[0] < 0.5 * p.stroke;
                     ye[0] = if low { 0.0 } else { p.stroke };
                     ye[1] = 0.0;
                     let f = sys.force(&ye);
-                    if low && f <= 0.0 {
+                    if low && f <= friction {
                         Mode::Closed
-                    } else if !low && f >= 0.0 {
+                    } else if !low && f >= -friction {
                         Mode::Open
                     } else {
+                        slide = if low { 1.0 } else { -1.0 };
                         Mode::Free
                     }
                 }
-                Mode::Closed | Mode::Open => Mode::Free,
+                Mode::Closed => {
+                    slide = 1.0;
+                    Mode::Free
+                }
+                Mode::Open => {
+                    slide = -1.0;
+                    Mode::Free
+                }
+                Mode::Stuck => {
+                    slide = sys.force(&ye).signum();
+                    Mode::Free
+                }
             };
             y = ye;
             out.events.push((t, mode));

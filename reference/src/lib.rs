@@ -7,7 +7,8 @@
 //!   chamber's flow balance (no closed form).
 //! * [`dynamics`]: the FSI model integrated by an adaptive stiff solver
 //!   (Radau IIA order 5, `differential-equations`) with exact location of
-//!   the end-stop events, and the same with the explicit Dormand-Prince
+//!   the end-stop events (and, optionally, Coulomb friction with its stick
+//!   and slip events), and the same with the explicit Dormand-Prince
 //!   8(5,3) method as an unrelated cross-check.
 
 #[cfg(feature = "dynamics")]
