@@ -14,6 +14,7 @@ pub mod coverage;
 pub mod fixed_audit;
 pub mod identify_study;
 pub mod matrix;
+pub mod monitor_campaign;
 pub mod observability;
 pub mod probe;
 pub mod random;

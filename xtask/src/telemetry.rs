@@ -281,6 +281,7 @@ mod tests {
                 q_total: 9.7e-7,
                 compensation_error: 2.1e-7,
             },
+            health: compensator::monitor::HealthEstimate::NONE,
             flags,
         }
     }

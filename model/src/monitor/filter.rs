@@ -87,8 +87,8 @@ impl HealthFilter {
             ph[i] = row.iter().zip(h).map(|(a, b)| a * b).sum();
         }
         let inv = 1.0 / s;
-        for i in 0..PARAMETERS {
-            self.theta[i] += ph[i] * inv * nu;
+        for (theta, k) in self.theta.iter_mut().zip(&ph) {
+            *theta += k * inv * nu;
         }
         for i in 0..PARAMETERS {
             for j in 0..=i {
@@ -155,8 +155,8 @@ mod tests {
             let pred: f32 = h.iter().zip(&f.theta()).map(|(a, b)| a * b).sum();
             f.update(&h, y - pred, s);
         }
-        for i in 0..PARAMETERS {
-            assert!((f.theta()[i] - truth[i]).abs() < 1e-3, "{i}: {:?}", f.theta());
+        for (got, want) in f.theta().iter().zip(&truth) {
+            assert!((got - want).abs() < 1e-3, "{:?}", f.theta());
         }
     }
 }

@@ -566,8 +566,8 @@ impl Monitor {
     }
 
     /// Adds a reading to the isolation sums. A fault's signature is the
-    /// secant of the reading over the fault's size fitted so far (`(h(theta
-    /// + delta e_k) - h(theta)) / delta`, the derivative while the size is
+    /// secant of the reading over the fault's size fitted so far
+    /// (`(h(theta + delta e_k) - h(theta)) / delta`, the derivative while the size is
     /// not yet known): the reading is not linear in the divider or the
     /// spring over a fault's size, and the derivative's shape at the old
     /// parameters would favour the wrong fault. `at` is the redistribution
@@ -610,9 +610,9 @@ impl Monitor {
         // Log-likelihood gain of each single-fault fit, `b^2 / (2 c)`, with
         // the fault's sign (an amplitude of the wrong sign gains nothing).
         let mut gain = [0.0f32; 6];
-        for i in 0..6 {
-            if self.fit_c[i] > 0.0 && self.fit_b[i] > 0.0 {
-                gain[i] = 0.5 * self.fit_b[i] * self.fit_b[i] / self.fit_c[i];
+        for ((g, b), c) in gain.iter_mut().zip(&self.fit_b).zip(&self.fit_c) {
+            if *c > 0.0 && *b > 0.0 {
+                *g = 0.5 * b * b / c;
             }
         }
         let mut best = 0;

@@ -1,0 +1,141 @@
+//! The condition monitor against the fault-injection data
+//! ([`crate::campaign`]): each scenario's records run through the
+//! firmware's `f32` estimator with its monitor (`compensator::monitor`),
+//! the probe's readings on their ticks and the second sensor's offered as
+//! they come, and what the monitor's flags said and when.
+
+use crate::campaign::{Fault, Quantity, Scenario, SecondSensor};
+use compensator::Params;
+use compensator::estimator::{Estimator, EstimatorConfig, Flags};
+use compensator::monitor::{self, MonitorSettings};
+
+/// The monitor's flags that name or announce a device change (not the
+/// per-reading ones).
+pub const ALARMS: Flags = Flags(
+    Flags::DEVICE_CHANGED.0
+        | Flags::CAPILLARY_RESTRICTED.0
+        | Flags::ORIFICE_CLOGGED.0
+        | Flags::SPRING_RELAXED.0
+        | Flags::PRELOAD_LOST.0
+        | Flags::PLUNGER_STICKING.0
+        | Flags::SENSOR_OFFSET.0,
+);
+
+/// The monitor's settings for the campaign's sensor: its noise with the
+/// ADC's quantisation (`lsb^2 / 12`), its class as a uniform limit (GUM
+/// 4.3.7), its period.
+pub fn settings(sensor: &SecondSensor) -> MonitorSettings {
+    let quantity = match sensor.quantity {
+        Quantity::PA => monitor::Quantity::ChamberA,
+        Quantity::PB => monitor::Quantity::ChamberB,
+        Quantity::DPAB => monitor::Quantity::Difference,
+        Quantity::X => monitor::Quantity::Displacement,
+    };
+    let lsb = sensor.lsb();
+    MonitorSettings {
+        quantity,
+        sd_noise: (sensor.noise_sd * sensor.noise_sd + lsb * lsb / 12.0).sqrt() as f32,
+        sd_accuracy: (sensor.accuracy * sensor.width() / 3f64.sqrt()) as f32,
+        sample_period: (1.0 / sensor.rate_hz) as f32,
+    }
+}
+
+/// The flags that name `fault` correctly on `quantity`'s sensor, or `None`
+/// where the sensor cannot see it at all (a pressure sensor and the
+/// spring, the preload or friction: `docs/monitoring.md`).
+pub fn expected(fault: Fault, quantity: Quantity) -> Option<Flags> {
+    let pressure = quantity != Quantity::X;
+    match fault {
+        Fault::None => None,
+        Fault::CapillaryRestricted(_) | Fault::OrificeWorn(_) => Some(Flags::CAPILLARY_RESTRICTED),
+        Fault::OrificeClogged(_) => Some(Flags::ORIFICE_CLOGGED),
+        Fault::SpringRelaxed(_) if !pressure => Some(Flags::SPRING_RELAXED),
+        Fault::PreloadLost(_) if !pressure => Some(Flags::PRELOAD_LOST),
+        Fault::Sticking(_) if !pressure => Some(Flags::PLUNGER_STICKING),
+        // A displacement sensor's zero moved up reads as a lost preload.
+        Fault::SensorOffset(_) if !pressure => Some(Flags(Flags::SENSOR_OFFSET.0 | Flags::PRELOAD_LOST.0)),
+        Fault::SensorOffset(_) => Some(Flags::SENSOR_OFFSET),
+        _ => None,
+    }
+}
+
+/// What one scenario's run found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Outcome {
+    /// The fault's onset \[s\] (infinite for a healthy run).
+    pub onset: f64,
+    /// First alarm before the onset \[s\] (a false alarm), if any.
+    pub false_alarm: Option<f64>,
+    /// Delay from the onset to the first alarm \[s\].
+    pub detected: Option<f64>,
+    /// Delay from the onset to the first named fault \[s\], and the flag.
+    pub named: Option<(f64, Flags)>,
+    /// Simulated healthy time \[s\] (before the onset).
+    pub healthy_time: f64,
+    /// Readings the monitor rejected (gate, non-finite).
+    pub rejected: u32,
+}
+
+/// Runs `scenario` through the estimator of its nominal design with the
+/// monitor of its sensor.
+///
+/// # Errors
+///
+/// A scenario the records or the estimator refuse.
+pub fn run(scenario: &Scenario) -> Result<Outcome, String> {
+    let nominal = &scenario.nominal;
+    let p32 = Params::<f32>::new(nominal).map_err(|e| e.to_string())?;
+    let config = EstimatorConfig::new(nominal).map_err(|e| e.to_string())?;
+    let mut records = scenario.records()?.peekable();
+    let first = records
+        .peek()
+        .and_then(|s| s.probe)
+        .ok_or("the first record has no probe reading")?;
+    let mut est = Estimator::new(&p32, config, first as f32)
+        .map_err(|e| e.to_string())?
+        .with_monitor(settings(&scenario.sensor))
+        .map_err(|e| e.to_string())?;
+    let onset = if scenario.injection.fault == Fault::None {
+        f64::INFINITY
+    } else {
+        scenario.injection.onset
+    };
+    let mut out = Outcome {
+        onset,
+        false_alarm: None,
+        detected: None,
+        named: None,
+        healthy_time: scenario.duration.min(onset),
+        rejected: 0,
+    };
+    let mut tick = 0u64;
+    let names = Flags(ALARMS.0 & !Flags::DEVICE_CHANGED.0);
+    for s in records {
+        while tick < s.tick {
+            est.tick(Ok(None));
+            tick += 1;
+        }
+        if let Some(y) = s.second {
+            est.offer_second(Ok(y as f32));
+        }
+        let e = est.tick(Ok(s.probe.map(|v| v as f32)));
+        tick += 1;
+        let alarm = Flags(e.flags.0 & ALARMS.0);
+        if alarm.is_empty() {
+            continue;
+        }
+        if s.t < onset {
+            out.false_alarm.get_or_insert(s.t);
+            // A false alarm ends the run's use: the monitor latched it.
+            break;
+        }
+        out.detected.get_or_insert(s.t - onset);
+        let named = Flags(alarm.0 & names.0);
+        if !named.is_empty() {
+            out.named = Some((s.t - onset, named));
+            break;
+        }
+    }
+    out.rejected = est.health().rejected;
+    Ok(out)
+}

@@ -1,0 +1,96 @@
+//! The condition monitor on the paper preset with a probe that does not
+//! lag: a restricted capillary is detected and named from a chamber
+//! pressure and from the displacement, a relaxed spring from the
+//! displacement, and a healthy device raises nothing. (The campaign over
+//! seeded designs with the probe's lag and tolerance and the devices'
+//! spreads is `examples/monitor_campaign.rs`.)
+
+use compensator::Params;
+use compensator::estimator::{Estimator, EstimatorConfig, Flags};
+use compensator::monitor::{MonitorSettings, Quantity};
+use compensator::params::RawCore;
+use compensator_reference::statics::equilibrium;
+use host_tests::random::Rng;
+use host_tests::repo_root;
+
+/// Runs 60 s at 60 C, then a cooling at 0.1 C/s with the device changed by
+/// `fault` from 60 s on; returns the first named flags and their time.
+fn run(q: Quantity, fault: fn(&mut RawCore)) -> Option<(f64, Flags)> {
+    let mut raw = compensator_cli::load(&repo_root().join("presets/paper.toml")).unwrap();
+    raw.probe.time_constant = 0.01;
+    raw.probe.well_time_constant = 0.0;
+    let p = Params::<f32>::new(&raw).unwrap();
+    let cfg = EstimatorConfig::new(&raw).unwrap();
+    let sd = if q == Quantity::Displacement {
+        1e-3 * raw.core.stroke
+    } else {
+        100.0
+    };
+    let settings = MonitorSettings {
+        quantity: q,
+        sd_noise: sd as f32,
+        sd_accuracy: (2.5 * sd) as f32,
+        sample_period: 0.01,
+    };
+    let mut est = Estimator::new(&p, cfg, 60.0).unwrap().with_monitor(settings).unwrap();
+    let mut bad = raw.core;
+    fault(&mut bad);
+    let mut rng = Rng::new(7);
+    let names = Flags(
+        Flags::CAPILLARY_RESTRICTED.0
+            | Flags::ORIFICE_CLOGGED.0
+            | Flags::SPRING_RELAXED.0
+            | Flags::PRELOAD_LOST.0
+            | Flags::PLUNGER_STICKING.0
+            | Flags::SENSOR_OFFSET.0,
+    );
+    for k in 0..120_000u64 {
+        let t = k as f64 * 1e-3;
+        let temp = if t < 60.0 { 60.0 } else { 60.0 - 0.1 * (t - 60.0) };
+        let e = est.tick(Ok(k.is_multiple_of(20).then_some(temp as f32)));
+        if k.is_multiple_of(10) {
+            let core = if t >= 60.0 { &bad } else { &raw.core };
+            let pt = equilibrium(core, temp);
+            let y = match q {
+                Quantity::ChamberA => pt.p_a,
+                Quantity::ChamberB => pt.p_b,
+                Quantity::Difference => pt.p_b - pt.p_a,
+                Quantity::Displacement => pt.x,
+            };
+            let n = (rng.unit() + rng.unit() + rng.unit() + rng.unit() - 2.0) * 3f64.sqrt();
+            est.offer_second(Ok((y + n * sd) as f32));
+        }
+        let named = Flags(e.flags.0 & names.0);
+        if !named.is_empty() {
+            return Some((t, named));
+        }
+        assert!(
+            !(t < 60.0 && e.flags.contains(Flags::DEVICE_CHANGED)),
+            "a change before the fault at {t}"
+        );
+    }
+    None
+}
+
+#[test]
+fn a_restricted_capillary_is_named_from_either_sensor() {
+    for q in [Quantity::ChamberA, Quantity::Displacement] {
+        let (t, f) = run(q, |c| c.laminar_diameter *= 0.8f64.powf(0.25)).expect("named");
+        assert_eq!(f, Flags::CAPILLARY_RESTRICTED, "{q:?}");
+        // The isolation waits for a kelvin of temperature change (10 s).
+        assert!((60.0..75.0).contains(&t), "{q:?} at {t}");
+    }
+}
+
+#[test]
+fn a_relaxed_spring_is_named_from_the_displacement_only() {
+    let (_, f) = run(Quantity::Displacement, |c| c.spring_rate *= 0.9).expect("named");
+    assert_eq!(f, Flags::SPRING_RELAXED);
+    assert_eq!(run(Quantity::ChamberA, |c| c.spring_rate *= 0.9), None);
+}
+
+#[test]
+fn a_healthy_device_raises_nothing() {
+    assert_eq!(run(Quantity::ChamberA, |_| {}), None);
+    assert_eq!(run(Quantity::Displacement, |_| {}), None);
+}
