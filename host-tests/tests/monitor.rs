@@ -36,14 +36,7 @@ fn run(q: Quantity, fault: fn(&mut RawCore)) -> Option<(f64, Flags)> {
     let mut bad = raw.core;
     fault(&mut bad);
     let mut rng = Rng::new(7);
-    let names = Flags(
-        Flags::CAPILLARY_RESTRICTED.0
-            | Flags::ORIFICE_CLOGGED.0
-            | Flags::SPRING_RELAXED.0
-            | Flags::PRELOAD_LOST.0
-            | Flags::PLUNGER_STICKING.0
-            | Flags::SENSOR_OFFSET.0,
-    );
+    let names = compensator::monitor::LATCHED;
     for k in 0..120_000u64 {
         let t = k as f64 * 1e-3;
         let temp = if t < 60.0 { 60.0 } else { 60.0 - 0.1 * (t - 60.0) };
