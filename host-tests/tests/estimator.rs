@@ -594,6 +594,15 @@ fn flag_names_follow_the_bit_order() {
         (Flags::TWIN_RESEATED, "TWIN_RESEATED"),
         (Flags::DEADLINE_MISSED, "DEADLINE_MISSED"),
         (Flags::WATCHDOG_RESET, "WATCHDOG_RESET"),
+        (Flags::DEVICE_CHANGED, "DEVICE_CHANGED"),
+        (Flags::CAPILLARY_RESTRICTED, "CAPILLARY_RESTRICTED"),
+        (Flags::ORIFICE_CLOGGED, "ORIFICE_CLOGGED"),
+        (Flags::SPRING_RELAXED, "SPRING_RELAXED"),
+        (Flags::PRELOAD_LOST, "PRELOAD_LOST"),
+        (Flags::PLUNGER_STICKING, "PLUNGER_STICKING"),
+        (Flags::SENSOR_OFFSET, "SENSOR_OFFSET"),
+        (Flags::SECOND_SENSOR_FAULT, "SECOND_SENSOR_FAULT"),
+        (Flags::INNOVATION_REJECTED, "INNOVATION_REJECTED"),
     ];
     assert_eq!(Flags::NAMES.len(), flags.len());
     for (f, name) in flags {
