@@ -103,6 +103,9 @@ fn the_estimator_publishes_its_plants_estimate() {
     from_plant.t_probe = e.t_probe;
     from_plant.deadline_misses = e.deadline_misses;
     from_plant.lost_ticks = e.lost_ticks;
-    assert_eq!(from_plant, e);
+    // Compared as printed: without a monitor the health estimate is NaN,
+    // which never equals itself.
+    assert!(e.health.divider.is_nan() && e.health.flags.is_empty());
+    assert_eq!(format!("{from_plant:?}"), format!("{e:?}"));
     assert!(e.x.is_finite() && e.q_total > 0.0, "{e:?}");
 }
