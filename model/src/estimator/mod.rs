@@ -90,7 +90,9 @@ pub use stability::{quartic_hurwitz, slowest_decay_rate};
 
 use crate::dynamics::Twin;
 use crate::error::ModelError;
-use crate::monitor::{HealthEstimate, Monitor, MonitorError, MonitorSettings, PlantView};
+use crate::monitor::{HealthEstimate, Monitor};
+#[cfg(feature = "monitor")]
+use crate::monitor::{MonitorError, MonitorSettings, PlantView};
 use crate::params::Params;
 use crate::scalar::Real;
 use crate::sensor::SensorFault;
@@ -204,6 +206,7 @@ pub struct Estimator<T = f32, U = UncertaintyTable, O = ObserverDesign> {
     monitor: Option<Monitor>,
     /// The second sensor's reading not yet given to the monitor (it runs
     /// in a job's place: [`Estimator::offer_second`]).
+    #[cfg(feature = "monitor")]
     second: Option<Result<f32, SensorFault>>,
     /// The monitor's estimate at its last reading.
     health: HealthEstimate,
@@ -254,6 +257,7 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
             late: false,
             deferred: 0,
             monitor: None,
+            #[cfg(feature = "monitor")]
             second: None,
             health: HealthEstimate::NONE,
             health_flags: Flags::empty(),
@@ -269,6 +273,7 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
     /// # Errors
     ///
     /// As [`Monitor::new`]: a setting not finite and positive, named.
+    #[cfg(feature = "monitor")]
     pub fn with_monitor(mut self, settings: MonitorSettings) -> Result<Self, MonitorError> {
         self.monitor = Some(Monitor::new(self.plant.params(), settings)?);
         Ok(self)
@@ -284,10 +289,31 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
     /// job (in the job's place: the worst tick stays the twin's plus one
     /// job, the monitor or the telemetry); a newer reading replaces one not
     /// yet taken. Without a monitor it is ignored.
+    #[cfg(feature = "monitor")]
     pub fn offer_second(&mut self, reading: Result<f32, SensorFault>) {
         if self.monitor.is_some() {
             self.second = Some(reading);
         }
+    }
+
+    /// Gives a waiting reading of the second sensor to the monitor (in a
+    /// job's place); `false` when there is none.
+    #[cfg(feature = "monitor")]
+    fn take_second(&mut self) -> bool {
+        let (Some(monitor), Some(reading)) = (self.monitor.as_mut(), self.second.take()) else {
+            return false;
+        };
+        let s = self.plant.twin().state();
+        let view = PlantView {
+            oil: *self.plant.oil(),
+            x: s.x,
+            p_a: s.p_a,
+            p_b: s.p_b,
+            var_t: self.observer.variance(self.config.observer_design()),
+        };
+        self.health = monitor.update(self.plant.params(), &view, reading);
+        self.health_flags = self.health.flags;
+        true
     }
 
     /// The monitor's estimate at its last reading ([`HealthEstimate::NONE`]
@@ -407,18 +433,11 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
             // A job tick (a telemetry tick only publishes: the costliest
             // tick is spared); a waiting reading of the second sensor takes
             // the job's place.
-            if let (Some(monitor), Some(reading)) = (self.monitor.as_mut(), self.second.take()) {
-                let s = self.plant.twin().state();
-                let view = PlantView {
-                    oil: *self.plant.oil(),
-                    x: s.x,
-                    p_a: s.p_a,
-                    p_b: s.p_b,
-                    var_t: self.observer.variance(self.config.observer_design()),
-                };
-                self.health = monitor.update(self.plant.params(), &view, reading);
-                self.health_flags = self.health.flags;
-            } else {
+            #[cfg(feature = "monitor")]
+            let taken = self.take_second();
+            #[cfg(not(feature = "monitor"))]
+            let taken = false;
+            if !taken {
                 let (observer, design) = (&self.observer, self.config.observer_design());
                 self.plant.run_job(self.config.table(), t, || observer.variance(design));
             }
