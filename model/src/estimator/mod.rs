@@ -211,6 +211,7 @@ pub struct Estimator<T = f32, U = UncertaintyTable, O = ObserverDesign> {
     /// The monitor's estimate at its last reading.
     health: HealthEstimate,
     /// Flags of the monitor's last reading, for the next estimate only.
+    #[cfg(feature = "monitor")]
     health_flags: Flags,
 }
 
@@ -260,6 +261,7 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
             #[cfg(feature = "monitor")]
             second: None,
             health: HealthEstimate::NONE,
+            #[cfg(feature = "monitor")]
             health_flags: Flags::empty(),
         })
     }
@@ -442,12 +444,16 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
                 self.plant.run_job(self.config.table(), t, || observer.variance(design));
             }
         }
+        #[cfg(feature = "monitor")]
         flags.insert(core::mem::replace(
             &mut self.health_flags,
             Flags(self.health.flags.0 & !crate::monitor::PER_READING.0),
         ));
         let mut e = self.plant.estimate(t, flags);
-        e.health = self.health;
+        #[cfg(feature = "monitor")]
+        {
+            e.health = self.health;
+        }
         e.tick = self.tick;
         e.t_probe = self.observer.last_reading();
         e.deadline_misses = self.deadline_misses;
