@@ -423,37 +423,22 @@ impl Monitor {
         let dln_a = point.viscosity.d1 / point.viscosity.value + 0.5 * point.density.d1 / point.density.value;
         let dy_dt = now.jacobian[DIVIDER] * dln_a;
         let r = self.settings.sd_noise * self.settings.sd_noise + dy_dt * dy_dt * view.var_t;
+        // The parameters, the tests' state and the flags are filled in by
+        // `publish`, on every path.
         let mut estimate = HealthEstimate {
-            divider: exp(theta[DIVIDER]),
-            sd_divider: self.filter.sd(DIVIDER),
-            spring: exp(theta[SPRING]),
-            sd_spring: self.filter.sd(SPRING),
-            offset: theta[OFFSET],
-            sd_offset: self.filter.sd(OFFSET),
-            friction: self.friction_width * self.spring_rate,
             predicted,
-            innovation: f32::NAN,
-            cusum: if self.cusum[0] > self.cusum[1] {
-                self.cusum[0]
-            } else {
-                self.cusum[1]
-            },
-            rejected: self.rejected,
-            flags,
+            ..HealthEstimate::NONE
         };
         let y = match measured {
             Ok(y) if y.is_finite() && r.is_finite() && predicted.is_finite() => y,
             Ok(_) => {
                 self.rejected = self.rejected.saturating_add(1);
                 flags.insert(Flags::INNOVATION_REJECTED);
-                estimate.rejected = self.rejected;
-                estimate.flags = flags;
-                return estimate;
+                return self.publish(estimate, flags);
             }
             Err(_) => {
                 flags.insert(Flags::SECOND_SENSOR_FAULT);
-                estimate.flags = flags;
-                return estimate;
+                return self.publish(estimate, flags);
             }
         };
         let nu = y - predicted;
