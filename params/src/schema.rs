@@ -651,8 +651,9 @@ impl RawMonitor {
         Ok(())
     }
 
-    /// The rules against the device and the estimator (with a sensor; this
-    /// section valid on its own):
+    /// The rules against the device and the estimator (with a sensor; each
+    /// field within its plausible range), after `range_max` above
+    /// `range_min`:
     ///
     /// * `p_a`, `p_b`: the range covers every pressure a chamber can have,
     ///   from the outlet `p_c` (`operating.outlet_pressure`) to the supply
@@ -669,14 +670,18 @@ impl RawMonitor {
     ///
     /// # Errors
     ///
-    /// `monitor.range_min` or `monitor.range_max`, [`Problem::OutOfRange`]
-    /// with the bounds and their unit; `monitor.sample_hz`,
+    /// `monitor.range_max`, [`Problem::Inconsistent`], not above
+    /// `range_min`; `monitor.range_min` or `monitor.range_max`,
+    /// [`Problem::OutOfRange`] with the bounds and their unit; `monitor.sample_hz`,
     /// [`Problem::OutOfRange`].
     pub fn check_device(&self, core: &RawCore, estimator: &RawEstimator) -> Result<(), ParamError> {
         if !self.has_sensor() {
             return Ok(());
         }
         let n = self.named();
+        if !(self.range_max > self.range_min) {
+            return Err(err(n.range_max, Problem::Inconsistent("not above monitor.range_min")));
+        }
         let p_c = core.outlet_pressure;
         let p_p = core.outlet_pressure + core.pressure_drop;
         let (low, high, largest, min_why, max_why, span_why) = if self.sensor == 1.0 || self.sensor == 2.0 {
@@ -1533,8 +1538,10 @@ impl RawParams {
         self.monitor.check_fields()?;
         self.core.check_rules()?;
         self.estimator.check_rules()?;
-        self.monitor.check_rules()?;
+        // The device's rules first: a range in the wrong unit is named
+        // before the noise it makes too wide.
         self.monitor.check_device(&self.core, &self.estimator)?;
+        self.monitor.check_rules()?;
         if let Some(m) = &self.machine {
             // The losses are scaled by the viscosity at the reference
             // temperature: the oil model must be used there.

@@ -79,7 +79,7 @@ mod simulated;
 
 pub use driver::{Error, Transducer};
 pub use monitor::Checks;
-pub use simulated::{SimulatedTransducer, TransducerFault};
+pub use simulated::{SimulatedMonitor, SimulatedTransducer, TransducerFault, simulated};
 
 use super::SensorFault;
 use crate::params::{MONITOR_ADC_REFERENCE, ParamError, RawMonitor};
@@ -371,11 +371,19 @@ impl Settings {
             return fail(
                 "monitor.accuracy",
                 accuracy,
-                Problem::OutOfRange { min: 0.0, max: 0.1, why },
+                Problem::OutOfRange {
+                    min: 0.0,
+                    max: 0.1,
+                    why,
+                },
             );
         }
         if !matches!(bits, 6 | 8 | 10 | 12) {
-            return fail("monitor.adc_bits", f32::from(bits), Problem::NotOneOf(&[6.0, 8.0, 10.0, 12.0]));
+            return fail(
+                "monitor.adc_bits",
+                f32::from(bits),
+                Problem::NotOneOf(&[6.0, 8.0, 10.0, 12.0]),
+            );
         }
         if !(sample_hz > 0.0 && sample_hz.is_finite()) {
             return fail("monitor.sample_hz", sample_hz, Problem::NotPositive);

@@ -3,8 +3,18 @@
 //! ([`Stm32AdcState`]), the input a transducer with seeded Gaussian noise
 //! and injectable faults.
 
-use super::Settings;
-use crate::sensor::ntc::{AdcRegisters, Stm32AdcState};
+use super::{Settings, Transducer};
+use crate::sensor::ntc::{AdcRegisters, RegisterAdc, Stm32AdcState};
+
+/// The transducer driver over the simulated STM32F4 ADC's registers.
+pub type SimulatedMonitor = Transducer<RegisterAdc<SimulatedTransducer>>;
+
+/// The driver of `settings` over its simulator reading `reading` \[Pa or
+/// m\], its noise drawn from `seed` (the ADC set to the settings' bits).
+pub fn simulated(settings: Settings, reading: f32, seed: u64) -> SimulatedMonitor {
+    let adc = RegisterAdc::new(SimulatedTransducer::new(settings, reading, seed), settings.bits);
+    Transducer::new(adc, settings)
+}
 
 /// A fault injected into the simulated transducer.
 #[derive(Clone, Copy, Debug, PartialEq)]
