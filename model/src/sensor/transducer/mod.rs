@@ -23,8 +23,8 @@
 //! with `(low, high)` = (0.5 V, 4.5 V) or (4 mA, 20 mA) ([`Settings::reading_of_code`]).
 //! The ratiometric output is proportional to the transducer's own 5 V
 //! supply, taken as exactly 5 V: the ADC's reference is not that supply,
-//! so its tolerance enters the reading (the accuracy budget of
-//! `docs/parameters.md`).
+//! so its tolerance enters the reading (the error budget of
+//! `docs/firmware.md`, "The monitor's transducer").
 //!
 //! # Fault levels ([`Limits`])
 //!
