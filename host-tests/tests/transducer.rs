@@ -332,6 +332,16 @@ fn each_injected_fault_is_detected() {
         assert!(drv.read().is_err());
         drv.device_mut().registers_mut().fault = None;
         assert!(close(drv.read().unwrap(), 250_000.0, 1000.0));
+        // An open loop for a while, then healthy: no stuck or noisy verdict
+        // from the jump (a fault level restarts the checks).
+        for episode in [1, 10, 100] {
+            drv.device_mut().registers_mut().fault = Some(TransducerFault::OpenLoop);
+            for _ in 0..episode {
+                assert!(matches!(drv.read(), Err(SensorFault::OpenCircuit(_))));
+            }
+            drv.device_mut().registers_mut().fault = None;
+            assert_eq!(first_fault(&mut drv, 1000), None, "{output:?} after {episode}");
+        }
     }
 }
 

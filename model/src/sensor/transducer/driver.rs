@@ -68,8 +68,9 @@ impl<ADC: AdcChannel> Transducer<ADC> {
     }
 
     /// Reads one code and decodes it to a reading \[Pa or m\]: the level
-    /// faults first ([`Settings::classify`]), then the stuck and noise
-    /// checks ([`Checks::update`], fed every code).
+    /// faults first ([`Settings::classify`]; one resets the checks), then
+    /// the stuck and noise checks ([`Checks::update`], fed every code that
+    /// is a reading).
     ///
     /// # Errors
     ///
@@ -79,10 +80,19 @@ impl<ADC: AdcChannel> Transducer<ADC> {
     /// [`SensorFault::Noisy`] (the code as its detail).
     pub fn read_reading(&mut self) -> Result<f32, Error<ADC::Error>> {
         let code = self.adc.read_code().map_err(Error::Adc)?;
-        let checks = self.checks.update(code);
-        let reading = self.settings.classify(code).map_err(Error::Fault)?;
-        checks.map_err(Error::Fault)?;
-        Ok(reading)
+        match self.settings.classify(code) {
+            Ok(reading) => {
+                self.checks.update(code).map_err(Error::Fault)?;
+                Ok(reading)
+            }
+            Err(fault) => {
+                // A fault level is no sample of the noise: the checks start
+                // again from the next reading (else the jump back from an
+                // open loop would read as a noisy window).
+                self.checks.reset();
+                Err(Error::Fault(fault))
+            }
+        }
     }
 
     /// Reads one reading \[Pa or m\] (the caller paces calls to
