@@ -22,7 +22,7 @@
 
 pub mod replay;
 
-use compensator_params::{Field, Named, RawCore, RawEstimator, RawMachine, RawParams, RawProbe};
+use compensator_params::{Field, Named, RawCore, RawEstimator, RawMachine, RawMonitor, RawParams, RawProbe};
 
 /// The generated `params.rs` and what the build should say about it.
 #[derive(Clone, Debug, PartialEq)]
@@ -127,6 +127,7 @@ pub fn params_rs(raw: &RawParams, path: &str, source: &str) -> Result<ParamsRs, 
         &RawEstimator::FIELD.zip(raw.estimator.named()).into_array(),
     );
     let probe = literal("RawProbe", &RawProbe::FIELD.zip(raw.probe.named()).into_array());
+    let monitor = literal("RawMonitor", &RawMonitor::FIELD.zip(raw.monitor.named()).into_array());
     let config = compensator::estimator::EstimatorConfig::new(raw).map_err(|e| e.to_string())?;
     let direct = compensator::estimator::observer_settings(raw, config.sample_period()).without_lag();
     let direct = compensator::estimator::ObserverDesign::new(&direct).map_err(|e| format!("probe without lag: {e}"))?;
@@ -142,6 +143,7 @@ pub fn params_rs(raw: &RawParams, path: &str, source: &str) -> Result<ParamsRs, 
          machine: {machine},\n    \
          estimator: {estimator},\n    \
          probe: {probe},\n    \
+         monitor: {monitor},\n    \
          tolerances: ::compensator::params::RawTolerances::NONE,\n}};\n\
          /// The oil-temperature observer designed at build time for the file's probe.\n\
          pub static OBSERVER: ::compensator::estimator::ObserverDesign = {observer};\n\

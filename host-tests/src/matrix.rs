@@ -18,7 +18,8 @@
 use compensator::equilibrium::equilibrium;
 use compensator::estimator::{ConfigError, Estimator, EstimatorConfig};
 use compensator::params::{
-    CORE_FIELDS, Compact, ESTIMATOR_FIELDS, Field, Kind, MACHINE_FIELDS, PROBE_FIELDS, Problem, RawParams,
+    CORE_FIELDS, Compact, ESTIMATOR_FIELDS, Field, Kind, MACHINE_FIELDS, MONITOR_FIELDS, PROBE_FIELDS, Problem,
+    RawParams,
 };
 use compensator::uncertainty::UncertaintyError;
 use compensator::{Float, Params};
@@ -32,6 +33,7 @@ pub fn fields() -> impl Iterator<Item = &'static Field> {
         .chain(MACHINE_FIELDS.iter())
         .chain(ESTIMATOR_FIELDS.iter())
         .chain(PROBE_FIELDS.iter())
+        .chain(MONITOR_FIELDS.iter())
 }
 
 /// The standard uncertainty of every field that can have one, as a field
@@ -141,9 +143,15 @@ impl Case {
         }
     }
 
-    /// Inside the plausible range: a rule between fields may refuse it.
-    fn in_range(self) -> bool {
-        matches!(self, Case::AtMin | Case::AtMax)
+    /// Inside the plausible range of `field`: a rule between fields may
+    /// refuse it (the range's ends; the text `"x"` for a field that has
+    /// the name, `monitor.sensor`'s displacement).
+    fn in_range(self, field: &Field) -> bool {
+        match self {
+            Case::AtMin | Case::AtMax => true,
+            Case::Text => matches!(field.kind, Kind::Named(names) if names.contains(&"x")),
+            _ => false,
+        }
     }
 
     /// The TOML value written for `field` (`None`: the key left out).
@@ -188,6 +196,13 @@ impl Case {
 /// section; `[estimator]` keys are appended).
 pub fn base_text() -> String {
     std::fs::read_to_string(crate::repo_root().join("presets/paper.toml")).expect("presets/paper.toml")
+}
+
+/// The preset the cases of a `[monitor]` field edit:
+/// `presets/paper-monitor.toml` (the paper preset with a chamber pressure
+/// transducer), so that the monitor's rules are in force.
+pub fn monitor_base_text() -> String {
+    std::fs::read_to_string(crate::repo_root().join("presets/paper-monitor.toml")).expect("presets/paper-monitor.toml")
 }
 
 /// `text` with `field` set to `value` (its line replaced, added under its
@@ -381,7 +396,8 @@ impl Cell {
         match &self.outcome {
             Outcome::Accepted { finite, .. } => *finite,
             Outcome::Refused(r) => {
-                r.field == Some(self.field.path) || (self.case.in_range() && r.message.contains(self.field.path))
+                r.field == Some(self.field.path)
+                    || (self.case.in_range(self.field) && r.message.contains(self.field.path))
             }
         }
     }
@@ -413,11 +429,11 @@ pub fn tolerance_matrix() -> Vec<Cell> {
 }
 
 fn cells(fields: Vec<&'static Field>) -> Vec<Cell> {
-    let base = base_text();
+    let (paper, monitor) = (base_text(), monitor_base_text());
     fields
         .into_iter()
         .flat_map(|field| {
-            let base = &base;
+            let base = if field.section == "monitor" { &monitor } else { &paper };
             Case::ALL.iter().map(move |&case| Cell {
                 field,
                 case,
@@ -442,6 +458,7 @@ pub fn field_table() -> String {
             (Some(d), Kind::Named(names)) => format!("`\"{}\"`", names.get(d as usize).copied().unwrap_or("?")),
             (Some(d), _) => Compact(d).to_string(),
             (None, _) if f.section == "machine" => "required in `[machine]`".into(),
+            (None, _) if f.section == "monitor" => "required with a `sensor`".into(),
             (None, _) => "required".into(),
         };
         let also = match f.kind {

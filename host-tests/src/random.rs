@@ -72,6 +72,7 @@ pub fn physical_params(rng: &mut Rng) -> RawParams {
         machine: None,
         estimator: RawEstimator::DEFAULT,
         probe: compensator::params::RawProbe::DEFAULT,
+        monitor: compensator::params::RawMonitor::NONE,
         tolerances: compensator::params::RawTolerances::NONE,
     };
     raw.validate().expect("the generator makes valid sets");

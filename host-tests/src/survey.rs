@@ -108,6 +108,7 @@ pub fn designs(count: usize, seed: u64) -> Vec<RawParams> {
                 machine: None,
                 estimator: base.estimator,
                 probe: base.probe,
+                monitor: compensator::params::RawMonitor::NONE,
                 tolerances: compensator::params::RawTolerances::NONE,
             };
             let p = Params::<f64>::new(&raw).expect("scattered sets are valid");

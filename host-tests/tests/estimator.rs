@@ -575,6 +575,7 @@ fn closed_stop_case() -> RawParams {
         machine: None,
         estimator: compensator::params::RawEstimator::DEFAULT,
         probe: compensator::params::RawProbe::DEFAULT,
+        monitor: compensator::params::RawMonitor::NONE,
         tolerances: compensator::params::RawTolerances::NONE,
     };
     raw.validate().unwrap();
@@ -665,6 +666,7 @@ fn a_plunger_chattering_on_a_stop_leaves_it_in_a_warm_up() {
         machine: None,
         estimator: compensator::params::RawEstimator::DEFAULT,
         probe: compensator::params::RawProbe::DEFAULT,
+        monitor: compensator::params::RawMonitor::NONE,
         tolerances: compensator::params::RawTolerances::NONE,
     };
     // Through the probe it was found with (27.8 s), as the tracking study

@@ -198,6 +198,7 @@ fn make(origin: Origin) -> Option<Design> {
                 machine: None,
                 estimator: base.estimator,
                 probe: base.probe,
+                monitor: compensator::params::RawMonitor::NONE,
                 tolerances: compensator::params::RawTolerances::NONE,
             };
             raw.validate().ok()?;

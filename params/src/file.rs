@@ -414,9 +414,10 @@ pub fn load(path: &Path) -> Result<RawParams, LoadError> {
 }
 
 /// Writes a parameter set back as TOML (core sections, then `[machine]` if
-/// present, then the `[estimator]` keys that differ from their defaults).
+/// present, then the `[estimator]`, `[probe]` and `[monitor]` keys that
+/// differ from their defaults).
 pub fn to_toml(raw: &RawParams) -> String {
-    use crate::{RawCore, RawEstimator, RawMachine, RawProbe};
+    use crate::{RawCore, RawEstimator, RawMachine, RawMonitor, RawProbe};
     let mut out = String::new();
     let mut section = "";
     let mut emit = |out: &mut String, field: &Field, v: f64| {
@@ -451,6 +452,14 @@ pub fn to_toml(raw: &RawParams) -> String {
     }
     for (f, n) in RawProbe::FIELD.zip(raw.probe.named()).into_array() {
         if Some(n.value) != f.default {
+            emit(&mut out, &f, n.value);
+        }
+    }
+    // The monitor's required keys read as 0 without a sensor.
+    let sensor = raw.monitor.has_sensor();
+    for (f, n) in RawMonitor::FIELD.zip(raw.monitor.named()).into_array() {
+        let default = f.default.or(if sensor { None } else { Some(0.0) });
+        if Some(n.value) != default {
             emit(&mut out, &f, n.value);
         }
     }

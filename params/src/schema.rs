@@ -490,6 +490,284 @@ schema! {
     tolerance_b: "probe"."tolerance_b" ["1/K", 1.0e-6 ..= 0.1, Kind::OrZero] = Some(0.005), "Part of the probe's tolerance proportional to |t| (IEC 60751 class B: 0.005).";
 }
 
+schema! {
+    /// The condition monitor's optional second sensor (optional section
+    /// `[monitor]`): one chamber pressure transducer (`p_a`, `p_b`, or the
+    /// difference `p_b - p_a`) or a plunger displacement sensor (LVDT or
+    /// Hall), read by the STM32F405's ADC. Without the section, or with
+    /// `sensor = "none"`, nothing else of it is used (nor checked beyond its
+    /// own plausible range). With a sensor, `range_min`, `range_max` and
+    /// `noise` are required; their unit is the quantity's: Pa for a
+    /// pressure, m for the displacement.
+    struct RawMonitor, fields MonitorFields, const MONITOR_FIELDS;
+    sensor: "monitor"."sensor" ["-", 0.0 ..= 4.0, Kind::Named(&MONITOR_SENSORS)] = Some(0.0), "What the second sensor measures: \"none\", \"p_a\" or \"p_b\" (a chamber pressure), \"dp_ab\" (p_b - p_a), \"x\" (the plunger's displacement).";
+    output: "monitor"."output" ["-", 0.0 ..= 1.0, Kind::Named(&MONITOR_OUTPUTS)] = Some(0.0), "Its output: \"ratiometric\" (0.5-4.5 V of a 5 V supply, through a divider into the ADC) or \"current\" (4-20 mA into a shunt resistor).";
+    // Pa for a pressure (vacuum to 1 GPa, either sign for a difference),
+    // m for a displacement; the rules between fields (`check_rules`) tie
+    // them to the device's pressures and stroke, which catches bar, MPa or
+    // mm typed by mistake.
+    range_min: "monitor"."range_min" ["Pa or m", -1.0e9 ..= 1.0e9] = None, "Reading at 0.5 V (ratiometric) or 4 mA (current): Pa for a pressure, m for x (required with a sensor).";
+    range_max: "monitor"."range_max" ["Pa or m", -1.0e9 ..= 1.0e9] = None, "Reading at 4.5 V or 20 mA, above range_min: Pa for a pressure, m for x (required with a sensor).";
+    // Accuracy classes 0.01 % to 10 % of the span.
+    accuracy: "monitor"."accuracy" ["-", 1.0e-5 ..= 0.1] = Some(0.0025), "Accuracy class as a fraction of the span (0.001: class 0.1 %), a limit: its standard uncertainty is accuracy * span / sqrt(3) (GUM 4.3.7, uniform).";
+    noise: "monitor"."noise" ["Pa or m", 1.0e-12 ..= 1.0e9, Kind::OrZero] = None, "Standard deviation of one reading's noise, Pa (m for x), without the ADC's quantization; below the span (required with a sensor; 0: none, which disables the stuck check).";
+    sample_hz: "monitor"."sample_hz" ["Hz", 0.1 ..= 100_000.0] = Some(100.0), "Reading rate (at most estimator.tick_hz).";
+    // The STM32F4's ADC resolutions (ADC_CR1 RES), as estimator.adc_bits.
+    adc_bits: "monitor"."adc_bits" ["-", 6.0 ..= 12.0, Kind::OneOf(&[6.0, 8.0, 10.0, 12.0])] = Some(12.0), "ADC resolution in bits of the monitor's channel: 12, 10, 8 or 6 (STM32F4 ADC_CR1 RES).";
+    divider: "monitor"."divider" ["-", 0.1 ..= 1.0] = Some(0.66), "Ratiometric output: the divider's ratio V_adc / V_out into the 3.3 V ADC (0.66: 5 V to 3.3 V); 4.75 V (the short-to-supply limit) times it must stay below 3.3 V.";
+    shunt: "monitor"."shunt" ["ohm", 10.0 ..= 1000.0] = Some(150.0), "Current output: the shunt resistor the loop current flows through to ground (150 ohm: 20 mA = 3.0 V); 21 mA (NAMUR NE 43's fault-high limit) times it must stay below 3.3 V.";
+}
+
+/// The names of `monitor.sensor`, in the order of its values.
+pub const MONITOR_SENSORS: [&str; 5] = ["none", "p_a", "p_b", "dp_ab", "x"];
+
+/// The names of `monitor.output`, in the order of its values.
+pub const MONITOR_OUTPUTS: [&str; 2] = ["ratiometric", "current"];
+
+/// The STM32F405 ADC's reference voltage `V_REF+` the monitor's channel is
+/// converted against \[V\] (VDDA of the board, 3.3 V).
+pub const MONITOR_ADC_REFERENCE: f64 = 3.3;
+
+/// The ratiometric output's short-to-supply limit \[V\]: above it a reading
+/// is a fault (`monitor.divider` must keep it inside the ADC's range).
+pub const MONITOR_RATIOMETRIC_FAULT_HIGH: f64 = 4.75;
+
+/// NAMUR NE 43's fault-high limit of a 4-20 mA loop \[A\] (`monitor.shunt`
+/// must keep it inside the ADC's range).
+pub const MONITOR_CURRENT_FAULT_HIGH: f64 = 0.021;
+
+/// The largest span a monitor's range may have, in multiples of the
+/// largest reading the device gives (the supply pressure, the pressure
+/// drop, the stroke): a wider range is a unit typed wrong (bar for Pa the
+/// other way round, mm for m), and would leave one ADC code a sizeable
+/// fraction of every reading.
+pub const MONITOR_SPAN_LIMIT: f64 = 100.0;
+
+impl RawMonitor {
+    /// No second sensor (`sensor = "none"`; the other fields at their
+    /// defaults, the required ones 0). What a file without `[monitor]`
+    /// reads as.
+    pub const NONE: RawMonitor = RawMonitor {
+        range_min: 0.0,
+        range_max: 0.0,
+        noise: 0.0,
+        ..RawMonitor::WITH_DEFAULTS
+    };
+
+    /// The same as [`RawMonitor::NONE`].
+    pub const DEFAULT: RawMonitor = RawMonitor::NONE;
+
+    /// Whether the file names a second sensor (`monitor.sensor` not
+    /// `"none"`).
+    pub fn has_sensor(&self) -> bool {
+        self.sensor != 0.0
+    }
+
+    /// Whether the sensor measures a pressure (`p_a`, `p_b`, `dp_ab`; else
+    /// none or the displacement `x`).
+    pub fn is_pressure(&self) -> bool {
+        self.sensor == 1.0 || self.sensor == 2.0 || self.sensor == 3.0
+    }
+
+    /// Whether the output is a 4-20 mA current loop (else ratiometric).
+    pub fn is_current(&self) -> bool {
+        self.output == 1.0
+    }
+
+    /// The span `range_max - range_min` \[Pa or m\].
+    pub fn span(&self) -> f64 {
+        self.range_max - self.range_min
+    }
+
+    /// The standard uncertainty of the accuracy class \[Pa or m\]:
+    /// `accuracy * span / sqrt(3)`, the class taken as the half-width of
+    /// a uniform distribution (GUM 4.3.7).
+    pub fn class_uncertainty(&self) -> f64 {
+        self.accuracy * self.span() / libm::sqrt(3.0)
+    }
+
+    /// Checks the monitor section on its own: every field within its
+    /// plausible range, then (with a sensor) the rules that need no other
+    /// section. [`RawParams::validate`] adds the rules against the device
+    /// ([`RawMonitor::check_device`]).
+    ///
+    /// # Errors
+    ///
+    /// The first field's [`Field::check`] error; then, with a sensor:
+    /// * `monitor.range_max`, [`Problem::Inconsistent`]: not above
+    ///   `monitor.range_min`;
+    /// * `monitor.noise`, [`Problem::OutOfRange`]: not below the span;
+    /// * `monitor.divider`, [`Problem::OutOfRange`] (ratiometric): 4.75 V
+    ///   times it reaches the ADC's 3.3 V;
+    /// * `monitor.shunt`, [`Problem::OutOfRange`] (current): 21 mA times
+    ///   it reaches 3.3 V.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        self.check_fields()?;
+        self.check_rules()
+    }
+
+    /// The rules of [`RawMonitor::validate`] between this section's fields
+    /// (each within its range).
+    fn check_rules(&self) -> Result<(), ParamError> {
+        if !self.has_sensor() {
+            return Ok(());
+        }
+        let n = self.named();
+        if !(self.range_max > self.range_min) {
+            return Err(err(n.range_max, Problem::Inconsistent("not above monitor.range_min")));
+        }
+        if !(self.noise < self.span()) {
+            return Err(err(
+                n.noise,
+                Problem::OutOfRange {
+                    min: 0.0,
+                    max: self.span(),
+                    why: "below the span monitor.range_max - monitor.range_min",
+                },
+            ));
+        }
+        if self.is_current() {
+            let max = MONITOR_ADC_REFERENCE / MONITOR_CURRENT_FAULT_HIGH;
+            if !(self.shunt * MONITOR_CURRENT_FAULT_HIGH < MONITOR_ADC_REFERENCE) {
+                return Err(err(
+                    n.shunt,
+                    Problem::OutOfRange {
+                        min: 0.0,
+                        max,
+                        why: "21 mA (NAMUR NE 43 fault high) through it must stay below the ADC's 3.3 V",
+                    },
+                ));
+            }
+        } else if !(self.divider * MONITOR_RATIOMETRIC_FAULT_HIGH < MONITOR_ADC_REFERENCE) {
+            return Err(err(
+                n.divider,
+                Problem::OutOfRange {
+                    min: 0.0,
+                    max: MONITOR_ADC_REFERENCE / MONITOR_RATIOMETRIC_FAULT_HIGH,
+                    why: "4.75 V (the short-to-supply limit) times it must stay below the ADC's 3.3 V",
+                },
+            ));
+        }
+        Ok(())
+    }
+
+    /// The rules against the device and the estimator (with a sensor; each
+    /// field within its plausible range), after `range_max` above
+    /// `range_min`:
+    ///
+    /// * `p_a`, `p_b`: the range covers every pressure a chamber can have,
+    ///   from the outlet `p_c` (`operating.outlet_pressure`) to the supply
+    ///   `p_p = p_c + operating.pressure_drop`;
+    /// * `dp_ab`: the range covers `-pressure_drop ..= pressure_drop`
+    ///   (both chambers lie between `p_c` and `p_p`, so `|p_b - p_a|` is at
+    ///   most the drop: the bound every state can reach, not only the
+    ///   validated range's equilibria);
+    /// * `x`: the range covers the stroke `0 ..= plunger.stroke`;
+    /// * the span at most [`MONITOR_SPAN_LIMIT`] times the largest reading
+    ///   (`p_p`, the drop, the stroke): a range in bar or MPa, or in mm,
+    ///   typed for Pa or m is refused by the first rules or this one;
+    /// * `monitor.sample_hz` at most `estimator.tick_hz`.
+    ///
+    /// # Errors
+    ///
+    /// `monitor.range_max`, [`Problem::Inconsistent`], not above
+    /// `range_min`; `monitor.range_min` or `monitor.range_max`,
+    /// [`Problem::OutOfRange`] with the bounds and their unit; `monitor.sample_hz`,
+    /// [`Problem::OutOfRange`].
+    pub fn check_device(&self, core: &RawCore, estimator: &RawEstimator) -> Result<(), ParamError> {
+        if !self.has_sensor() {
+            return Ok(());
+        }
+        let n = self.named();
+        if !(self.range_max > self.range_min) {
+            return Err(err(n.range_max, Problem::Inconsistent("not above monitor.range_min")));
+        }
+        let p_c = core.outlet_pressure;
+        let p_p = core.outlet_pressure + core.pressure_drop;
+        let (low, high, largest, min_why, max_why, span_why) = if self.sensor == 1.0 || self.sensor == 2.0 {
+            (
+                p_c,
+                p_p,
+                p_p,
+                "monitor.sensor \"p_a\" or \"p_b\": at most the outlet pressure operating.outlet_pressure, in Pa (not bar or MPa)",
+                "monitor.sensor \"p_a\" or \"p_b\": at least the supply pressure operating.outlet_pressure + operating.pressure_drop; the unit is Pa, not bar or MPa",
+                "monitor.sensor \"p_a\" or \"p_b\": the span at most 100 times the supply pressure; the unit is Pa",
+            )
+        } else if self.sensor == 3.0 {
+            (
+                -core.pressure_drop,
+                core.pressure_drop,
+                core.pressure_drop,
+                "monitor.sensor \"dp_ab\": at most -operating.pressure_drop (p_b - p_a reaches -drop..drop), in Pa (not bar or MPa)",
+                "monitor.sensor \"dp_ab\": at least operating.pressure_drop (p_b - p_a reaches -drop..drop); the unit is Pa, not bar or MPa",
+                "monitor.sensor \"dp_ab\": the span at most 100 times operating.pressure_drop; the unit is Pa",
+            )
+        } else {
+            (
+                0.0,
+                core.stroke,
+                core.stroke,
+                "monitor.sensor \"x\": at most 0 (the plunger's closed stop), in m",
+                "monitor.sensor \"x\": at least plunger.stroke; the unit is m, not mm",
+                "monitor.sensor \"x\": the span at most 100 times plunger.stroke; the unit is m, not mm",
+            )
+        };
+        let limit = MONITOR_SPAN_LIMIT * largest;
+        if !(self.range_min <= low) {
+            return Err(err(
+                n.range_min,
+                Problem::OutOfRange {
+                    min: high - limit,
+                    max: low,
+                    why: min_why,
+                },
+            ));
+        }
+        if !(self.range_max >= high) {
+            return Err(err(
+                n.range_max,
+                Problem::OutOfRange {
+                    min: high,
+                    max: low + limit,
+                    why: max_why,
+                },
+            ));
+        }
+        if !(self.span() <= limit) {
+            // Blame the end further from the device's readings.
+            let blamed = if self.range_max - high >= low - self.range_min {
+                n.range_max
+            } else {
+                n.range_min
+            };
+            let (min, max) = if blamed.path == n.range_max.path {
+                (high, self.range_min + limit)
+            } else {
+                (self.range_max - limit, low)
+            };
+            return Err(err(
+                blamed,
+                Problem::OutOfRange {
+                    min,
+                    max,
+                    why: span_why,
+                },
+            ));
+        }
+        if !(self.sample_hz <= estimator.tick_hz) {
+            return Err(err(
+                n.sample_hz,
+                Problem::OutOfRange {
+                    min: 0.1,
+                    max: estimator.tick_hz,
+                    why: "at most estimator.tick_hz",
+                },
+            ));
+        }
+        Ok(())
+    }
+}
+
 impl RawProbe {
     /// The defaults of the `[probe]` section (a class B PT100 insert in a
     /// thermowell).
@@ -733,19 +1011,23 @@ pub struct RawParams {
     pub estimator: RawEstimator,
     /// The temperature probe (defaults where the file is silent).
     pub probe: RawProbe,
+    /// The condition monitor's second sensor ([`RawMonitor::NONE`] where
+    /// the file has no `[monitor]` section).
+    pub monitor: RawMonitor,
     /// The parameters' standard uncertainties (none where the file is
     /// silent).
     pub tolerances: RawTolerances,
 }
 
 /// Every field of the file in file order: core, `[machine]`, `[estimator]`,
-/// `[probe]`.
+/// `[probe]`, `[monitor]`.
 pub fn all_fields() -> impl Iterator<Item = &'static Field> {
     CORE_FIELDS
         .iter()
         .chain(MACHINE_FIELDS.iter())
         .chain(ESTIMATOR_FIELDS.iter())
         .chain(PROBE_FIELDS.iter())
+        .chain(MONITOR_FIELDS.iter())
 }
 
 /// The field named `path` (`section.key`, as in messages and `docs/parameters.md`).
@@ -1242,8 +1524,9 @@ impl RawParams {
     ///
     /// # Errors
     ///
-    /// The first [`ParamError`] in that order (see [`RawCore::validate`]
-    /// and [`RawEstimator::validate`] for the rules;
+    /// The first [`ParamError`] in that order (see [`RawCore::validate`],
+    /// [`RawEstimator::validate`], [`RawMonitor::validate`] and
+    /// [`RawMonitor::check_device`] for the rules;
     /// `machine.leakage_temperature` outside the oil range).
     pub fn validate(&self) -> Result<(), ParamError> {
         self.core.check_fields()?;
@@ -1252,8 +1535,13 @@ impl RawParams {
         }
         self.estimator.check_fields()?;
         self.probe.check_fields()?;
+        self.monitor.check_fields()?;
         self.core.check_rules()?;
         self.estimator.check_rules()?;
+        // The device's rules first: a range in the wrong unit is named
+        // before the noise it makes too wide.
+        self.monitor.check_device(&self.core, &self.estimator)?;
+        self.monitor.check_rules()?;
         if let Some(m) = &self.machine {
             // The losses are scaled by the viscosity at the reference
             // temperature: the oil model must be used there.
@@ -1287,6 +1575,7 @@ impl RawParams {
             .value(path)
             .or_else(|| self.estimator.value(path))
             .or_else(|| self.probe.value(path))
+            .or_else(|| self.monitor.value(path))
         {
             return Ok(v);
         }
@@ -1309,7 +1598,10 @@ impl RawParams {
             Some(slot) => Some(slot),
             None => match self.estimator.value_mut(path) {
                 Some(slot) => Some(slot),
-                None => self.probe.value_mut(path),
+                None => match self.probe.value_mut(path) {
+                    Some(slot) => Some(slot),
+                    None => self.monitor.value_mut(path),
+                },
             },
         };
         if let Some(slot) = slot {
@@ -1359,11 +1651,25 @@ impl RawParams {
         let estimator =
             RawEstimator::from_fields(|field| get(field.section, field.key).or(field.default).unwrap_or(f64::NAN));
         let probe = RawProbe::from_fields(|field| get(field.section, field.key).or(field.default).unwrap_or(f64::NAN));
+        // The monitor: its sensor first; without one, the keys it needs
+        // are not needed (0 where absent), with one they are required.
+        let sensor = get("monitor", "sensor").unwrap_or(0.0);
+        let monitor = RawMonitor::try_from_fields(|field| match (get(field.section, field.key), field.default) {
+            (Some(v), _) => Ok(v),
+            (None, Some(d)) => Ok(d),
+            (None, None) if sensor == 0.0 => Ok(0.0),
+            (None, None) => Err(ParamError {
+                field: field.path,
+                value: f64::NAN,
+                problem: Problem::Missing,
+            }),
+        })?;
         let raw = RawParams {
             core,
             machine,
             estimator,
             probe,
+            monitor,
             tolerances: RawTolerances::NONE,
         };
         raw.validate()?;

@@ -11,9 +11,10 @@
 
 pub use compensator_params::{
     CORE_FIELDS, Compact, CoreFields, Correlation, ECHO_MAX, ESTIMATOR_FIELDS, Echo, EstimatorFields, Field, KELVIN,
-    Kind, MACHINE_FIELDS, MAX_CORRELATIONS, MachineFields, NTC_FAULT_CODES, Named, PROBE_FIELDS, ParamError,
-    ProbeFields, Problem, Range, RawCore, RawEstimator, RawMachine, RawParams, RawProbe, RawTolerances, SENSOR_KINDS,
-    VISCOSITY_40C_CST,
+    Kind, MACHINE_FIELDS, MAX_CORRELATIONS, MONITOR_ADC_REFERENCE, MONITOR_CURRENT_FAULT_HIGH, MONITOR_FIELDS,
+    MONITOR_OUTPUTS, MONITOR_RATIOMETRIC_FAULT_HIGH, MONITOR_SENSORS, MONITOR_SPAN_LIMIT, MachineFields, MonitorFields,
+    NTC_FAULT_CODES, Named, PROBE_FIELDS, ParamError, ProbeFields, Problem, Range, RawCore, RawEstimator, RawMachine,
+    RawMonitor, RawParams, RawProbe, RawTolerances, SENSOR_KINDS, VISCOSITY_40C_CST,
 };
 
 use crate::fluid::Oil;

@@ -1,12 +1,15 @@
 //! The edge between the parameter file and the drivers: the drivers
 //! (`max31865`, `ntc`) each take their own settings struct and import
 //! nothing of the file's schema; this module fills those structs from the
-//! file's `[estimator]` section and says which sensor the file chose.
+//! file's `[estimator]` section and says which sensor the file chose, and
+//! the monitor's transducer settings from its `[monitor]` section
+//! ([`monitor_settings`]).
 
 use super::max31865::{self, DIAGNOSIS_INTERVAL, Mains, Wires};
 use super::ntc::{self, Curve};
 use super::rtd::Cvd;
-use crate::params::RawEstimator;
+use super::transducer::{self, SettingsError};
+use crate::params::{RawEstimator, RawParams};
 
 /// The sensor a parameter file chose (`estimator.sensor`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -103,4 +106,22 @@ impl ntc::Settings {
             period: sample_period(raw),
         }
     }
+}
+
+/// The condition monitor's second sensor of a parameter set: `None`
+/// without one (no `[monitor]` section, or `sensor = "none"`), else its
+/// transducer settings (`TryFrom<&RawMonitor>`), the set validated first
+/// (the monitor's rules against the device: its range covers the
+/// chambers' pressures or the stroke, its rate at most the tick's).
+///
+/// # Errors
+///
+/// [`SettingsError::Param`] naming the field the set's validation or the
+/// settings refuse.
+pub fn monitor_settings(raw: &RawParams) -> Result<Option<transducer::Settings>, SettingsError> {
+    if !raw.monitor.has_sensor() {
+        return Ok(None);
+    }
+    raw.validate()?;
+    transducer::Settings::try_from(&raw.monitor).map(Some)
 }

@@ -11,6 +11,10 @@
 //!   STM32F405's 12-bit ADC (beta or Steinhart-Hart), over the minimal
 //!   [`ntc::AdcChannel`] trait, and a register-level simulator of the
 //!   STM32F4 ADC.
+//! * [`transducer`]: the condition monitor's second sensor, a chamber
+//!   pressure or plunger displacement transducer (ratiometric or 4-20 mA,
+//!   NAMUR NE 43) on the same ADC, with its stuck and noise checks and a
+//!   register-level simulator ([`transducer::SimulatedTransducer`]).
 //! * [`simulated`]: what the replays need of a simulated sensor
 //!   ([`simulated::SimulatedSource`]: the temperature it sees, injected
 //!   faults), for either chip.
@@ -22,6 +26,7 @@ pub mod max31865;
 pub mod ntc;
 pub mod rtd;
 pub mod simulated;
+pub mod transducer;
 
 /// What the chip said about a fault, beyond its general cause, packed in
 /// 16 bits ([`Detail::word`] unpacks it): a reading's
@@ -107,10 +112,12 @@ pub enum SensorFault {
     /// (MISO stuck high, RTD-high and RTD-low together).
     Bus,
     /// The element reads open: an RTD above the converter's high threshold,
-    /// an NTC divider's code near full scale.
+    /// an NTC divider's code near full scale, a transducer's signal below
+    /// its fault-low limit (an open loop or wire: NAMUR NE 43's 3.6 mA).
     OpenCircuit(Detail),
     /// The element reads shorted: an RTD below the low threshold, an NTC
-    /// divider's code near zero.
+    /// divider's code near zero, a transducer's signal above its fault-high
+    /// limit (a short to the supply: NE 43's 21 mA).
     ShortCircuit(Detail),
     /// A force or reference line of the element is open or shorted, found
     /// by a diagnosis cycle (the MAX31865's REFIN-/RTDIN- comparisons):
@@ -119,11 +126,19 @@ pub enum SensorFault {
     /// Over- or under-voltage on a converter input.
     Supply(Detail),
     /// A reading that maps to no temperature of the element's range
-    /// (a saturated code, NaN, outside the range the element is rated for).
+    /// (a saturated code, NaN, outside the range the element is rated for;
+    /// a transducer's signal between its measuring band and its fault
+    /// limits).
     OutOfRange(Detail),
     /// The converter gave no result where one was due (a diagnosis cycle
     /// that did not finish, a conversion that did not complete).
     Stale,
+    /// The same code for longer than the sensor's specified noise allows
+    /// (a frozen output or converter; [`transducer`]).
+    Stuck(Detail),
+    /// The readings scatter more than the sensor's specified noise allows
+    /// (a loose contact, interference; [`transducer`]).
+    Noisy(Detail),
 }
 
 impl SensorFault {
@@ -134,7 +149,9 @@ impl SensorFault {
             | SensorFault::ShortCircuit(d)
             | SensorFault::Wiring(d)
             | SensorFault::Supply(d)
-            | SensorFault::OutOfRange(d) => d,
+            | SensorFault::OutOfRange(d)
+            | SensorFault::Stuck(d)
+            | SensorFault::Noisy(d) => d,
             SensorFault::Bus | SensorFault::Stale => Detail::NONE,
         }
     }
@@ -148,8 +165,10 @@ impl core::fmt::Display for SensorFault {
             SensorFault::ShortCircuit(_) => "the sensing element reads shorted",
             SensorFault::Wiring(_) => "a force or reference line of the element is open or shorted",
             SensorFault::Supply(_) => "over- or under-voltage on a converter input",
-            SensorFault::OutOfRange(_) => "a reading no temperature of the element's range gives",
+            SensorFault::OutOfRange(_) => "a reading outside the range the element is rated for",
             SensorFault::Stale => "the converter gave no result where one was due",
+            SensorFault::Stuck(_) => "the same code for longer than the sensor's noise allows (stuck)",
+            SensorFault::Noisy(_) => "the readings scatter more than the sensor's noise allows (noisy)",
         })?;
         write!(f, "{}", self.detail())
     }

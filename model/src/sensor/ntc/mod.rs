@@ -57,7 +57,7 @@ mod driver;
 mod stm32_adc;
 
 pub use driver::{AdcChannel, Error, Ntc};
-pub use stm32_adc::{AdcRegisters, EOC_POLLS, RegisterAdc, SimulatedStm32Adc, Timeout, reg};
+pub use stm32_adc::{AdcRegisters, EOC_POLLS, RegisterAdc, SimulatedStm32Adc, Stm32AdcState, Timeout, reg};
 
 /// `T25` of the beta equation \[K\].
 pub const T25: f32 = 298.15;

@@ -124,11 +124,85 @@ impl<R: AdcRegisters> AdcChannel for RegisterAdc<R> {
     }
 }
 
-/// The STM32F4 ADC with an NTC divider at its input, at register level:
-/// SWSTART (with ADON) converts at once, the code of the divider at
+/// The registers of a simulated STM32F4 ADC (SR, CR1, CR2, DR) and what
+/// a software-triggered regular conversion does to them, whatever is at
+/// the input: the simulators of each input ([`SimulatedStm32Adc`] with its
+/// NTC divider, the monitor's transducer) hold one and give it the code of
+/// each conversion.
+///
+/// SWSTART written with ADON converts at once: the input's code, at the
+/// resolution CR1 holds, goes to DR, EOC and STRT are set; reading DR
+/// clears EOC; a conversion whose result was not read sets OVR. SR's bits
+/// are rc_w0 (writing 0 clears, 1 keeps).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Stm32AdcState {
+    sr: u32,
+    cr1: u32,
+    cr2: u32,
+    dr: u32,
+}
+
+impl Stm32AdcState {
+    /// The registers at reset (ADC off, 12 bits).
+    pub const RESET: Stm32AdcState = Stm32AdcState {
+        sr: 0,
+        cr1: 0,
+        cr2: 0,
+        dr: 0,
+    };
+
+    /// The resolution CR1 holds \[bits\].
+    pub fn bits(&self) -> u8 {
+        reg::bits_of(self.cr1)
+    }
+
+    /// Reads the register at `offset` (reading DR clears EOC; unknown
+    /// offsets read 0).
+    pub fn read(&mut self, offset: u32) -> u32 {
+        match offset {
+            reg::SR => self.sr,
+            reg::CR1 => self.cr1,
+            reg::CR2 => self.cr2,
+            reg::DR => {
+                self.sr &= !reg::SR_EOC;
+                self.dr
+            }
+            _ => 0,
+        }
+    }
+
+    /// Writes `value` to the register at `offset`. A write of SWSTART with
+    /// ADON starts a conversion unless `stuck` (a converter that no longer
+    /// ends its conversions): `convert` gets CR1's resolution \[bits\] and
+    /// returns the input's code, which is masked to it. Returns whether a
+    /// conversion ran.
+    pub fn write(&mut self, offset: u32, value: u32, stuck: bool, convert: impl FnOnce(u8) -> u16) -> bool {
+        match offset {
+            reg::SR => self.sr &= value,
+            reg::CR1 => self.cr1 = value,
+            reg::CR2 => {
+                self.cr2 = value & !reg::CR2_SWSTART;
+                if value & reg::CR2_SWSTART != 0 && value & reg::CR2_ADON != 0 && !stuck {
+                    if self.sr & reg::SR_EOC != 0 {
+                        self.sr |= reg::SR_OVR;
+                    }
+                    let bits = self.bits();
+                    let mask = ((1u32 << bits) - 1) as u16;
+                    self.dr = u32::from(convert(bits) & mask);
+                    self.sr |= reg::SR_EOC | reg::SR_STRT;
+                    return true;
+                }
+            }
+            _ => {}
+        }
+        false
+    }
+}
+
+/// The STM32F4 ADC with an NTC divider at its input, at register level
+/// ([`Stm32AdcState`]): each conversion is the code of the divider at
 /// [`SimulatedStm32Adc::temperature`] rounded to the nearest
-/// ([`Settings::code_of`]) at the resolution CR1 holds, sets EOC and STRT;
-/// reading DR clears EOC; a conversion whose result is not read sets OVR.
+/// ([`Settings::code_of`]) at the resolution CR1 holds.
 ///
 /// Injected faults: an open or a shorted NTC (full scale, 0), a forced
 /// code, and a converter that no longer ends its conversions (EOC never
@@ -148,10 +222,7 @@ pub struct SimulatedStm32Adc {
     pub stuck: bool,
     /// Conversions run so far.
     pub conversions: u32,
-    sr: u32,
-    cr1: u32,
-    cr2: u32,
-    dr: u32,
+    regs: Stm32AdcState,
 }
 
 impl SimulatedStm32Adc {
@@ -166,19 +237,13 @@ impl SimulatedStm32Adc {
             forced_code: None,
             stuck: false,
             conversions: 0,
-            sr: 0,
-            cr1: 0,
-            cr2: 0,
-            dr: 0,
+            regs: Stm32AdcState::RESET,
         }
     }
 
-    /// The code the divider gives now, at CR1's resolution.
-    fn convert(&self) -> u16 {
-        let s = Settings {
-            bits: reg::bits_of(self.cr1),
-            ..self.settings
-        };
+    /// The code the divider gives now, at `bits` of resolution.
+    fn convert(&self, bits: u8) -> u16 {
+        let s = Settings { bits, ..self.settings };
         if let Some(c) = self.forced_code {
             return c & (s.full_scale() - 1);
         }
@@ -194,35 +259,13 @@ impl SimulatedStm32Adc {
 
 impl AdcRegisters for SimulatedStm32Adc {
     fn read(&mut self, offset: u32) -> u32 {
-        match offset {
-            reg::SR => self.sr,
-            reg::CR1 => self.cr1,
-            reg::CR2 => self.cr2,
-            reg::DR => {
-                self.sr &= !reg::SR_EOC;
-                self.dr
-            }
-            _ => 0,
-        }
+        self.regs.read(offset)
     }
 
     fn write(&mut self, offset: u32, value: u32) {
-        match offset {
-            // rc_w0 bits: writing 0 clears, 1 keeps.
-            reg::SR => self.sr &= value,
-            reg::CR1 => self.cr1 = value,
-            reg::CR2 => {
-                self.cr2 = value & !reg::CR2_SWSTART;
-                if value & reg::CR2_SWSTART != 0 && value & reg::CR2_ADON != 0 && !self.stuck {
-                    if self.sr & reg::SR_EOC != 0 {
-                        self.sr |= reg::SR_OVR;
-                    }
-                    self.conversions = self.conversions.wrapping_add(1);
-                    self.dr = u32::from(self.convert());
-                    self.sr |= reg::SR_EOC | reg::SR_STRT;
-                }
-            }
-            _ => {}
+        let this = *self;
+        if self.regs.write(offset, value, self.stuck, |bits| this.convert(bits)) {
+            self.conversions = self.conversions.wrapping_add(1);
         }
     }
 }
