@@ -23,8 +23,8 @@ pub const ALARMS: Flags = Flags(
 
 /// The monitor's settings for the campaign's sensor: its noise with the
 /// ADC's quantisation (`lsb^2 / 12`), its class as a uniform limit (GUM
-/// 4.3.7), its period.
-pub fn settings(sensor: &SecondSensor) -> MonitorSettings {
+/// 4.3.7), its period; the probe of the `nominal` design file.
+pub fn settings(sensor: &SecondSensor, nominal: &compensator::params::RawParams) -> MonitorSettings {
     let quantity = match sensor.quantity {
         Quantity::PA => monitor::Quantity::ChamberA,
         Quantity::PB => monitor::Quantity::ChamberB,
@@ -37,6 +37,7 @@ pub fn settings(sensor: &SecondSensor) -> MonitorSettings {
         sd_noise: (sensor.noise_sd * sensor.noise_sd + lsb * lsb / 12.0).sqrt() as f32,
         sd_accuracy: (sensor.accuracy * sensor.width() / 3f64.sqrt()) as f32,
         sample_period: (1.0 / sensor.rate_hz) as f32,
+        probe: monitor::ProbeModel::new(nominal),
     }
 }
 
@@ -93,7 +94,7 @@ pub fn run(scenario: &Scenario) -> Result<Outcome, String> {
         .ok_or("the first record has no probe reading")?;
     let mut est = Estimator::new(&p32, config, first as f32)
         .map_err(|e| e.to_string())?
-        .with_monitor(settings(&scenario.sensor))
+        .with_monitor(settings(&scenario.sensor, nominal))
         .map_err(|e| e.to_string())?;
     let onset = if scenario.injection.fault == Fault::None {
         f64::INFINITY

@@ -92,7 +92,7 @@ use crate::dynamics::Twin;
 use crate::error::ModelError;
 use crate::monitor::{HealthEstimate, Monitor};
 #[cfg(feature = "monitor")]
-use crate::monitor::{MonitorError, MonitorSettings, PlantView};
+use crate::monitor::{MonitorError, MonitorSettings, PlantView, ProbeSample};
 use crate::params::Params;
 use crate::scalar::Real;
 use crate::sensor::SensorFault;
@@ -213,6 +213,13 @@ pub struct Estimator<T = f32, U = UncertaintyTable, O = ObserverDesign> {
     /// Flags of the monitor's last reading, for the next estimate only.
     #[cfg(feature = "monitor")]
     health_flags: Flags,
+    /// The probe's last accepted reading and its tick, until the monitor
+    /// takes it.
+    #[cfg(feature = "monitor")]
+    probe_sample: Option<(f32, u32)>,
+    /// The tick of the monitor's last reading.
+    #[cfg(feature = "monitor")]
+    monitor_tick: u32,
 }
 
 impl<U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Copy> Estimator<f32, U, O> {
@@ -263,6 +270,10 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
             health: HealthEstimate::NONE,
             #[cfg(feature = "monitor")]
             health_flags: Flags::empty(),
+            #[cfg(feature = "monitor")]
+            probe_sample: None,
+            #[cfg(feature = "monitor")]
+            monitor_tick: 0,
         })
     }
 
@@ -306,13 +317,19 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
             return false;
         };
         let s = self.plant.twin().state();
+        let tick = self.config.observer_design().tick;
         let view = PlantView {
             oil: *self.plant.oil(),
             x: s.x,
             p_a: s.p_a,
             p_b: s.p_b,
-            var_t: self.observer.variance(self.config.observer_design()),
+            dt: self.tick.wrapping_sub(self.monitor_tick) as f32 * tick,
+            probe: self.probe_sample.take().map(|(value, at)| ProbeSample {
+                value,
+                age: self.tick.wrapping_sub(at) as f32 * tick,
+            }),
         };
+        self.monitor_tick = self.tick;
         self.health = monitor.update(self.plant.params(), &view, reading);
         self.health_flags = self.health.flags;
         true
@@ -390,7 +407,13 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
         match sample {
             Ok(Some(t)) if t.is_finite() && self.config.oil.contains(t) => {
                 match self.observer.offer(design, &self.config.spikes, t) {
-                    Verdict::Accepted | Verdict::Step => self.since_sample = 0,
+                    Verdict::Accepted | Verdict::Step => {
+                        self.since_sample = 0;
+                        #[cfg(feature = "monitor")]
+                        if self.monitor.is_some() {
+                            self.probe_sample = Some((t, self.tick));
+                        }
+                    }
                     Verdict::Spike => flags.insert(Flags::SPIKE),
                 }
             }

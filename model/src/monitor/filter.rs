@@ -2,12 +2,12 @@
 //! [`PARAMETERS`] states observed through one scalar reading a sample.
 //!
 //! ```text
-//! predict:  P <- P + Q                       (Q diagonal: the drift)
+//! predict:  P <- P + Q dt                    (Q diagonal: the drift per hour)
 //! update:   S = H P H' + R,  K = P H' / S,  theta <- theta + K nu,
 //!           P <- P - K H P                  (then symmetrised)
 //! ```
 //!
-//! Cost: about 40 multiply-adds and one division per reading.
+//! Cost: about 60 multiply-adds and one division per update.
 
 use super::signature::PARAMETERS;
 use crate::scalar::Real;
@@ -23,7 +23,7 @@ pub struct HealthFilter {
 
 impl HealthFilter {
     /// At zero, each parameter with its prior standard deviation `prior`
-    /// and the random walk's variance per reading `q`.
+    /// and the random walk's variance per hour `q`.
     pub fn new(prior: [f32; PARAMETERS], q: [f32; PARAMETERS]) -> Self {
         let mut p = [[0.0; PARAMETERS]; PARAMETERS];
         for i in 0..PARAMETERS {
@@ -69,26 +69,29 @@ impl HealthFilter {
         s
     }
 
-    /// The random walk over one reading's period.
-    pub fn predict(&mut self) {
+    /// The random walk over `hours`.
+    pub fn predict(&mut self, hours: f32) {
         for i in 0..PARAMETERS {
-            self.p[i][i] += self.q[i];
+            self.p[i][i] += self.q[i] * hours;
         }
     }
 
     /// The update with the innovation `nu` of variance `s` (`H P H' + R`,
-    /// positive) through the Jacobian `h`.
-    pub fn update(&mut self, h: &[f32; PARAMETERS], nu: f32, s: f32) {
+    /// positive) through the Jacobian `h`; returns the change of the
+    /// estimates (zero when `s` is not positive).
+    pub fn update(&mut self, h: &[f32; PARAMETERS], nu: f32, s: f32) -> [f32; PARAMETERS] {
+        let mut change = [0.0; PARAMETERS];
         if !(s > 0.0) {
-            return;
+            return change;
         }
         let mut ph = [0.0f32; PARAMETERS];
         for (i, row) in self.p.iter().enumerate() {
             ph[i] = row.iter().zip(h).map(|(a, b)| a * b).sum();
         }
         let inv = 1.0 / s;
-        for (theta, k) in self.theta.iter_mut().zip(&ph) {
-            *theta += k * inv * nu;
+        for ((theta, k), c) in self.theta.iter_mut().zip(&ph).zip(change.iter_mut()) {
+            *c = k * inv * nu;
+            *theta += *c;
         }
         for i in 0..PARAMETERS {
             for j in 0..=i {
@@ -100,6 +103,7 @@ impl HealthFilter {
                 self.p[i][i] = 0.0;
             }
         }
+        change
     }
 
     /// Moves parameter `i` by `by` (a change isolated and sized by the
@@ -130,12 +134,13 @@ mod tests {
     /// Gaussian: `theta = P h nu / (h^2 P + R)`, `P' = P R / (h^2 P + R)`.
     #[test]
     fn one_update_is_the_gaussian_posterior() {
-        let mut f = HealthFilter::new([2.0, 1.0, 1.0], [0.0; PARAMETERS]);
-        let h = [3.0, 0.0, 0.0];
+        let mut f = HealthFilter::new([2.0, 1.0, 1.0, 1.0], [0.0; PARAMETERS]);
+        let h = [3.0, 0.0, 0.0, 0.0];
         let (nu, r) = (1.5f32, 4.0f32);
         let s = f.innovation_variance(&h) + r;
         assert_eq!(s, 40.0);
-        f.update(&h, nu, s);
+        let change = f.update(&h, nu, s);
+        assert_eq!(change, f.theta());
         assert!((f.theta()[0] - 4.0 * 3.0 * 1.5 / 40.0).abs() < 1e-6);
         assert!((f.covariance()[0][0] - 4.0 * 4.0 / 40.0).abs() < 1e-6);
         assert_eq!(f.theta()[1], 0.0);
@@ -145,11 +150,11 @@ mod tests {
     /// converge on it with the least-squares variance.
     #[test]
     fn converges_on_a_constant() {
-        let mut f = HealthFilter::new([1.0, 1.0, 1.0], [0.0; PARAMETERS]);
-        let truth = [0.2f32, -0.1, 0.05];
+        let mut f = HealthFilter::new([1.0; PARAMETERS], [0.0; PARAMETERS]);
+        let truth = [0.2f32, -0.1, 0.05, 0.3];
         for k in 0..2000 {
             let t = k as f32 * 0.01;
-            let h = [1.0 + t.sin(), t.cos(), 1.0];
+            let h = [1.0 + t.sin(), t.cos(), 1.0, (0.5 * t).sin()];
             let y: f32 = h.iter().zip(&truth).map(|(a, b)| a * b).sum();
             let s = f.innovation_variance(&h) + 1e-4;
             let pred: f32 = h.iter().zip(&f.theta()).map(|(a, b)| a * b).sum();

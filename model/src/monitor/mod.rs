@@ -1,40 +1,76 @@
 //! Condition monitoring: a second sensor (a chamber pressure or the
-//! plunger displacement) corrects the twin's reading, and sequential tests
-//! on what the twin cannot explain name the device's fault.
+//! plunger displacement) says what the oil's temperature is, faster and
+//! finer than the probe; the probe, through its own lag, says whether the
+//! device still reads as its health estimate says; sequential tests on
+//! what the two cannot agree on name the device's fault.
+//!
+//! **Why the probe is the test, not the second sensor.** The
+//! oil-temperature observer inverts the probe's lag: in a step of the oil
+//! (1 C/s through an 8 s probe) its estimate is off by up to 1.3 K for a
+//! few seconds, 20 to 50 times its own variance (`docs/monitoring.md`, the
+//! observer's error over the campaign's histories). A reading of the
+//! second sensor compared with the twin at the observer's temperature
+//! carries that error: a chamber pressure moves 1-7 kPa per kelvin, 5-35
+//! of its noise's standard deviations. The comparison made the other way
+//! round carries none of it: the second sensor's reading gives the oil
+//! temperature at which the device, as the health parameters say it is,
+//! reads it; that temperature, sent through the probe's lag, predicts the
+//! probe's reading, with nothing to invert. A change of the device (a
+//! restricted capillary: the pressure says the oil warmed by kelvins, the
+//! probe never follows) shows in the probe's innovation as the fault's
+//! step through the lag; a true change of the oil shows in both and
+//! cancels.
 //!
 //! Per reading of the second sensor, in this order:
 //!
-//! 1. **Prediction.** The twin (the nominal device of the parameter file)
-//!    gives its reading `y_twin` now; the health parameters `theta` move it
-//!    by what they move the quasi-static reading at the twin's oil
-//!    ([`signature`]: `y = y_twin + h(theta) - h(0)`), and, for the
+//! 1. **The sensor's temperature.** The twin (the nominal device of the
+//!    parameter file, at the oil temperature of its Fluid job) gives its
+//!    reading `y_twin` now; the health parameters `theta` move it by what
+//!    they move the quasi-static reading at the twin's oil
+//!    ([`signature`]: `y_pred = y_twin + h(theta) - h(0)`), and, for the
 //!    displacement, a plunger held by friction stays in its play band
-//!    ([`signature::play`]), then the stops clamp it.
-//! 2. **Filter.** A Kalman filter of the health parameters ([`filter`]:
-//!    the divider `theta_A = ln(A / A_file)`, the spring `theta_k =
-//!    ln(c / c_file)`, the reading's offset `delta`), each a slow random
-//!    walk, updates with the innovation `nu = y - y_pred`, whose variance is
-//!    `S = H P H' + R`: the sensor's noise, the filter's own uncertainty,
-//!    and the oil-temperature observer's variance through `dy/dT` (the
-//!    probe's lag in a fast change). An innovation beyond [`GATE`]
-//!    standard deviations is counted ([`HealthEstimate::rejected`]), not
-//!    applied.
-//! 3. **Detection.** A two-sided CUSUM of the standardised innovation
+//!    ([`signature::play`]), then the stops clamp it. The reading `y` then
+//!    says the oil is at `T_s = T_twin + (y - y_pred) / (dy/dT)`, `dy/dT` the
+//!    reading's temperature sensitivity through the redistribution
+//!    parameter (`dA/dT = A (nu'/nu + rho'/(2 rho))`). Where the reading
+//!    hardly depends on the temperature (a plunger on a stop, held by
+//!    friction, or reading less than [`MAX_TEMPERATURE_SD`] a kelvin per
+//!    standard deviation of its noise) it says nothing: `T_s` is the
+//!    twin's, and the reading counts as uninformed.
+//! 2. **Through the probe's lag** ([`lag`]): `T_s`, its derivatives in the
+//!    health parameters (the filter's Jacobian), each hypothesis'
+//!    signature (step 4) and the uninformed indicator go through the
+//!    probe's first-order lag (and the well's).
+//! 3. **At a reading of the probe.** Its innovation is `nu = y_p -
+//!    T_probe - beta (a + b |T|)` (`beta`: where the probe sits within
+//!    its IEC 60751 tolerance, a health parameter), of variance `S = H P H'
+//!    + R`: the probe's noise and quantization, the second sensor's noise
+//!    through the lag, and the observer's error for the uninformed share of
+//!    the lag's memory. A Kalman filter of the health parameters
+//!    ([`filter`]: the divider `theta_A = ln(A / A_file)`, the spring
+//!    `theta_k = ln(c / c_file)`, the reading's offset `delta`, the probe's
+//!    `beta`, each a slow random walk) updates with it; a change of the
+//!    parameters moves the lagged temperature by the lagged Jacobian. An
+//!    innovation beyond [`GATE`] standard deviations is counted
+//!    ([`HealthEstimate::rejected`]), not applied; with more than
+//!    [`MAX_UNINFORMED`] of the lag's memory uninformed there is no test.
+//! 4. **Detection.** A two-sided CUSUM of the standardised innovation
 //!    `z = nu / sqrt(S)` ([`CUSUM_DRIFT`], [`CUSUM_THRESHOLD`]) says the
 //!    device no longer behaves as the filter's device: `DEVICE_CHANGED`.
-//! 4. **Isolation.** From the CUSUM run's start on (the change's onset), the
-//!    innovations are fitted by each fault's signature alone (a generalised
-//!    likelihood ratio over the window, [`Hypothesis`]); the fault whose
-//!    fit explains the innovations better than every other's by
-//!    [`ISOLATION_MARGIN`] in log-likelihood is named (its flag latches),
-//!    the filter's variance of its parameter is reopened so that the
-//!    parameter settles on the fault's size, and watching resumes. While a
-//!    change is detected and not yet isolated the filter is frozen, so
-//!    that it does not absorb the change it is trying to name.
+//! 5. **Isolation.** From the CUSUM run's start on (the change's onset), the
+//!    innovations are fitted by each fault's signature alone, through the
+//!    lag (a generalised likelihood ratio over the window, [`Hypothesis`]);
+//!    the fault whose fit explains the innovations better than every
+//!    other's by [`ISOLATION_MARGIN`] in log-likelihood, over at least
+//!    [`ISOLATION_SPAN`] of oil temperature, is named (its flag latches),
+//!    its parameter moves by the fitted size and its variance reopens, and
+//!    watching resumes. While a change is detected and not yet isolated
+//!    the filter is frozen, so that it does not absorb the change it is
+//!    trying to name.
 //!
-//! The second sensor's own faults (`crate::sensor::SensorFault`) skip the
-//! update and raise `SECOND_SENSOR_FAULT`; the estimate then rests on the
-//! temperature alone, as without a monitor.
+//! The second sensor's own faults (`crate::sensor::SensorFault`) skip its
+//! reading and raise `SECOND_SENSOR_FAULT`; the lag then runs on the
+//! twin's temperature (uninformed) and the tests pause.
 //!
 //! **Why not the twin's four states in the filter.** The twin's chamber
 //! pressures and plunger settle within milliseconds
@@ -44,17 +80,20 @@
 //! perturbation): an extended Kalman filter of `(x, v, p_a, p_b, theta)`
 //! would carry a covariance of the fast states that is the quasi-static
 //! image of `theta`'s, at four times the cost. The filter here keeps the
-//! slow states; the twin supplies the fast ones' transient, and the
-//! quasi-static algebra the health parameters' effect on them.
+//! slow states; the twin supplies the fast ones' transient, the
+//! quasi-static algebra the health parameters' effect on them, and the
+//! second sensor the oil's temperature.
 //!
 //! What each sensor can tell apart, and the flags' confusions, are in the
 //! project's `docs/monitoring.md`. Nothing here allocates or panics; a
 //! non-finite input is a rejected reading.
 
 pub mod filter;
+pub mod lag;
 pub mod signature;
 
 pub use filter::HealthFilter;
+pub use lag::ProbeModel;
 pub use signature::{Design, Quantity, Reading};
 
 use crate::equilibrium::a_parameter;
@@ -62,16 +101,18 @@ use crate::estimator::{Flags, clamp};
 use crate::fluid::FluidPoint;
 use crate::params::Params;
 use crate::scalar::Real;
-use signature::{DIVIDER, OFFSET, PARAMETERS, SPRING, exp, play};
+use lag::{Decay, Lag};
+use signature::{DIVIDER, OFFSET, PARAMETERS, PROBE, SPRING, exp, play};
 
-/// Standard deviations of the innovation beyond which a reading is not
-/// applied to the filter: `P(|z| > 6) = 2e-9` for a normal innovation,
-/// below one a day at 100 readings a second.
+/// Standard deviations of the probe's innovation beyond which a reading is
+/// not applied to the filter: `P(|z| > 6) = 2e-9` for a normal innovation,
+/// below one a day at 50 readings a second.
 pub const GATE: f32 = 6.0;
 
 /// Drift `k` of the CUSUM, in innovation standard deviations: a bias of the
-/// model below it (an unmodelled lag, a probe's tolerance the filter has
-/// not yet learned) only drains the statistic.
+/// model below it (the lag's discretisation, the quasi-static device
+/// against the twin's transient, a health estimate not yet converged) only
+/// drains the statistic.
 pub const CUSUM_DRIFT: f32 = 3.0;
 
 /// Threshold `h` of the CUSUM in innovation standard deviations. For a
@@ -94,17 +135,44 @@ pub const ISOLATION_MARGIN: f32 = 6.9;
 /// with the temperature.
 pub const ISOLATION_SPAN: f32 = 1.0;
 
-/// Relative model error of a fault's signature in the isolation's fit: the
-/// variance of each reading there is `S + (MODEL_ERROR nu)^2`, so that a
-/// signal far above the noise does not make the small misfits of the
-/// linearisation and of the temperature estimate decisive.
+/// Relative error of a fault's signature, systematic over the isolation's
+/// window (the nominal design's shape against the device's as built, the
+/// linearisation, the onset's timing): a misfit this large does not
+/// average down with more readings, so another fault is ruled out only
+/// when its fit is worse than the named one's by more than this error of
+/// the whole signal could make it, `MODEL_ERROR^2 sum(nu^2 / S) / 2` in
+/// log-likelihood on top of [`ISOLATION_MARGIN`]. A large fault, far above
+/// the noise, is named once the temperature has spread the signatures
+/// apart by more than the model's error, not by chance of its misfit.
 pub const MODEL_ERROR: f32 = 0.02;
 
-/// Readings after a fault is named during which the filter takes every
-/// reading (no gate, no test): it settles on the fault's size from the
-/// tests' fit, whose linearisation at the old parameters is off by the
+/// Probe readings after a fault is named during which the filter takes
+/// every reading (no gate, no test): it settles on the fault's size from
+/// the tests' fit, whose linearisation at the old parameters is off by the
 /// change's curvature.
 pub const SETTLE_READINGS: u32 = 200;
+
+/// The largest standard deviation \[K\] of the oil temperature one reading
+/// of the second sensor may give for it to inform the probe's prediction
+/// (its noise over its temperature sensitivity): a plunger near a stop
+/// hardly moves with the oil.
+pub const MAX_TEMPERATURE_SD: f32 = 2.0;
+
+/// The farthest \[K\] the second sensor's temperature is taken from the
+/// twin's: beyond the linearisation, a gross change of the device (a
+/// capillary at half its conductance reads 14 K away).
+pub const MAX_DEVIATION: f32 = 25.0;
+
+/// The share of the probe lag's memory that may come from uninformed
+/// readings (the twin's temperature) before the probe's readings are no
+/// longer tested.
+pub const MAX_UNINFORMED: f32 = 0.02;
+
+/// The oil-temperature observer's largest error \[K\] behind a step of the
+/// oil, which an uninformed share of the lag's memory carries into the
+/// probe's prediction: 1.33 K over the campaign's histories (`cargo run
+/// --release -p host-tests --example observer_error`).
+pub const UNINFORMED_ERROR: f32 = 1.5;
 
 /// Priors of the health parameters: standard deviations of a device as
 /// built around its file (the divider's `A` goes with the capillary's bore
@@ -115,10 +183,14 @@ pub const PRIOR_SPRING: f32 = 0.05;
 /// Prior of the displacement's offset as a fraction of the stroke (the
 /// preload's and the sensor's zero), on top of the sensor's accuracy.
 pub const PRIOR_OFFSET_STROKES: f32 = 0.02;
+/// Prior of the probe's place within its tolerance: uniform over `[-1,
+/// 1]`, standard deviation `1 / sqrt(3)` (GUM 4.3.7).
+pub const PRIOR_PROBE: f32 = 0.577_350_3;
 
 /// Random-walk drift of the health parameters per square root of an hour:
-/// the device's slow wear the filter follows without a flag.
-pub const DRIFT_PER_SQRT_HOUR: [f32; PARAMETERS] = [0.005, 0.002, 0.0];
+/// the device's slow wear and the probe's ageing, which the filter follows
+/// without a flag.
+pub const DRIFT_PER_SQRT_HOUR: [f32; PARAMETERS] = [0.005, 0.002, 0.0, 0.01];
 
 /// The friction the sticking test is designed for, as a fraction of the
 /// spring's force at mid-stroke (`F = f c (x0 + x_max / 2)`): the play
@@ -126,7 +198,7 @@ pub const DRIFT_PER_SQRT_HOUR: [f32; PARAMETERS] = [0.005, 0.002, 0.0];
 pub const STICKING_DESIGN: f32 = 0.05;
 
 /// What the monitor needs of its sensor (from the device file's
-/// `[monitor]`).
+/// `[monitor]`) and of the oil-temperature probe (its `[probe]`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MonitorSettings {
     /// What is measured.
@@ -139,13 +211,16 @@ pub struct MonitorSettings {
     pub sd_accuracy: f32,
     /// Time between readings \[s\].
     pub sample_period: f32,
+    /// The oil-temperature probe ([`ProbeModel::new`] of the device file).
+    pub probe: ProbeModel,
 }
 
 /// Why a monitor cannot be built: the setting named.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MonitorError {
     /// The setting is not finite and positive (`monitor.noise`,
-    /// `monitor.accuracy`, `monitor.sample_hz`).
+    /// `monitor.accuracy`, `monitor.sample_hz`, `probe.time_constant`,
+    /// `probe.noise`).
     NotPositive(&'static str),
 }
 
@@ -178,9 +253,12 @@ pub enum Hypothesis {
     Sticking,
 }
 
+/// Hypotheses the isolation fits.
+pub const HYPOTHESES: usize = 6;
+
 impl Hypothesis {
     /// Every hypothesis, in the accumulators' order.
-    pub const ALL: [Hypothesis; 6] = [
+    pub const ALL: [Hypothesis; HYPOTHESES] = [
         Hypothesis::CapillaryRestricted,
         Hypothesis::OrificeClogged,
         Hypothesis::SpringRelaxed,
@@ -209,10 +287,29 @@ impl Hypothesis {
             _ => 1.0,
         }
     }
+
+    /// The health parameter it moves ([`PARAMETERS`] for the play band).
+    fn parameter(self) -> usize {
+        match self {
+            Hypothesis::CapillaryRestricted | Hypothesis::OrificeClogged => DIVIDER,
+            Hypothesis::SpringRelaxed => SPRING,
+            Hypothesis::OffsetUp | Hypothesis::OffsetDown => OFFSET,
+            Hypothesis::Sticking => PARAMETERS,
+        }
+    }
+}
+
+/// A reading of the oil-temperature probe the monitor has not yet seen.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProbeSample {
+    /// The reading \[C\], as the observer accepted it.
+    pub value: f32,
+    /// How long before the monitor's reading it was taken \[s\].
+    pub age: f32,
 }
 
 /// What the monitor reads of the plant at a reading: the twin's oil and
-/// state, and the oil-temperature observer's variance.
+/// state, the time since its last reading, and the probe's new reading.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PlantView {
     /// The twin's oil (its temperature and the temperature derivatives of
@@ -224,8 +321,10 @@ pub struct PlantView {
     pub p_a: f32,
     /// The twin's chamber (b) pressure \[Pa\].
     pub p_b: f32,
-    /// Variance of the oil-temperature estimate \[K^2\].
-    pub var_t: f32,
+    /// Time since the monitor's previous reading \[s\] (ignored at the first).
+    pub dt: f32,
+    /// The probe's reading since the monitor's previous one, if any.
+    pub probe: Option<ProbeSample>,
 }
 
 /// The monitor's estimate after a reading.
@@ -245,12 +344,22 @@ pub struct HealthEstimate {
     pub offset: f32,
     /// Its standard deviation \[Pa or m\].
     pub sd_offset: f32,
+    /// The probe's error at the twin's oil temperature \[K\]: where it sits
+    /// within its tolerance times the tolerance there.
+    pub probe_bias: f32,
+    /// Its standard deviation \[K\].
+    pub sd_probe_bias: f32,
+    /// The oil temperature the second sensor's reading gives through the
+    /// health estimate \[C\] (the twin's where the reading does not depend
+    /// on it).
+    pub oil: f32,
     /// The friction force holding the plunger \[N\] (0 until sticking is
     /// isolated).
     pub friction: f32,
-    /// The corrected reading the monitor predicted \[Pa or m\].
+    /// The corrected reading the monitor predicted at the twin's oil
+    /// temperature \[Pa or m\].
     pub predicted: f32,
-    /// The standardised innovation of the last reading.
+    /// The standardised innovation of the probe's last reading tested.
     pub innovation: f32,
     /// The larger of the two CUSUM statistics (in innovation standard
     /// deviations).
@@ -272,6 +381,9 @@ impl HealthEstimate {
         sd_spring: f32::NAN,
         offset: f32::NAN,
         sd_offset: f32::NAN,
+        probe_bias: f32::NAN,
+        sd_probe_bias: f32::NAN,
+        oil: f32::NAN,
         friction: f32::NAN,
         predicted: f32::NAN,
         innovation: f32::NAN,
@@ -281,15 +393,34 @@ impl HealthEstimate {
     };
 }
 
+/// The lag's signals: the second sensor's temperature, its derivatives in
+/// the first three health parameters, each hypothesis' signature, the
+/// uninformed indicator.
+const OIL: usize = 0;
+const D_THETA: usize = 1;
+const SIGNATURE: usize = D_THETA + OFFSET + 1;
+const UNINFORMED: usize = SIGNATURE + HYPOTHESES;
+const SIGNALS: usize = UNINFORMED + 1;
+
 /// The condition monitor (see the module docs). `f32`; one reading costs
-/// two exponentials, two square roots and a 3-state filter update.
+/// two exponentials and a square root (three more of each while a change
+/// is being isolated), the lag of 11 signals, and at a probe reading a
+/// 4-state filter update.
 #[derive(Clone, Copy, Debug)]
 pub struct Monitor {
     design: Design,
     settings: MonitorSettings,
-    /// The file's spring rate `c` [N/m].
+    /// The file's spring rate `c` \[N/m\].
     spring_rate: f32,
     filter: HealthFilter,
+    /// The probe's lag of the signals, and its decay for the last step.
+    lag: Lag<SIGNALS>,
+    decay: Decay,
+    /// The variance the second sensor's noise leaves in the lagged
+    /// temperature \[K^2\].
+    lag_variance: f32,
+    /// The first reading has set the lag at rest.
+    started: bool,
     /// The play band's half width of an isolated sticking fault \[m\].
     friction_width: f32,
     /// Where the monitor's plunger is held by that friction \[m\].
@@ -304,14 +435,22 @@ pub struct Monitor {
     detected: bool,
     /// Isolation sums over the CUSUM's run: per hypothesis `sum g nu / S`
     /// and `sum g^2 / S`.
-    fit_b: [f32; 6],
-    fit_c: [f32; 6],
+    fit_b: [f32; HYPOTHESES],
+    fit_c: [f32; HYPOTHESES],
+    /// `sum nu^2 / S` over the run: the signal's energy.
+    energy: f32,
+    /// The standardised innovation of the probe's last reading tested.
+    innovation: f32,
     latched: Flags,
     rejected: u32,
     /// Readings left of the settling after a named fault.
     settling: u32,
     /// The oil temperatures the isolation window spans \[C\].
     window: (f32, f32),
+    /// The parameters whose temperature sensitivity turns a reading into
+    /// the second sensor's temperature: the file's device, then each named
+    /// fault's.
+    reference: [f32; PARAMETERS],
 }
 
 impl Monitor {
@@ -333,6 +472,11 @@ impl Monitor {
         positive(settings.sd_noise, "monitor.noise")?;
         positive(settings.sd_accuracy, "monitor.accuracy")?;
         positive(settings.sample_period, "monitor.sample_hz")?;
+        positive(settings.probe.time_constant, "probe.time_constant")?;
+        positive(settings.probe.reading_sd, "probe.noise")?;
+        if !(settings.probe.well_time_constant >= 0.0 && settings.probe.well_time_constant.is_finite()) {
+            return Err(MonitorError::NotPositive("probe.well_time_constant"));
+        }
         let plunger = &params.plunger;
         let design = Design {
             quantity: settings.quantity,
@@ -350,29 +494,35 @@ impl Monitor {
             ),
             _ => settings.sd_accuracy,
         };
-        let hours = settings.sample_period / 3600.0;
         let mut drift = [0.0; PARAMETERS];
         for (d, per) in drift.iter_mut().zip(DRIFT_PER_SQRT_HOUR) {
-            *d = per * per * hours;
+            *d = per * per;
         }
-        let filter = HealthFilter::new([PRIOR_DIVIDER, PRIOR_SPRING, sd_offset], drift);
+        let filter = HealthFilter::new([PRIOR_DIVIDER, PRIOR_SPRING, sd_offset, PRIOR_PROBE], drift);
         Ok(Monitor {
             design,
             settings,
             spring_rate: plunger.spring_rate,
             filter,
+            lag: Lag::at_rest([0.0; SIGNALS]),
+            decay: Decay::new(&settings.probe, settings.sample_period),
+            lag_variance: 0.0,
+            started: false,
             friction_width: 0.0,
             held: f32::NAN,
             design_width: STICKING_DESIGN * (plunger.preload + 0.5 * plunger.stroke),
             test_held: f32::NAN,
             cusum: [0.0; 2],
             detected: false,
-            fit_b: [0.0; 6],
-            fit_c: [0.0; 6],
+            fit_b: [0.0; HYPOTHESES],
+            fit_c: [0.0; HYPOTHESES],
+            energy: 0.0,
+            innovation: f32::NAN,
             latched: Flags::empty(),
             rejected: 0,
             settling: 0,
             window: (f32::NAN, f32::NAN),
+            reference: [0.0; PARAMETERS],
         })
     }
 
@@ -405,9 +555,15 @@ impl Monitor {
         }
     }
 
+    /// A change is being watched or isolated: the hypotheses' signatures
+    /// run through the lag.
+    fn running(&self) -> bool {
+        self.detected || self.cusum[0] > 0.0 || self.cusum[1] > 0.0
+    }
+
     /// One reading `measured` (`Err`: the sensor's own checks refused it)
-    /// of the second sensor, with the plant as it is now (see the module
-    /// docs).
+    /// of the second sensor, with the plant as it is now and the probe's
+    /// reading since the last (see the module docs).
     pub fn update<E>(&mut self, params: &Params<f32>, view: &PlantView, measured: Result<f32, E>) -> HealthEstimate {
         let mut flags = self.latched;
         let a = a_parameter(params, &view.oil.state);
@@ -421,53 +577,178 @@ impl Monitor {
         // dy/dT through A: dA/dT = A (nu'/nu + rho'/(2 rho)).
         let point = &view.oil;
         let dln_a = point.viscosity.d1 / point.viscosity.value + 0.5 * point.density.d1 / point.density.value;
-        let dy_dt = now.jacobian[DIVIDER] * dln_a;
-        let r = self.settings.sd_noise * self.settings.sd_noise + dy_dt * dy_dt * view.var_t;
-        // The parameters, the tests' state and the flags are filled in by
-        // `publish`, on every path.
+        // The temperature sensitivity at the reference parameters, not the
+        // filter's: `T_s` must be linear in the parameters the filter
+        // moves, or a move along what one temperature cannot tell apart
+        // (the divider against the probe's error) changes `T_s` through
+        // the slope and the filter runs away along it.
+        let slope = if self.reference == [0.0; PARAMETERS] {
+            nominal.jacobian[DIVIDER]
+        } else {
+            self.design.reading(a, &self.reference).jacobian[DIVIDER]
+        };
+        let dy_dt = if jacobian[DIVIDER] == 0.0 { 0.0 } else { slope * dln_a };
+        let t_twin = point.state.temperature;
         let mut estimate = HealthEstimate {
             predicted,
+            innovation: self.innovation,
             ..HealthEstimate::NONE
         };
-        let y = match measured {
-            Ok(y) if y.is_finite() && r.is_finite() && predicted.is_finite() => y,
+        let reading = match measured {
+            Ok(y) if y.is_finite() => Some(y),
             Ok(_) => {
                 self.rejected = self.rejected.saturating_add(1);
                 flags.insert(Flags::INNOVATION_REJECTED);
-                return self.publish(estimate, flags);
+                None
             }
             Err(_) => {
                 flags.insert(Flags::SECOND_SENSOR_FAULT);
-                return self.publish(estimate, flags);
+                None
             }
         };
-        let nu = y - predicted;
-        let s = self.filter.innovation_variance(&jacobian) + r;
+        // The second sensor's temperature and the signals the lag carries.
+        let sd_t = self.settings.sd_noise / libm::fabsf(dy_dt);
+        let mut u = [0.0f32; SIGNALS];
+        u[OIL] = t_twin;
+        let informed = match reading {
+            Some(y) if sd_t < MAX_TEMPERATURE_SD && predicted.is_finite() && t_twin.is_finite() => {
+                let inv = -1.0 / dy_dt;
+                u[OIL] = t_twin - clamp((y - predicted) * inv, -MAX_DEVIATION, MAX_DEVIATION);
+                for k in 0..=OFFSET {
+                    u[D_THETA + k] = jacobian[k] * inv;
+                }
+                if self.running() {
+                    self.signatures(&mut u, inv, (a, &theta, now.value), &jacobian, sticking);
+                }
+                true
+            }
+            _ => {
+                u[UNINFORMED] = 1.0;
+                false
+            }
+        };
+        estimate.oil = u[OIL];
+        if !self.started {
+            if !u[OIL].is_finite() {
+                return self.publish(estimate, flags, t_twin);
+            }
+            self.lag = Lag::at_rest(u);
+            self.started = true;
+        } else if view.dt > 0.0 && view.dt.is_finite() {
+            if view.dt != self.decay.h {
+                self.decay = Decay::new(&self.settings.probe, view.dt);
+            }
+            self.lag.step(&u, &self.decay);
+            let p = self.decay.probe;
+            let fresh = if informed { sd_t * sd_t } else { 0.0 };
+            self.lag_variance = p * p * self.lag_variance + (1.0 - p) * (1.0 - p) * fresh;
+            self.filter.predict(view.dt * (1.0 / 3600.0));
+        }
+        if let Some(sample) = view.probe {
+            self.test(sample, t_twin, &mut estimate, &mut flags);
+        }
+        self.publish(estimate, flags, t_twin)
+    }
+
+    /// The hypotheses' signatures on the second sensor's temperature
+    /// (`inv = -1 / (dy/dT)`) into `u`. A fault's signature is the secant
+    /// of the reading over the fault's size fitted so far (`(h(theta +
+    /// delta e_k) - h(theta)) / delta`, the derivative while the size is not
+    /// yet known): the reading is not linear in the divider or the spring
+    /// over a fault's size, and the derivative's shape at the old
+    /// parameters would favour the wrong fault. `at` is the redistribution
+    /// parameter, the filter's parameters and the reading there.
+    fn signatures(
+        &self,
+        u: &mut [f32; SIGNALS],
+        inv: f32,
+        at: (f32, &[f32; PARAMETERS], f32),
+        jacobian: &[f32; PARAMETERS],
+        sticking: f32,
+    ) {
+        let (a, theta, value) = at;
+        for (i, h) in Hypothesis::ALL.iter().enumerate() {
+            let k = h.parameter();
+            let g = if k == PARAMETERS {
+                sticking
+            } else if k == OFFSET || jacobian[k] == 0.0 || !(self.fit_c[i] > 0.0) {
+                jacobian[k] * h.sign()
+            } else {
+                // The size fitted so far, by the fault's sign (at least a
+                // hundredth, where the secant is the derivative).
+                let size = clamp(self.fit_b[i] / self.fit_c[i], 0.01, 2.0);
+                let mut moved = *theta;
+                moved[k] += h.sign() * size;
+                (self.design.reading(a, &moved).value - value) / size
+            };
+            u[SIGNATURE + i] = g * inv;
+        }
+    }
+
+    /// The probe's reading `sample` against the lagged temperature: the
+    /// tests, then the filter (see the module docs, steps 3-5). `t_oil` is
+    /// the twin's oil temperature \[C\].
+    fn test(&mut self, sample: ProbeSample, t_oil: f32, estimate: &mut HealthEstimate, flags: &mut Flags) {
+        let probe = self.settings.probe;
+        let uninformed = self.lag.probe(UNINFORMED);
+        if !(uninformed <= MAX_UNINFORMED) || !sample.value.is_finite() {
+            return;
+        }
+        // The lagged temperature when the reading was taken.
+        let age = clamp(sample.age, 0.0, 1.0);
+        let t_probe = self.lag.probe(OIL) - age * self.lag.probe_rate(OIL, &probe);
+        // The tolerance at the twin's smooth temperature, not at the lagged
+        // one, which carries the second sensor's noise: a Jacobian that
+        // moves with the innovation's own noise biases the filter along
+        // what one temperature cannot tell apart (the divider against the
+        // probe's error), by far more than the tolerance's slope suggests.
+        let tolerance = probe.tolerance_at(t_oil);
+        let theta = self.filter.theta();
+        let nu = sample.value - t_probe - theta[PROBE] * tolerance;
+        let mut h = [tolerance; PARAMETERS];
+        for (k, h) in h.iter_mut().enumerate().take(OFFSET + 1) {
+            *h = self.lag.probe(D_THETA + k);
+        }
+        let spread = uninformed * UNINFORMED_ERROR;
+        let r = probe.reading_sd * probe.reading_sd + self.lag_variance + spread * spread;
+        let s = self.filter.innovation_variance(&h) + r;
         let z = nu / <f32 as Real>::sqrt(s);
+        if !z.is_finite() {
+            return;
+        }
         estimate.innovation = z;
+        self.innovation = z;
         if self.settling > 0 {
             self.settling -= 1;
-            self.filter.update(&jacobian, nu, s);
-            self.filter.predict();
-            return self.publish(estimate, flags);
+            self.learn(&h, nu, s);
+            return;
         }
         // Detection: the two-sided CUSUM; a run starting from zero starts
-        // the isolation sums (the change's onset).
-        let zc = clamp(z, -CUSUM_CLIP, CUSUM_CLIP);
-        if self.cusum == [0.0, 0.0] && !self.detected {
-            self.fit_b = [0.0; 6];
-            self.fit_c = [0.0; 6];
+        // the isolation sums and the signatures (the change's onset).
+        if !self.running() {
+            self.fit_b = [0.0; HYPOTHESES];
+            self.fit_c = [0.0; HYPOTHESES];
+            self.energy = 0.0;
             self.test_held = f32::NAN;
-            self.window = (view.oil.state.temperature, view.oil.state.temperature);
+            self.window = (t_oil, t_oil);
+            for i in 0..HYPOTHESES {
+                self.lag.clear(SIGNATURE + i);
+            }
         }
+        let zc = clamp(z, -CUSUM_CLIP, CUSUM_CLIP);
         self.cusum[0] = clamp(self.cusum[0] + zc - CUSUM_DRIFT, 0.0, f32::MAX);
         self.cusum[1] = clamp(self.cusum[1] - zc - CUSUM_DRIFT, 0.0, f32::MAX);
-        let running = self.detected || self.cusum[0] > 0.0 || self.cusum[1] > 0.0;
-        if running {
-            let t = view.oil.state.temperature;
-            self.window = (clamp(self.window.0, f32::MIN, t), clamp(self.window.1, t, f32::MAX));
-            let s = s + MODEL_ERROR * MODEL_ERROR * nu * nu;
-            self.accumulate(nu, s, (a, &theta, now.value), &jacobian, sticking);
+        if self.running() {
+            self.window = (
+                clamp(self.window.0, f32::MIN, t_oil),
+                clamp(self.window.1, t_oil, f32::MAX),
+            );
+            self.energy += nu * nu / s;
+            for i in 0..HYPOTHESES {
+                let g = self.lag.probe(SIGNATURE + i);
+                self.fit_b[i] += g * nu / s;
+                self.fit_c[i] += g * g / s;
+            }
         }
         if self.cusum[0] > CUSUM_THRESHOLD || self.cusum[1] > CUSUM_THRESHOLD {
             self.detected = true;
@@ -485,15 +766,23 @@ impl Monitor {
         } else if !(self.cusum[0] > 0.25 * CUSUM_THRESHOLD || self.cusum[1] > 0.25 * CUSUM_THRESHOLD) {
             // A suspicious run holds the filter: it must not learn the
             // change before the tests have named it.
-            self.filter.update(&jacobian, nu, s);
+            self.learn(&h, nu, s);
         }
-        self.filter.predict();
-        self.publish(estimate, flags)
     }
 
-    /// `estimate` with the filter's parameters now, the tests' state and
-    /// `flags`.
-    fn publish(&mut self, mut estimate: HealthEstimate, flags: Flags) -> HealthEstimate {
+    /// The filter's update; the lagged temperature follows the parameters'
+    /// change through the lagged Jacobian (as if the new parameters had
+    /// read every past reading).
+    fn learn(&mut self, h: &[f32; PARAMETERS], nu: f32, s: f32) {
+        let change = self.filter.update(h, nu, s);
+        for (k, c) in change.iter().enumerate().take(OFFSET + 1) {
+            self.lag.add_scaled(OIL, D_THETA + k, *c);
+        }
+    }
+
+    /// `estimate` with the filter's parameters now (the probe's error at
+    /// the oil temperature `t_oil` \[C\]), the tests' state and `flags`.
+    fn publish(&mut self, mut estimate: HealthEstimate, flags: Flags, t_oil: f32) -> HealthEstimate {
         self.latched = Flags(flags.0 & LATCHED.0);
         let theta = self.filter.theta();
         estimate.divider = exp(theta[DIVIDER]);
@@ -502,6 +791,9 @@ impl Monitor {
         estimate.sd_spring = self.filter.sd(SPRING);
         estimate.offset = theta[OFFSET];
         estimate.sd_offset = self.filter.sd(OFFSET);
+        let tolerance = self.settings.probe.tolerance_at(t_oil);
+        estimate.probe_bias = theta[PROBE] * tolerance;
+        estimate.sd_probe_bias = self.filter.sd(PROBE) * tolerance;
         estimate.friction = self.friction_width * self.spring_rate;
         estimate.cusum = if self.cusum[0] > self.cusum[1] {
             self.cusum[0]
@@ -550,58 +842,19 @@ impl Monitor {
         (x, jacobian, self.test_held - free)
     }
 
-    /// Adds a reading to the isolation sums. A fault's signature is the
-    /// secant of the reading over the fault's size fitted so far
-    /// (`(h(theta + delta e_k) - h(theta)) / delta`, the derivative while the size is
-    /// not yet known): the reading is not linear in the divider or the
-    /// spring over a fault's size, and the derivative's shape at the old
-    /// parameters would favour the wrong fault. `at` is the redistribution
-    /// parameter, the filter's parameters and the reading there.
-    fn accumulate(
-        &mut self,
-        nu: f32,
-        s: f32,
-        at: (f32, &[f32; PARAMETERS], f32),
-        jacobian: &[f32; PARAMETERS],
-        sticking: f32,
-    ) {
-        let (a, theta, value) = at;
-        for (i, h) in Hypothesis::ALL.iter().enumerate() {
-            let k = match h {
-                Hypothesis::CapillaryRestricted | Hypothesis::OrificeClogged => DIVIDER,
-                Hypothesis::SpringRelaxed => SPRING,
-                Hypothesis::OffsetUp | Hypothesis::OffsetDown => OFFSET,
-                Hypothesis::Sticking => PARAMETERS,
-            };
-            let g = if k == PARAMETERS {
-                sticking
-            } else if k == OFFSET || jacobian[k] == 0.0 || !(self.fit_c[i] > 0.0) {
-                jacobian[k] * h.sign()
-            } else {
-                // The size fitted so far, by the fault's sign (at least a
-                // hundredth, where the secant is the derivative).
-                let size = clamp(self.fit_b[i] / self.fit_c[i], 0.01, 2.0);
-                let mut moved = *theta;
-                moved[k] += h.sign() * size;
-                (self.design.reading(a, &moved).value - value) / size
-            };
-            self.fit_b[i] += g * nu / s;
-            self.fit_c[i] += g * g / s;
-        }
-    }
-
-    /// The hypothesis whose fit beats every other's by the margin, if any.
+    /// The hypothesis whose fit beats every other's by the margin (the
+    /// noise's and the model error's, [`MODEL_ERROR`]), if any.
     fn isolated(&self) -> Option<Hypothesis> {
         // Log-likelihood gain of each single-fault fit, `b^2 / (2 c)`, with
         // the fault's sign (an amplitude of the wrong sign gains nothing).
-        let mut gain = [0.0f32; 6];
+        let mut gain = [0.0f32; HYPOTHESES];
         for ((g, b), c) in gain.iter_mut().zip(&self.fit_b).zip(&self.fit_c) {
             if *c > 0.0 && *b > 0.0 {
                 *g = 0.5 * b * b / c;
             }
         }
         let mut best = 0;
-        for i in 1..6 {
+        for i in 1..HYPOTHESES {
             if gain[i] > gain[best] {
                 best = i;
             }
@@ -613,16 +866,19 @@ impl Monitor {
             }
         }
         let span = self.window.1 - self.window.0;
-        if gain[best] - second >= ISOLATION_MARGIN && span >= ISOLATION_SPAN {
+        let margin = ISOLATION_MARGIN + 0.5 * MODEL_ERROR * MODEL_ERROR * self.energy;
+        if gain[best] - second >= margin && span >= ISOLATION_SPAN {
             Some(Hypothesis::ALL[best])
         } else {
             None
         }
     }
 
-    /// Accepts hypothesis `h`: its parameter's variance reopens (the
-    /// filter then settles on the fault's size), or the friction's fitted
-    /// width enters the prediction; the tests restart.
+    /// Accepts hypothesis `h`: its parameter moves by the fitted size and
+    /// its variance reopens (the filter then settles on the fault's size),
+    /// or the friction's fitted width enters the prediction; the lagged
+    /// temperature takes the fitted change since the onset; the tests
+    /// restart.
     fn confirm(&mut self, h: Hypothesis) {
         let i = Hypothesis::ALL.iter().position(|&x| x == h).unwrap_or(0);
         // The fit's amplitude (the change in the parameter, by the
@@ -632,27 +888,26 @@ impl Monitor {
         } else {
             (0.0, 0.0)
         };
-        let mut size = |k: usize| {
+        self.lag.add_scaled(OIL, SIGNATURE + i, amplitude);
+        let k = h.parameter();
+        if k < PARAMETERS {
             let by = h.sign() * amplitude;
             self.filter.shift(k, by);
             // Room for the linearisation's error (a tenth of the change).
             let room = 0.1 * libm::fabsf(by);
             self.filter.reopen(k, <f32 as Real>::sqrt(sd * sd + room * room));
-        };
-        match h {
-            Hypothesis::CapillaryRestricted | Hypothesis::OrificeClogged => size(DIVIDER),
-            Hypothesis::SpringRelaxed => size(SPRING),
-            Hypothesis::OffsetUp | Hypothesis::OffsetDown => size(OFFSET),
-            Hypothesis::Sticking => {
-                self.friction_width += clamp(amplitude, 0.0, 4.0) * self.design_width;
-                self.held = f32::NAN;
-            }
+        } else {
+            self.friction_width += clamp(amplitude, 0.0, 4.0) * self.design_width;
+            self.held = f32::NAN;
         }
+        self.reference = self.filter.theta();
+        self.reference[PROBE] = 0.0;
         self.settling = SETTLE_READINGS;
         self.detected = false;
         self.cusum = [0.0; 2];
-        self.fit_b = [0.0; 6];
-        self.fit_c = [0.0; 6];
+        self.fit_b = [0.0; HYPOTHESES];
+        self.fit_c = [0.0; HYPOTHESES];
+        self.energy = 0.0;
     }
 }
 

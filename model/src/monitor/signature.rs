@@ -66,8 +66,12 @@ pub const SPRING: usize = 1;
 /// Index of `delta`, the reading's offset \[Pa or m\] (the preload's loss,
 /// for the displacement).
 pub const OFFSET: usize = 2;
+/// Index of `beta`, where the oil-temperature probe sits within its
+/// tolerance (`-1..1`: its error is `beta (a + b |t|)`, IEC 60751); it does
+/// not enter the second sensor's reading.
+pub const PROBE: usize = 3;
 /// Health parameters the filter estimates.
-pub const PARAMETERS: usize = 3;
+pub const PARAMETERS: usize = 4;
 
 /// The design's constants a reading needs.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -177,7 +181,7 @@ mod tests {
     /// in `f64` of the same algebra written out again).
     #[test]
     fn the_jacobian_is_the_reading_s_derivative() {
-        let reference = |q: Quantity, a: f64, th: [f64; 3]| -> f64 {
+        let reference = |q: Quantity, a: f64, th: [f64; PARAMETERS]| -> f64 {
             let (dp, pc, c, x0) = (4.0e5, 1.0e5, 3.0e-9, 1.0e-4);
             let ad = a / dp.sqrt() * th[0].exp();
             let qq = 2.0 / (ad + (ad * ad + 4.0).sqrt());
@@ -197,7 +201,7 @@ mod tests {
             Quantity::Displacement,
         ] {
             for a in [100.0f32, 447.2, 2000.0] {
-                for th in [[0.0f32, 0.0, 0.0], [0.2, -0.1, 0.0]] {
+                for th in [[0.0f32, 0.0, 0.0, 0.0], [0.2, -0.1, 0.0, 0.5]] {
                     let r = design(q).reading(a, &th);
                     let th64 = th.map(f64::from);
                     let v = reference(q, f64::from(a), th64);
