@@ -6,10 +6,10 @@
 //!
 //!     cargo run --release -p host-tests --example monitor_trace -- [design] [seed] [hours] [sensor] [fault] [every]
 //!
-//! `design` 0 is the paper preset, `n` the seeded `host_tests::campaign::design(seed * 1000 + n - 1)`.
+//! `design` 0 is the paper preset (the campaign's onset, `monitor_campaign`'s), `n` the seeded `host_tests::campaign::design(seed * 1000 + n - 1)`.
 use compensator::Params;
 use compensator::estimator::{Estimator, EstimatorConfig};
-use host_tests::campaign::{Fault, Injection, Quantity, Scenario, catalogue, design};
+use host_tests::campaign::{Fault, Injection, Quantity, Scenario, catalogue_before_move, design};
 use host_tests::monitor_campaign::{ALARMS, settings};
 
 fn main() {
@@ -26,14 +26,24 @@ fn main() {
     } else {
         design(seed.wrapping_mul(1000) + d - 1)
     };
-    let base = &catalogue(&nominal, q, hours * 3600.0, seed + d)[0];
-    let s = Scenario {
+    let lead = ((seed * 7 + d) % 21) as f64;
+    let base = &catalogue_before_move(&nominal, q, hours * 3600.0, seed + d, lead)[0];
+    let mut s = Scenario {
         injection: Injection {
             fault,
             onset: base.injection.onset,
         },
         ..base.clone()
     };
+    if std::env::var("NO_CLASS").is_ok() {
+        s.probe_class = 0.0;
+    }
+    if std::env::var("NO_OFFSET").is_ok() {
+        s.sensor_offset = 0.0;
+    }
+    if std::env::var("NO_SPREAD").is_ok() {
+        s.device = s.nominal.core;
+    }
     println!(
         "probe class {:.3}, sensor offset {:.4e}, onset {:.0} s",
         s.probe_class, s.sensor_offset, s.injection.onset
@@ -49,7 +59,7 @@ fn main() {
     let mut tick = 0u64;
     let mut last_row = -1e9;
     let mut last_alarm = -1e9;
-    println!("t T_true T_est dT T_s y pred truth z cusum divider sd_div bias offset flags");
+    println!("t T_true T_est dT T_s y pred truth twin z cusum divider sd_div bias offset flags");
     for r in records {
         while tick < r.tick {
             est.tick(Ok(None));
@@ -71,7 +81,7 @@ fn main() {
         if r.t - last_row >= every || r.t - last_alarm < 5.0 {
             last_row = r.t;
             println!(
-                "{:.2} {:.3} {:.3} {:.3} {:.3} {:.6e} {:.6e} {:.6e} {:.2} {:.2} {:.4} {:.4} {:.4} {:.3e} {:08x}",
+                "{:.2} {:.3} {:.3} {:.3} {:.3} {:.6e} {:.6e} {:.6e} {:.4e} {:.2} {:.2} {:.4} {:.4} {:.4} {:.3e} {:08x}",
                 r.t,
                 r.t_true,
                 e.temperature,
@@ -80,6 +90,7 @@ fn main() {
                 r.second.unwrap(),
                 h.predicted,
                 r.truth.value(q),
+                e.x,
                 h.innovation,
                 h.cusum,
                 h.divider,

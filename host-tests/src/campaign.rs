@@ -106,7 +106,7 @@ pub enum Fault {
 
 impl Fault {
     /// The faults of a campaign at typical severities.
-    pub const CATALOGUE: [Fault; 14] = [
+    pub const CATALOGUE: [Fault; 15] = [
         Fault::None,
         Fault::CapillaryRestricted(0.9),
         Fault::CapillaryRestricted(0.8),
@@ -119,6 +119,7 @@ impl Fault {
         Fault::PreloadLost(0.5),
         Fault::Sticking(0.02),
         Fault::Sticking(0.05),
+        Fault::Sticking(0.1),
         Fault::SensorOffset(0.002),
         Fault::SensorOffset(0.005),
     ];
@@ -993,6 +994,58 @@ impl Scenario {
 pub fn onset_after_warm_up(profile: &Profile, duration: f64) -> f64 {
     let t = profile.warmed_up() + 600.0;
     if t < duration { t } else { 0.5 * duration }
+}
+
+/// Oil temperature span \[K\] over which a fault of the divider is to be
+/// named, and the time \[s\] it is to take ([`onset_before_move`]).
+pub const MOVE: (f64, f64) = (5.0, 60.0);
+
+/// An onset just before the history moves the oil by [`MOVE`]'s span within
+/// its time: the first time `t` from `after` on (every second) where the
+/// oil's temperature starts moving and spans `MOVE.0` over `[t, t +
+/// MOVE.1]`, less `lead` \[s\]; `None` when no such move follows.
+pub fn onset_before_move(profile: &Profile, after: f64, lead: f64) -> Option<f64> {
+    let (span, within) = MOVE;
+    let end = profile.end() - within;
+    let mut t = after.max(0.0);
+    while t < end {
+        let moving = (profile.temperature(t + 1.0) - profile.temperature(t)).abs() > 0.05;
+        if moving {
+            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+            let mut u = t;
+            while u <= t + within {
+                let v = profile.temperature(u);
+                lo = lo.min(v);
+                hi = hi.max(v);
+                u += 0.5;
+            }
+            if hi - lo >= span {
+                return Some((t - lead).max(after));
+            }
+        }
+        t += 1.0;
+    }
+    None
+}
+
+/// As [`catalogue`], the onset [`onset_before_move`] (ten minutes after
+/// the warm-up, `lead` before the move) where the history has such a move,
+/// else [`onset_after_warm_up`].
+pub fn catalogue_before_move(
+    nominal: &RawParams,
+    quantity: Quantity,
+    duration: f64,
+    seed: u64,
+    lead: f64,
+) -> Vec<Scenario> {
+    let mut runs = catalogue(nominal, quantity, duration, seed);
+    let profile = &runs[0].profile;
+    if let Some(onset) = onset_before_move(profile, profile.warmed_up() + 600.0, lead) {
+        for s in &mut runs {
+            s.injection.onset = onset;
+        }
+    }
+    runs
 }
 
 /// One scenario per fault of [`Fault::CATALOGUE`] for `nominal` with the

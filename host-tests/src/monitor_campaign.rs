@@ -4,7 +4,7 @@
 //! the probe's readings on their ticks and the second sensor's offered as
 //! they come, and what the monitor's flags said and when.
 
-use crate::campaign::{Fault, Quantity, Scenario, SecondSensor};
+use crate::campaign::{Fault, MOVE, Quantity, Scenario, SecondSensor};
 use compensator::Params;
 use compensator::estimator::{Estimator, EstimatorConfig, Flags};
 use compensator::monitor::{self, MonitorSettings};
@@ -67,18 +67,36 @@ pub struct Outcome {
     pub onset: f64,
     /// First alarm before the onset \[s\] (a false alarm), if any.
     pub false_alarm: Option<f64>,
+    /// Alarms before the onset: a healthy run's monitor is reset after each
+    /// (as after an inspection that found the device healthy) and watches
+    /// on; a faulty run ends at its first.
+    pub false_alarms: u32,
     /// Delay from the onset to the first alarm \[s\].
     pub detected: Option<f64>,
     /// Delay from the onset to the first named fault \[s\], and the flag.
     pub named: Option<(f64, Flags)>,
+    /// Delay from the onset until the oil's temperature since the onset
+    /// spans [`MOVE`]'s span \[s\] (the operation a divider's fault is to be
+    /// named within).
+    pub spanned: Option<f64>,
+    /// Delay from the onset until the true plunger lags its frictionless
+    /// position (clamped to the stops) by half its play band \[s\]: the
+    /// first temperature change that should have moved a plunger the
+    /// friction holds (sticking faults only).
+    pub held: Option<f64>,
     /// Simulated healthy time \[s\] (before the onset).
     pub healthy_time: f64,
     /// Readings the monitor rejected (gate, non-finite).
     pub rejected: u32,
 }
 
+/// How long the records are followed after a fault is named, to find when
+/// the operation spanned [`MOVE`] and when the plunger was held \[s\].
+const FOLLOW: f64 = 900.0;
+
 /// Runs `scenario` through the estimator of its nominal design with the
-/// monitor of its sensor.
+/// monitor of its sensor: a healthy scenario through its whole duration,
+/// a faulty one until its fault is named and [`FOLLOW`] after it.
 ///
 /// # Errors
 ///
@@ -96,7 +114,8 @@ pub fn run(scenario: &Scenario) -> Result<Outcome, String> {
         .map_err(|e| e.to_string())?
         .with_monitor(settings(&scenario.sensor, nominal))
         .map_err(|e| e.to_string())?;
-    let onset = if scenario.injection.fault == Fault::None {
+    let fault = scenario.injection.fault;
+    let onset = if fault == Fault::None {
         f64::INFINITY
     } else {
         scenario.injection.onset
@@ -104,14 +123,43 @@ pub fn run(scenario: &Scenario) -> Result<Outcome, String> {
     let mut out = Outcome {
         onset,
         false_alarm: None,
+        false_alarms: 0,
         detected: None,
         named: None,
+        spanned: None,
+        held: None,
         healthy_time: scenario.duration.min(onset),
         rejected: 0,
     };
+    let band = match fault {
+        Fault::Sticking(_) => {
+            let device = fault.degrade(&scenario.device);
+            fault.friction(&scenario.device) / device.spring_rate
+        }
+        _ => f64::NAN,
+    };
+    let stroke = scenario.device.stroke;
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     let mut tick = 0u64;
     let names = Flags(ALARMS.0 & !Flags::DEVICE_CHANGED.0);
     for s in records {
+        if s.t >= onset {
+            lo = lo.min(s.t_true);
+            hi = hi.max(s.t_true);
+            if out.spanned.is_none() && hi - lo >= MOVE.0 {
+                out.spanned = Some(s.t - onset);
+            }
+            if out.held.is_none() && (s.truth.x - s.truth.x_free.clamp(0.0, stroke)).abs() >= 0.5 * band {
+                out.held = Some(s.t - onset);
+            }
+        }
+        if let Some((t, _)) = out.named {
+            let held_known = out.held.is_some() || band.is_nan();
+            if (out.spanned.is_some() && held_known) || s.t > onset + t + FOLLOW {
+                break;
+            }
+            continue;
+        }
         while tick < s.tick {
             est.tick(Ok(None));
             tick += 1;
@@ -127,14 +175,18 @@ pub fn run(scenario: &Scenario) -> Result<Outcome, String> {
         }
         if s.t < onset {
             out.false_alarm.get_or_insert(s.t);
-            // A false alarm ends the run's use: the monitor latched it.
-            break;
+            out.false_alarms += 1;
+            if fault != Fault::None {
+                // A false alarm ends a faulty run's use: the monitor latched it.
+                break;
+            }
+            est.reset_monitor();
+            continue;
         }
         out.detected.get_or_insert(s.t - onset);
         let named = Flags(alarm.0 & names.0);
         if !named.is_empty() {
             out.named = Some((s.t - onset, named));
-            break;
         }
     }
     out.rejected = est.health().rejected;

@@ -297,6 +297,18 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
         self.monitor.as_ref()
     }
 
+    /// Clears the monitor's latched faults and restarts its health
+    /// parameters at their priors (after the device's maintenance or an
+    /// inspection that found it healthy); nothing without a monitor.
+    #[cfg(feature = "monitor")]
+    pub fn reset_monitor(&mut self) {
+        if let Some(m) = self.monitor.as_mut() {
+            m.reset(self.plant.params());
+            self.health = HealthEstimate::NONE;
+            self.health_flags = Flags::empty();
+        }
+    }
+
     /// A reading of the second sensor \[Pa or m\] (`Err`: refused by its
     /// own checks). The monitor takes it on the next tick that would run a
     /// job (in the job's place: the worst tick stays the twin's plus one

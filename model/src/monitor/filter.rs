@@ -106,6 +106,18 @@ impl HealthFilter {
         change
     }
 
+    /// Parameter `i` as a Gauss-Markov process over a step whose
+    /// correlation is `phi` (in `0..=1`): its estimate and its covariances
+    /// decay by `phi`, its variance tends to `stationary`.
+    pub fn decay(&mut self, i: usize, phi: f32, stationary: f32) {
+        self.theta[i] *= phi;
+        for j in 0..PARAMETERS {
+            self.p[i][j] *= phi;
+            self.p[j][i] *= phi;
+        }
+        self.p[i][i] += (1.0 - phi * phi) * stationary;
+    }
+
     /// Moves parameter `i` by `by` (a change isolated and sized by the
     /// tests).
     pub fn shift(&mut self, i: usize, by: f32) {
@@ -134,8 +146,8 @@ mod tests {
     /// Gaussian: `theta = P h nu / (h^2 P + R)`, `P' = P R / (h^2 P + R)`.
     #[test]
     fn one_update_is_the_gaussian_posterior() {
-        let mut f = HealthFilter::new([2.0, 1.0, 1.0, 1.0], [0.0; PARAMETERS]);
-        let h = [3.0, 0.0, 0.0, 0.0];
+        let mut f = HealthFilter::new([2.0, 1.0, 1.0, 1.0, 1.0], [0.0; PARAMETERS]);
+        let h = [3.0, 0.0, 0.0, 0.0, 0.0];
         let (nu, r) = (1.5f32, 4.0f32);
         let s = f.innovation_variance(&h) + r;
         assert_eq!(s, 40.0);
@@ -146,15 +158,32 @@ mod tests {
         assert_eq!(f.theta()[1], 0.0);
     }
 
+    /// A Gauss-Markov parameter forgets: its estimate decays, its variance
+    /// tends to the stationary one, its correlations fade.
+    #[test]
+    fn decay_forgets_towards_the_stationary_variance() {
+        let mut f = HealthFilter::new([1.0, 0.5, 1.0, 1.0, 0.1], [0.0; PARAMETERS]);
+        let h = [1.0, 0.0, 0.0, 0.0, 1.0];
+        let s = f.innovation_variance(&h) + 0.01;
+        f.update(&h, 0.5, s);
+        assert!(f.covariance()[0][4] < 0.0);
+        for _ in 0..400 {
+            f.decay(4, 0.99, 0.04);
+        }
+        assert!(f.theta()[4].abs() < 0.02 * 0.5);
+        assert!((f.covariance()[4][4] - 0.04).abs() < 1e-3, "{}", f.covariance()[4][4]);
+        assert!(f.covariance()[0][4].abs() < 1e-3);
+    }
+
     /// Repeated readings of one parameter through a changing Jacobian
     /// converge on it with the least-squares variance.
     #[test]
     fn converges_on_a_constant() {
         let mut f = HealthFilter::new([1.0; PARAMETERS], [0.0; PARAMETERS]);
-        let truth = [0.2f32, -0.1, 0.05, 0.3];
+        let truth = [0.2f32, -0.1, 0.05, 0.3, -0.2];
         for k in 0..2000 {
             let t = k as f32 * 0.01;
-            let h = [1.0 + t.sin(), t.cos(), 1.0, (0.5 * t).sin()];
+            let h = [1.0 + t.sin(), t.cos(), 1.0, (0.5 * t).sin(), (0.3 * t).cos()];
             let y: f32 = h.iter().zip(&truth).map(|(a, b)| a * b).sum();
             let s = f.innovation_variance(&h) + 1e-4;
             let pred: f32 = h.iter().zip(&f.theta()).map(|(a, b)| a * b).sum();

@@ -70,8 +70,13 @@ pub const OFFSET: usize = 2;
 /// tolerance (`-1..1`: its error is `beta (a + b |t|)`, IEC 60751); it does
 /// not enter the second sensor's reading.
 pub const PROBE: usize = 3;
+/// Index of `m`, the twin's own error as an offset of the reading \[Pa or
+/// m\] that wanders with the oil temperature (the reading's model error, a
+/// state so that the filter does not take a systematic misfit for
+/// evidence).
+pub const MODEL: usize = 4;
 /// Health parameters the filter estimates.
-pub const PARAMETERS: usize = 4;
+pub const PARAMETERS: usize = 5;
 
 /// The design's constants a reading needs.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -144,8 +149,9 @@ impl Design {
                 dp_ab * c - self.preload
             }
         };
+        jacobian[MODEL] = 1.0;
         Reading {
-            value: value + theta[OFFSET],
+            value: value + theta[OFFSET] + theta[MODEL],
             jacobian,
         }
     }
@@ -187,6 +193,7 @@ mod tests {
             let qq = 2.0 / (ad + (ad * ad + 4.0).sqrt());
             let (pa, pb) = (pc + dp - qq * qq * dp, pc + qq * qq * dp);
             th[2]
+                + th[4]
                 + match q {
                     Quantity::ChamberA => pa,
                     Quantity::ChamberB => pb,
@@ -201,7 +208,7 @@ mod tests {
             Quantity::Displacement,
         ] {
             for a in [100.0f32, 447.2, 2000.0] {
-                for th in [[0.0f32, 0.0, 0.0, 0.0], [0.2, -0.1, 0.0, 0.5]] {
+                for th in [[0.0f32, 0.0, 0.0, 0.0, 0.0], [0.2, -0.1, 0.0, 0.5, 0.0]] {
                     let r = design(q).reading(a, &th);
                     let th64 = th.map(f64::from);
                     let v = reference(q, f64::from(a), th64);
