@@ -65,8 +65,9 @@ fn write_log(path: &std::path::Path, column: &str, rows: &[Row], scale: f64) {
 /// The firmware's estimator with its monitor over `rows`, as the module
 /// docs of `compensator_cli::estimate` say the replay runs: each row on
 /// its tick, the second sensor's reading offered before the tick, the
-/// probe's given to it. Returns, per row, the estimate after its tick.
-fn direct(raw: &RawParams, rows: &[Row]) -> Vec<StateEstimate> {
+/// probe's given to it; `each` sees every tick's number, the row delivered
+/// on it and the estimate after it.
+fn replay(raw: &RawParams, rows: &[Row], mut each: impl FnMut(u64, Option<usize>, &StateEstimate)) {
     let tick = 1.0 / raw.estimator.tick_hz;
     let p32 = Params::<f32>::new(raw).unwrap();
     // The probe every 20 ticks, the second sensor every 10: the medians.
@@ -79,20 +80,29 @@ fn direct(raw: &RawParams, rows: &[Row]) -> Vec<StateEstimate> {
         .unwrap()
         .with_monitor(settings)
         .unwrap();
-    let mut out = Vec::with_capacity(rows.len());
     let mut k = 0u64;
-    for &(t, probe, second) in rows {
+    for (i, &(t, probe, second)) in rows.iter().enumerate() {
         let due = (t * raw.estimator.tick_hz + 1e-6).floor() as u64;
         while k < due {
-            est.tick(Ok(None));
+            each(k, None, &est.tick(Ok(None)));
             k += 1;
         }
         if let Some(y) = second {
             est.offer_second(Ok(y as f32));
         }
-        out.push(est.tick(Ok(probe.map(|v| v as f32))));
+        each(k, Some(i), &est.tick(Ok(probe.map(|v| v as f32))));
         k += 1;
     }
+}
+
+/// [`replay`]'s estimate after each row's tick.
+fn direct(raw: &RawParams, rows: &[Row]) -> Vec<StateEstimate> {
+    let mut out = Vec::with_capacity(rows.len());
+    replay(raw, rows, |_, row, e| {
+        if row.is_some() {
+            out.push(*e);
+        }
+    });
     out
 }
 
@@ -230,13 +240,20 @@ fn a_log_in_bar_is_refused_naming_the_row() {
         .filter_map(|(i, r)| r.2.map(|v| (i, v)))
         .max_by(|a, b| a.1.total_cmp(&b.1))
         .unwrap();
-    let command = "estimate";
-    let (code, out, err) = run_cli(&[command, "--params", path(&f.params), "--sensor-data", path(&bar)]);
-    assert_eq!(code, 2, "{command}: {err}");
-    assert!(out.is_empty(), "{command}");
-    let at = format!("row {} (line {}), column p_a_pa", i + 1, i + 2);
-    assert!(err.contains(&at) && err.contains("written in bar?"), "{command}: {err}");
-    assert_eq!(err.lines().count(), 1, "{err}");
+    for command in ["estimate", "monitor"] {
+        let (code, out, err) = run_cli(&[command, "--params", path(&f.params), "--sensor-data", path(&bar)]);
+        assert_eq!(code, 2, "{command}: {err}");
+        assert!(out.is_empty(), "{command}");
+        let at = format!("row {} (line {}), column p_a_pa", i + 1, i + 2);
+        assert!(err.contains(&at) && err.contains("written in bar?"), "{command}: {err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+    }
+    // In MPa: the same column, the unit named.
+    let mpa = f.dir.join("mpa.csv");
+    write_log(&mpa, "p_a_pa", &f.rows, 1e-6);
+    let (code, _, err) = run_cli(&["estimate", "--params", path(&f.params), "--sensor-data", path(&mpa)]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("written in MPa?"), "{err}");
     let _ = std::fs::remove_dir_all(&f.dir);
 }
 
@@ -299,4 +316,95 @@ fn a_column_the_device_file_does_not_measure_is_refused_naming_it() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("row 1 (line 2), column t_c: no probe reading"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn monitor_summarises_the_flags_as_the_library_raised_them() {
+    let f = fixture("monitor");
+    let png = f.dir.join("monitor.png");
+    let (code, out, err) = run_cli(&[
+        "monitor",
+        "--params",
+        path(&f.params),
+        "--sensor-data",
+        path(&f.log),
+        "--plot",
+        path(&png),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    // The first tick carrying each of the monitor's flags, the row on or
+    // before it, and the estimate at the end, from the library.
+    let mut first: Vec<(u32, usize, f64, u64)> = Vec::new();
+    let mut row = 0;
+    let mut last = None;
+    let tick = 1.0 / f.raw.estimator.tick_hz;
+    replay(&f.raw, &f.rows, |k, r, e| {
+        row = r.unwrap_or(row);
+        last = Some(*e);
+        let flags = e.flags.0 & compensator::estimator::health::MONITOR_FLAGS.0;
+        for bit in 0..32 {
+            if flags & (1 << bit) == 0 {
+                continue;
+            }
+            match first.iter_mut().find(|x| x.0 == bit) {
+                Some(x) => x.3 += 1,
+                None => first.push((bit, row, k as f64 * tick, 1)),
+            }
+        }
+    });
+    first.sort_by_key(|x| x.0);
+    let last = last.unwrap().health;
+    let (header, cells) = table(&out);
+    assert_eq!(cells.len(), first.len(), "{out}");
+    assert!(
+        first.iter().any(|x| Flags(1 << x.0) == Flags::CAPILLARY_RESTRICTED),
+        "{out}"
+    );
+    for (row, &(bit, r, t, ticks)) in cells.iter().zip(&first) {
+        let name = Flags(1 << bit).names().next().unwrap();
+        assert_eq!(row[col(&header, "flag")], name);
+        assert_eq!(row[col(&header, "first_row")], (r + 1).to_string(), "{name}");
+        assert_eq!(row[col(&header, "first_line")], (r + 2).to_string(), "{name}");
+        let time: f64 = row[col(&header, "first_time_s")].parse().unwrap();
+        assert!((time - t).abs() < 1e-9, "{name}: {time} against {t}");
+        assert_eq!(row[col(&header, "ticks")], ticks.to_string(), "{name}");
+        if name == "CAPILLARY_RESTRICTED" {
+            assert_eq!(row[col(&header, "parameter")], "divider");
+            let estimate: f64 = row[col(&header, "estimate")].parse().unwrap();
+            let sd: f64 = row[col(&header, "sd")].parse().unwrap();
+            let z: f64 = row[col(&header, "z")].parse().unwrap();
+            assert_eq!(estimate, f64::from(last.divider));
+            assert_eq!(sd, f64::from(last.sd_divider));
+            assert!((z - estimate.ln() / sd).abs() <= 1e-12 * z.abs(), "{z}");
+            // The onset is at 60 s; the restriction is named after it, and
+            // the CUSUM crossed its threshold of 10 before.
+            assert!(t > 60.0, "{t}");
+            let cusum: f64 = row[col(&header, "cusum_max")].parse().unwrap();
+            assert!(cusum > 10.0, "{cusum}");
+        }
+    }
+    assert!(err.contains("monitor: at the log's end divider"), "{err}");
+    let bytes = std::fs::read(&png).unwrap();
+    assert!(
+        bytes.starts_with(b"\x89PNG\r\n\x1a\n") && bytes.len() > 10_000,
+        "{} bytes",
+        bytes.len()
+    );
+    // Without a second sensor in the file there is nothing to monitor.
+    let probe = f.dir.join("probe.csv");
+    std::fs::write(&probe, "time_s,t_c\n0,40\n0.02,40\n").unwrap();
+    let (code, _, err) = run_cli(&[
+        "monitor",
+        "--params",
+        "presets/paper.toml",
+        "--sensor-data",
+        path(&probe),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("monitor.sensor = \"none\""), "{err}");
+    // A log without the sensor's column.
+    let (code, _, err) = run_cli(&["monitor", "--params", path(&f.params), "--sensor-data", path(&probe)]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("no column p_a_pa"), "{err}");
+    let _ = std::fs::remove_dir_all(&f.dir);
 }
