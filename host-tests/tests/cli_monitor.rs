@@ -408,3 +408,19 @@ fn monitor_summarises_the_flags_as_the_library_raised_them() {
     assert!(err.contains("no column p_a_pa"), "{err}");
     let _ = std::fs::remove_dir_all(&f.dir);
 }
+
+#[test]
+fn the_documented_log_is_what_the_example_writes() {
+    use host_tests::monitor_log::{DOCUMENTED_BAR_LOG, DOCUMENTED_LOG, documented, in_bar};
+    let written = documented().unwrap();
+    for (path, text) in [
+        (DOCUMENTED_LOG, written.clone()),
+        (DOCUMENTED_BAR_LOG, in_bar(&written, 1.0)),
+    ] {
+        let committed = std::fs::read_to_string(host_tests::repo_root().join(path)).unwrap();
+        assert!(
+            text == committed,
+            "{path} is stale: cargo run --release -p host-tests --example monitor_log"
+        );
+    }
+}
