@@ -207,9 +207,57 @@ pub fn read_columns(text: &str, wanted: &[&str]) -> Result<Numeric, String> {
     read(text, true, Some(wanted))
 }
 
+/// [`read_columns`] where an empty cell (or `NaN`) of a column in `sparse`
+/// reads as `NaN` (no value on that row: a log whose sensors read at different
+/// rates), and a cell of a column in `unchecked` is not held to its
+/// plausible range of [`crate::data::DATA_COLUMNS`] (the caller checks it
+/// against a range of its own, the device file's).
+///
+/// # Errors
+///
+/// As [`read_columns`].
+pub fn read_columns_with(text: &str, wanted: &[&str], sparse: &[&str], unchecked: &[&str]) -> Result<Numeric, String> {
+    read_spec(text, true, Some(wanted), sparse, unchecked)
+}
+
+/// The header row's names of a data file (as [`read_numeric`] reads it:
+/// byte-order mark, separator, comments), without reading its rows.
+///
+/// # Errors
+///
+/// The `csv` crate's error on a header it cannot read.
+pub fn header(text: &str) -> Result<Vec<String>, String> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut reader = ::csv::ReaderBuilder::new()
+        .delimiter(detect_delimiter(text))
+        .comment(Some(b'#'))
+        .trim(::csv::Trim::All)
+        .flexible(true)
+        .has_headers(true)
+        .from_reader(text.as_bytes());
+    Ok(reader
+        .headers()
+        .map_err(|e| format!("header: {e}"))?
+        .iter()
+        .map(str::to_string)
+        .collect())
+}
+
 /// [`read_numeric`], accepting `NaN` and infinities unless `finite_only`,
 /// parsing only the columns in `wanted` (all when `None`).
 fn read(text: &str, finite_only: bool, wanted: Option<&[&str]>) -> Result<Numeric, String> {
+    read_spec(text, finite_only, wanted, &[], &[])
+}
+
+/// [`read`] with the `sparse` and `unchecked` columns of
+/// [`read_columns_with`].
+fn read_spec(
+    text: &str,
+    finite_only: bool,
+    wanted: Option<&[&str]>,
+    sparse: &[&str],
+    unchecked: &[&str],
+) -> Result<Numeric, String> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let delimiter = detect_delimiter(text);
     let mut reader = ::csv::ReaderBuilder::new()
@@ -266,7 +314,8 @@ fn read(text: &str, finite_only: bool, wanted: Option<&[&str]>) -> Result<Numeri
             .zip(&out.header)
             .zip(&parsed_column)
             .map(|((cell, name), &parse)| {
-                if !parse {
+                if !parse || ((cell.is_empty() || cell.eq_ignore_ascii_case("nan")) && sparse.contains(&name.as_str()))
+                {
                     return Ok(f64::NAN);
                 }
                 let parsed = cell.parse::<f64>().or_else(|e| {
@@ -277,11 +326,15 @@ fn read(text: &str, finite_only: bool, wanted: Option<&[&str]>) -> Result<Numeri
                     }
                 });
                 match parsed {
-                    Ok(v) if wanted.is_some() && v.is_finite() => match crate::data::column(name) {
-                        Some(col) => crate::data::check(col, v, &format!("row {row_no} (line {line}), column {name}"))
-                            .map(|()| v),
-                        None => Ok(v),
-                    },
+                    Ok(v) if wanted.is_some() && v.is_finite() && !unchecked.contains(&name.as_str()) => {
+                        match crate::data::column(name) {
+                            Some(col) => {
+                                crate::data::check(col, v, &format!("row {row_no} (line {line}), column {name}"))
+                                    .map(|()| v)
+                            }
+                            None => Ok(v),
+                        }
+                    }
                     Ok(v) if v.is_finite() || !finite_only => Ok(v),
                     Ok(_) => Err(format!(
                         "row {row_no} (line {line}), column {name}: '{cell}' is not a finite number"

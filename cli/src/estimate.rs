@@ -24,23 +24,42 @@
 //! code) is flagged the same way; a value no probe reads (a `t_c` of
 //! 300,000: [`crate::data`]) is bad input.
 //!
+//! A second sensor's column ([`SECOND_COLUMNS`]: `p_a_pa`, `p_b_pa`,
+//! `dp_ab_pa` or `x_m`, the quantity of the device file's
+//! `monitor.sensor`) feeds the estimator's condition monitor
+//! (`Estimator::offer_second`, on the row's tick, before the probe's
+//! reading of the same row), with the monitor's settings from the file
+//! (`MonitorSettings::from_raw`) but its period, the median interval of
+//! the column's readings. The output then gains the health estimate's
+//! values ([`compensator::estimator::health::HEALTH_FIELDS`]) before
+//! `flags`, which names the monitor's flags too. With a second column
+//! either reading may be empty (or `NaN`) on a row, not both; the first
+//! row holds a probe reading. A telemetry CSV (it has `t_oil_c`) carries
+//! the estimator's own `x_m`, `p_a_pa` and `p_b_pa`: they are estimates,
+//! never taken as a second sensor's readings.
+//!
 //! Bad input, each naming the row, its line and the column: no reading
 //! column or two of them, times that do not increase, two readings within
 //! one tick, a gap longer than the estimator's fault timeout
 //! (`stale_after`), a log over [`MAX_ROWS`] readings or [`MAX_TICKS`]
 //! ticks (and [`crate::input::MAX_LOG_BYTES`]), a first reading the oil
-//! model does not take.
+//! model does not take; a second sensor's column for a quantity the
+//! device file's sensor does not measure, or in another unit
+//! ([`check_second`]: a bar column in a Pa log, mm in an m log).
 
-use crate::csv::{Numeric, read_columns};
+use crate::csv::{Numeric, read_columns_with};
 use crate::display::sig;
 use crate::error::CliError;
 use compensator::Params;
+use compensator::estimator::health::{HEALTH_FIELDS, HealthUnit};
 use compensator::estimator::telemetry::{Encoding, FIELDS, Record};
 use compensator::estimator::{Estimator, EstimatorConfig, StateEstimate};
+use compensator::monitor::{HealthEstimate, MonitorSettings, Quantity as MonitorQuantity};
 use compensator::params::RawParams;
 use compensator::sensor::max31865::Settings;
-use compensator::sensor::rtd;
+use compensator::sensor::transducer::{self, Quantity};
 use compensator::sensor::{Detail, SensorFault};
+use compensator::sensor::{device, rtd};
 
 /// What a log's reading column holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -91,6 +110,120 @@ pub const READING_COLUMNS: [ReadingColumn; 4] = [
 /// The column of the sample times.
 pub const TIME_COLUMN: &str = "time_s";
 
+/// A column a second sensor's readings may be in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SecondColumn {
+    /// Header name (as the telemetry names the quantity).
+    pub name: &'static str,
+    /// The quantity (`monitor.sensor`).
+    pub quantity: Quantity,
+    /// For help texts and messages.
+    pub doc: &'static str,
+}
+
+/// The columns of the second sensor's readings, one per quantity the
+/// device file's `monitor.sensor` may name; a log has at most one, the
+/// file's.
+pub const SECOND_COLUMNS: [SecondColumn; 4] = [
+    SecondColumn {
+        name: "p_a_pa",
+        quantity: Quantity::PressureA,
+        doc: "chamber (a) pressure [Pa]",
+    },
+    SecondColumn {
+        name: "p_b_pa",
+        quantity: Quantity::PressureB,
+        doc: "chamber (b) pressure [Pa]",
+    },
+    SecondColumn {
+        name: "dp_ab_pa",
+        quantity: Quantity::PressureDifference,
+        doc: "chamber pressure difference p_b - p_a [Pa]",
+    },
+    SecondColumn {
+        name: "x_m",
+        quantity: Quantity::Displacement,
+        doc: "plunger displacement [m]",
+    },
+];
+
+/// The column of `quantity`'s readings.
+pub fn second_column(quantity: Quantity) -> SecondColumn {
+    // Every quantity has its column (a test keeps it so).
+    SECOND_COLUMNS
+        .into_iter()
+        .find(|c| c.quantity == quantity)
+        .unwrap_or(SECOND_COLUMNS[0])
+}
+
+/// A column only the telemetry CSV has (the estimated oil temperature): a
+/// log with it is a telemetry record, whose `x_m`, `p_a_pa` and `p_b_pa`
+/// are the estimator's estimates, not a sensor's readings.
+pub const TELEMETRY_MARK: &str = "t_oil_c";
+
+/// The device file's second sensor as a log's column is checked against:
+/// its transducer, and the range the device's quantity spans.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SecondSensor {
+    /// The transducer channel's settings (range, output, ADC).
+    pub settings: transducer::Settings,
+    /// The range the quantity spans on the device \[Pa or m\]: a chamber's
+    /// pressure the outlet to the supply, their difference `-dp..dp`, the
+    /// displacement the stroke.
+    pub physical: (f64, f64),
+}
+
+impl SecondSensor {
+    /// The second sensor of the validated parameter set `raw`, `None`
+    /// without one.
+    ///
+    /// # Errors
+    ///
+    /// [`CliError::Input`] naming the field its settings refuse.
+    pub fn of(raw: &RawParams) -> Result<Option<SecondSensor>, CliError> {
+        let Some(settings) = device::monitor_settings(raw).map_err(|e| CliError::Input(format!("--params: {e}")))?
+        else {
+            return Ok(None);
+        };
+        let (p_c, dp) = (raw.core.outlet_pressure, raw.core.pressure_drop);
+        let physical = match settings.quantity {
+            Quantity::PressureA | Quantity::PressureB => (p_c, p_c + dp),
+            Quantity::PressureDifference => (-dp, dp),
+            Quantity::Displacement => (0.0, raw.core.stroke),
+        };
+        Ok(Some(SecondSensor { settings, physical }))
+    }
+
+    /// The readings the sensor gives as readings, its measuring band
+    /// \[Pa or m\]: `range_min..range_max` widened by the output's margins
+    /// (NAMUR NE 43's, 1.25 % of the span below and 3.125 % above); beyond
+    /// it the driver reports a fault, not a reading.
+    pub fn band(&self) -> (f64, f64) {
+        let (s, l) = (&self.settings, self.settings.output.limits());
+        (
+            f64::from(s.reading_of_signal(l.measure_low)),
+            f64::from(s.reading_of_signal(l.measure_high)),
+        )
+    }
+
+    /// The monitor's settings for readings every `period` \[s\].
+    pub fn monitor(&self, period: f64) -> MonitorSettings {
+        MonitorSettings {
+            sample_period: period as f32,
+            ..MonitorSettings::of_transducer(&self.settings)
+        }
+    }
+}
+
+/// A log's second sensor: its column and readings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Second {
+    /// The column.
+    pub column: SecondColumn,
+    /// Readings \[Pa or m\], one per row (NaN: none on that row).
+    pub value: Vec<f64>,
+}
+
 /// The telemetry record's columns the output carries, in this order,
 /// between `time_s` and `flags` (their units, digits and descriptions are
 /// the record's table's, `compensator::estimator::telemetry::FIELDS`).
@@ -139,10 +272,16 @@ pub struct Log {
     pub column: ReadingColumn,
     /// Sample times [s].
     pub time_s: Vec<f64>,
-    /// Readings, in the column's unit.
+    /// Readings, in the column's unit (NaN: none on that row, with a
+    /// second sensor's column only).
     pub value: Vec<f64>,
     /// Each row's line in the file (1-based).
     pub lines: Vec<u64>,
+    /// The second sensor's readings, if the log has its column.
+    pub second: Option<Second>,
+    /// What the log holds that is not taken, for standard error (a
+    /// telemetry CSV's estimates).
+    pub note: Option<String>,
 }
 
 impl Log {
@@ -155,15 +294,22 @@ impl Log {
 /// Reads a probe log: `time_s` and exactly one of [`READING_COLUMNS`]
 /// (other columns are ignored, text or numbers), with the `csv` crate as
 /// every data file ([`crate::csv::read_columns`]: separators, quotes,
-/// comments; each cell checked against its column's plausible range).
+/// comments; each cell checked against its column's plausible range), and
+/// the readings of the device file's second sensor `sensor` if the log has
+/// its column ([`SECOND_COLUMNS`]; never in a telemetry CSV, whose
+/// columns of those names are estimates).
 ///
 /// # Errors
 ///
 /// One line naming row, line and column where there is one: more than
 /// [`MAX_ROWS`] readings (counted before the cells are read), an empty
 /// file or one without rows, no `time_s`, no reading column or two, a
-/// cell that is not a plausible number, a `code` that is not whole.
-pub fn read_log(text: &str) -> Result<Log, String> {
+/// cell that is not a plausible number, a `code` that is not whole; a
+/// second sensor's column when the file has none or measures another
+/// quantity, a row with neither reading, a first row without a probe
+/// reading, a second sensor's reading outside its band or a column in
+/// another unit ([`check_second`]).
+pub fn read_log(text: &str, sensor: Option<&SecondSensor>) -> Result<Log, String> {
     let lines = text
         .lines()
         .filter(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
@@ -174,9 +320,33 @@ pub fn read_log(text: &str) -> Result<Log, String> {
             "{lines} rows, more than the limit of {MAX_ROWS} readings: {SPLIT}"
         ));
     }
+    let names = crate::csv::header(text)?;
+    let telemetry = names.iter().any(|h| h == TELEMETRY_MARK);
+    // A log without its time or probe column is refused for that first.
+    let probe_log =
+        names.iter().any(|h| h == TIME_COLUMN) && names.iter().any(|h| READING_COLUMNS.iter().any(|c| c.name == h));
+    let second = if telemetry || !probe_log {
+        None
+    } else {
+        second_of(&names, sensor)?
+    };
+    let note = (telemetry && sensor.is_some()).then(|| {
+        format!(
+            "the log is a telemetry CSV ({TELEMETRY_MARK}): its x_m, p_a_pa and p_b_pa are the estimator's estimates, \
+             not the second sensor's readings; the monitor gets none"
+        )
+    });
     let mut wanted = vec![TIME_COLUMN];
     wanted.extend(READING_COLUMNS.iter().map(|c| c.name));
-    let t: Numeric = read_columns(text, &wanted)?;
+    let mut sparse: Vec<&str> = Vec::new();
+    let mut unchecked: Vec<&str> = Vec::new();
+    if let Some(c) = second {
+        wanted.push(c.name);
+        sparse.extend(READING_COLUMNS.iter().map(|c| c.name));
+        sparse.push(c.name);
+        unchecked.push(c.name);
+    }
+    let t: Numeric = read_columns_with(text, &wanted, &sparse, &unchecked)?;
     let expected = || {
         let names: Vec<&str> = READING_COLUMNS.iter().map(|c| c.name).collect();
         format!(
@@ -205,14 +375,23 @@ pub fn read_log(text: &str) -> Result<Log, String> {
     if t.rows.is_empty() {
         return Err("no readings: the file has a header and no rows".into());
     }
-    let log = Log {
+    let mut log = Log {
         column,
         time_s: t.rows.iter().map(|r| r[time]).collect(),
         value: t.rows.iter().map(|r| r[index]).collect(),
         lines: t.lines.clone(),
+        second: None,
+        note,
     };
+    if let Some(c) = second {
+        let i = t.column(c.name).unwrap_or(index);
+        log.second = Some(Second {
+            column: c,
+            value: t.rows.iter().map(|r| r[i]).collect(),
+        });
+    }
     if column.reading == Reading::Code
-        && let Some(i) = log.value.iter().position(|v| v.fract() != 0.0)
+        && let Some(i) = log.value.iter().position(|v| v.is_finite() && v.fract() != 0.0)
     {
         return Err(format!(
             "{}: {} is not a whole number (the MAX31865's RTD code is an integer 0 to 32767)",
@@ -220,7 +399,147 @@ pub fn read_log(text: &str) -> Result<Log, String> {
             sig(log.value[i], 8)
         ));
     }
+    if let (Some(second), Some(sensor)) = (&log.second, sensor) {
+        if !log.value[0].is_finite() {
+            return Err(format!(
+                "{}: no probe reading on the first row: the estimator starts at the first row's probe reading; \
+                 begin the log at a row with one",
+                log.at(0, column.name)
+            ));
+        }
+        if let Some(i) = (0..log.value.len()).find(|&i| !log.value[i].is_finite() && !second.value[i].is_finite()) {
+            return Err(format!(
+                "row {} (line {}): neither a probe reading ({}) nor a second sensor's ({}): a row holds at least one",
+                i + 1,
+                log.lines[i],
+                column.name,
+                second.column.name
+            ));
+        }
+        check_second(&log, second, sensor)?;
+    }
     Ok(log)
+}
+
+/// The second sensor's column of a log whose header is `names`, for the
+/// device file's sensor `sensor`.
+///
+/// Errors: a second sensor's column when the file has none, or for
+/// another quantity than the file's sensor measures (naming the column).
+fn second_of(names: &[String], sensor: Option<&SecondSensor>) -> Result<Option<SecondColumn>, String> {
+    let present: Vec<SecondColumn> = SECOND_COLUMNS
+        .into_iter()
+        .filter(|c| names.iter().any(|h| h == c.name))
+        .collect();
+    let Some(first) = present.first() else {
+        return Ok(None);
+    };
+    let Some(sensor) = sensor else {
+        return Err(format!(
+            "column {}: a second sensor's readings ({}), but the device file has no second sensor \
+             (monitor.sensor = \"none\"): name it in the file's [monitor] section (docs/parameters.md), or leave the \
+             column out",
+            first.name, first.doc
+        ));
+    };
+    let q = sensor.settings.quantity;
+    if let Some(other) = present.iter().find(|c| c.quantity != q) {
+        return Err(format!(
+            "column {}: readings of the {}, but the device file's second sensor measures {} (monitor.sensor = \
+             \"{}\"), whose column is {}: leave the other column out",
+            other.name,
+            other.doc,
+            q.name(),
+            q.name(),
+            second_column(q).name
+        ));
+    }
+    Ok(Some(*first))
+}
+
+/// Checks the second sensor's readings against the device file:
+///
+/// * each inside the sensor's measuring band ([`SecondSensor::band`]),
+///   the likely unit named when a value is not (a displacement in mm);
+/// * the column as a whole not evidently in another unit: readings that
+///   vary, yet all lie within one step of the sensor's ADC of zero, while
+///   some likely unit (bar, kPa, MPa, psi; mm, um) puts every one inside
+///   the range the device's quantity spans, are that unit's (a chamber
+///   pressure in bar reads 0.4 to 3.2 where the sensor's steps are 152
+///   Pa). The unit named is the largest such.
+///
+/// # Errors
+///
+/// The row (the offending reading, or the column's largest), its line,
+/// the column, the value, the band or the ADC's step, and the likely unit.
+pub fn check_second(log: &Log, second: &Second, sensor: &SecondSensor) -> Result<(), String> {
+    let name = second.column.name;
+    let unit = sensor.settings.quantity.unit();
+    let (lo, hi) = sensor.band();
+    let (min, max) = (f64::from(sensor.settings.range.0), f64::from(sensor.settings.range.1));
+    let data = crate::data::column(name);
+    let hint = |v: f64, lo: f64, hi: f64| data.map_or(String::new(), |c| crate::data::unit_hint(c, v, lo, hi));
+    for (i, &v) in second.value.iter().enumerate() {
+        if v.is_finite() && !(lo..=hi).contains(&v) {
+            return Err(format!(
+                "{}: {} {unit} is outside the second sensor's measuring band {} to {} {unit} \
+                 (monitor.range_min..range_max = {} to {} {unit} with the output's margins; beyond it the sensor \
+                 reports a fault, not a reading){}",
+                log.at(i, name),
+                sig(v, 6),
+                sig(lo, 6),
+                sig(hi, 6),
+                sig(min, 6),
+                sig(max, 6),
+                hint(v, lo, hi)
+            ));
+        }
+    }
+    let finite: Vec<(usize, f64)> = second
+        .value
+        .iter()
+        .copied()
+        .enumerate()
+        .filter(|(_, v)| v.is_finite())
+        .collect();
+    let Some(&(largest, top)) = finite.iter().max_by(|a, b| a.1.abs().total_cmp(&b.1.abs())) else {
+        return Ok(());
+    };
+    let step = f64::from(sensor.settings.units_per_code());
+    let varies = finite.iter().any(|&(_, v)| v != finite[0].1);
+    if !(varies && top.abs() < step) {
+        return Ok(());
+    }
+    let (p_lo, p_hi) = sensor.physical;
+    let Some(other) = data.and_then(|c| {
+        let mut units: Vec<_> = c.likely.iter().collect();
+        units.sort_by(|a, b| b.factor.total_cmp(&a.factor));
+        units.into_iter().find(|u| {
+            finite
+                .iter()
+                .all(|&(_, v)| (p_lo..=p_hi).contains(&(v * u.factor + u.offset)))
+        })
+    }) else {
+        return Ok(());
+    };
+    Err(format!(
+        "{}: {} {unit}, the column's largest reading: every reading lies within {} {unit} of zero, less than one \
+         step of the sensor's {}-bit ADC over monitor.range_min..range_max = {} to {} {unit}, where the device's {} \
+         spans {} to {} {unit}; written in {}? ({} {} = {} {unit})",
+        log.at(largest, name),
+        sig(top, 6),
+        sig(step, 4),
+        sensor.settings.bits,
+        sig(min, 6),
+        sig(max, 6),
+        second.column.doc.split(" [").next().unwrap_or(name),
+        sig(p_lo, 6),
+        sig(p_hi, 6),
+        other.name,
+        sig(top, 6),
+        other.name,
+        sig(top * other.factor + other.offset, 6)
+    ))
 }
 
 /// Options of [`run`].
@@ -243,12 +562,45 @@ pub struct Replay {
     pub note: String,
 }
 
-/// The output's header: `time_s`, [`COLUMNS`], `flags`.
-pub fn header() -> Vec<&'static str> {
-    let mut h = vec![TIME_COLUMN];
-    h.extend(COLUMNS);
-    h.push(FLAGS_COLUMN);
+/// The output's header: `time_s`, [`COLUMNS`], with a monitor of
+/// `quantity` its health columns ([`health_columns`]), `flags`.
+pub fn header(quantity: Option<MonitorQuantity>) -> Vec<String> {
+    let mut h = vec![TIME_COLUMN.to_string()];
+    h.extend(COLUMNS.iter().map(|c| c.to_string()));
+    if let Some(q) = quantity {
+        h.extend(health_columns(q));
+    }
+    h.push(FLAGS_COLUMN.to_string());
     h
+}
+
+/// The health estimate's columns for a sensor of `quantity`, in
+/// [`HEALTH_FIELDS`]' order: each field's name with its unit's suffix
+/// (`divider`, `offset_pa`, `friction_n`).
+pub fn health_columns(quantity: MonitorQuantity) -> Vec<String> {
+    HEALTH_FIELDS
+        .iter()
+        .map(|f| format!("{}{}", f.name, f.unit.suffix(quantity)))
+        .collect()
+}
+
+/// The health estimate's cells, in [`health_columns`]' order: `f32`
+/// digits, a count whole, empty where the monitor has no value (before its
+/// first reading; the innovation of a reading it did not apply).
+pub fn health_cells(h: &HealthEstimate) -> Vec<String> {
+    HEALTH_FIELDS
+        .iter()
+        .map(|f| {
+            let v = (f.value)(h);
+            if !v.is_finite() {
+                String::new()
+            } else if f.unit == HealthUnit::Count {
+                crate::csv::number(v)
+            } else {
+                f32_cell(v as f32)
+            }
+        })
+        .collect()
 }
 
 /// `v` as a cell: an `f32` in the shorter of its two shortest round-trip
@@ -260,8 +612,9 @@ pub fn f32_cell(v: f32) -> String {
 }
 
 /// One output row: the estimate `e` at `time_s` (the record's fields as
-/// they travel: `f32` digits, a count whole).
-pub fn row(time_s: f64, e: &StateEstimate) -> String {
+/// they travel: `f32` digits, a count whole), with its health estimate
+/// when `health` (a monitor is fitted).
+pub fn row(time_s: f64, e: &StateEstimate, health: bool) -> String {
     let values = Record::of(e).values();
     let mut cells = vec![crate::csv::number(time_s)];
     for name in COLUMNS {
@@ -275,6 +628,9 @@ pub fn row(time_s: f64, e: &StateEstimate) -> String {
             _ => crate::csv::number(values[i]),
         });
     }
+    if health {
+        cells.extend(health_cells(&e.health));
+    }
     cells.push(e.flags.names().collect::<Vec<_>>().join("|"));
     cells.join(",")
 }
@@ -284,6 +640,9 @@ pub fn row(time_s: f64, e: &StateEstimate) -> String {
 /// resistance or code the probe's curve has no temperature for).
 fn sample(log: &Log, settings: &Settings, i: usize) -> Result<Option<f32>, SensorFault> {
     let v = log.value[i];
+    if v.is_nan() {
+        return Ok(None);
+    }
     let ohm = match log.column.reading {
         Reading::Temperature => return Ok(Some(v as f32)),
         Reading::Resistance => v as f32,
@@ -317,22 +676,97 @@ fn seconds(s: f64) -> String {
     }
 }
 
+/// One tick of a replay ([`replay`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Tick<'a> {
+    /// The tick's number from the first row's (0).
+    pub k: u64,
+    /// The tick's start \[s\] ([`tick_time`]).
+    pub time_s: f64,
+    /// The log's row delivered on this tick (0-based), if any.
+    pub row: Option<usize>,
+    /// The estimate after the tick.
+    pub estimate: &'a StateEstimate,
+    /// The firmware publishes this tick's estimate (a telemetry tick).
+    pub published: bool,
+}
+
+/// What a replay ran ([`replay`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Run {
+    /// The probe's reading interval the observer was designed for \[s\].
+    pub sample_period: f64,
+    /// Ticks run.
+    pub ticks: u64,
+    /// The estimator's tick \[s\].
+    pub tick: f64,
+    /// Ticks between telemetry records (0: none).
+    pub telemetry_every: u32,
+    /// Probe readings (rows with one).
+    pub probe_readings: usize,
+    /// The monitor's settings, with a second sensor's column.
+    pub monitor: Option<MonitorSettings>,
+    /// The second sensor's readings (rows with one).
+    pub second_readings: usize,
+}
+
+impl Run {
+    /// `estimate: 9001 readings (t_c) over 180 s, one every 20 ms ...`:
+    /// what ran, for standard error (`rows` the output's rows).
+    pub fn note(&self, command: &str, log: &Log, rows: Option<(usize, bool)>) -> String {
+        let n = log.time_s.len();
+        let span = sig(log.time_s[n - 1] - log.time_s[0], 8);
+        let mut note = format!(
+            "{command}: {} readings ({}) over {span} s, one every {} (the median interval: the observer is \
+             designed for it), {} ticks of {}",
+            self.probe_readings,
+            log.column.name,
+            seconds(self.sample_period),
+            self.ticks,
+            seconds(self.tick),
+        );
+        if let (Some(m), Some(second)) = (&self.monitor, &log.second) {
+            note.push_str(&format!(
+                "; {} readings of the second sensor ({}), one every {} (the monitor's period)",
+                self.second_readings,
+                second.column.name,
+                seconds(f64::from(m.sample_period))
+            ));
+        }
+        if let Some((rows, every_sample)) = rows {
+            note.push_str(&format!("; {rows} rows"));
+            if every_sample {
+                note.push_str(", one per reading");
+            } else {
+                note.push_str(&format!(
+                    ", one per telemetry period ({})",
+                    seconds(self.telemetry_every as f64 * self.tick)
+                ));
+            }
+        }
+        if let Some(extra) = &log.note {
+            note.push_str(&format!("\n{command}: {extra}"));
+        }
+        note
+    }
+}
+
 /// Runs the estimator of the validated parameter set `raw` over `log` (see
-/// the module docs).
+/// the module docs), with the condition monitor of the file's second
+/// sensor when the log has its column, calling `each` after every tick.
 ///
 /// # Errors
 ///
 /// [`CliError::Input`] naming row, line and column (prefixed by the
 /// caller with the file): times that do not increase, two rows within one
-/// tick, a gap longer than the fault timeout, a log longer than
-/// [`MAX_TICKS`], fewer than two rows, a first reading the estimator cannot
-/// start at, a log without a telemetry tick without
-/// [`Options::every_sample`] (no row to print); a file whose estimator
-/// cannot be built (named); `estimator.telemetry_hz = 0` without
-/// [`Options::every_sample`].
-pub fn run(raw: &RawParams, log: &Log, options: Options) -> Result<Replay, CliError> {
+/// tick, a gap between probe readings longer than the fault timeout, a log
+/// longer than [`MAX_TICKS`], fewer than two probe readings, a first
+/// reading the estimator cannot start at; a file whose estimator or
+/// monitor cannot be built (named).
+pub fn replay(raw: &RawParams, log: &Log, mut each: impl FnMut(Tick<'_>)) -> Result<Run, CliError> {
     let n = log.time_s.len();
-    if n < 2 {
+    let probe: Vec<usize> = (0..n).filter(|&i| !log.value[i].is_nan()).collect();
+    if probe.len() < 2 {
         return Err(CliError::Input(
             "one reading: the estimator needs at least two to know the log's reading interval".into(),
         ));
@@ -341,21 +775,16 @@ pub fn run(raw: &RawParams, log: &Log, options: Options) -> Result<Replay, CliEr
     let tick = 1.0 / hz;
     let t0 = log.time_s[0];
     let ticks = ticks_of(log, hz)?;
-    // The reading interval: the median of the intervals, in whole ticks.
-    let mut gaps: Vec<u64> = ticks.windows(2).map(|w| w[1] - w[0]).collect();
-    gaps.sort_unstable();
-    let median = gaps[gaps.len() / 2];
-    let sample_period = median as f64 * tick;
+    // A reading interval: the median of the intervals, in whole ticks.
+    let median = |rows: &[usize]| {
+        let mut gaps: Vec<u64> = rows.windows(2).map(|w| ticks[w[1]] - ticks[w[0]]).collect();
+        gaps.sort_unstable();
+        gaps.get(gaps.len() / 2).map_or(1, |&g| g)
+    };
+    let sample_period = median(&probe) as f64 * tick;
     let config = EstimatorConfig::with_sample_period(raw, sample_period)
         .map_err(|e| CliError::Input(format!("--params: {e}")))?;
-    check_gaps(log, &ticks, u64::from(config.stale_after), hz)?;
-    if config.telemetry_every == 0 && !options.every_sample {
-        return Err(CliError::Input(
-            "--params: estimator.telemetry_hz = 0: the file asks for no telemetry; give --every-sample for one row \
-             per reading"
-                .into(),
-        ));
-    }
+    check_gaps(log, &ticks, &probe, u64::from(config.stale_after), hz)?;
     let settings = Settings::from_params(&raw.estimator);
     let name = log.column.name;
     let start = first_reading(raw, log, &settings)?;
@@ -373,52 +802,95 @@ pub fn run(raw: &RawParams, log: &Log, options: Options) -> Result<Replay, CliEr
             sig(f64::from(start), 6)
         ))
     })?;
+    let mut monitor = None;
+    let mut second_readings = 0;
+    if let (Some(second), Some(sensor)) = (&log.second, SecondSensor::of(raw)?) {
+        let rows: Vec<usize> = (0..n).filter(|&i| !second.value[i].is_nan()).collect();
+        second_readings = rows.len();
+        let m = sensor.monitor(median(&rows) as f64 * tick);
+        estimator = estimator
+            .with_monitor(m)
+            .map_err(|e| CliError::Input(format!("--params: {e}")))?;
+        monitor = Some(m);
+    }
     let last = ticks[n - 1];
-    let mut out = header().join(",");
-    out.push('\n');
     let mut next = 0;
-    let mut rows = 0usize;
     for k in 0..=last {
-        let delivered = ticks.get(next) == Some(&k);
-        let reading = if delivered {
-            next += 1;
-            sample(log, &settings, next - 1)
-        } else {
-            Ok(None)
+        let row = (ticks.get(next) == Some(&k)).then_some(next);
+        let reading = match row {
+            Some(i) => {
+                next += 1;
+                if let Some(y) = log.second.as_ref().map(|s| s.value[i]).filter(|y| !y.is_nan()) {
+                    estimator.offer_second(Ok(y as f32));
+                }
+                sample(log, &settings, i)
+            }
+            None => Ok(None),
         };
         let e = estimator.tick(reading);
-        if (options.every_sample && delivered) || (!options.every_sample && estimator.telemetry_due()) {
-            out.push_str(&row(tick_time(t0, k, hz), &e));
+        each(Tick {
+            k,
+            time_s: tick_time(t0, k, hz),
+            row,
+            estimate: &e,
+            published: estimator.telemetry_due(),
+        });
+    }
+    Ok(Run {
+        sample_period,
+        ticks: last + 1,
+        tick,
+        telemetry_every: config.telemetry_every,
+        probe_readings: probe.len(),
+        monitor,
+        second_readings,
+    })
+}
+
+/// Runs the estimator of the validated parameter set `raw` over `log` (see
+/// the module docs) and tabulates its estimates.
+///
+/// # Errors
+///
+/// As [`replay`]; a log without a telemetry tick without
+/// [`Options::every_sample`] (no row to print);
+/// `estimator.telemetry_hz = 0` without [`Options::every_sample`].
+pub fn run(raw: &RawParams, log: &Log, options: Options) -> Result<Replay, CliError> {
+    if raw.estimator.telemetry_hz == 0.0 && !options.every_sample {
+        return Err(CliError::Input(
+            "--params: estimator.telemetry_hz = 0: the file asks for no telemetry; give --every-sample for one row \
+             per reading"
+                .into(),
+        ));
+    }
+    let quantity = match &log.second {
+        Some(_) => SecondSensor::of(raw)?.map(|s| s.monitor(1.0).quantity),
+        None => None,
+    };
+    let mut out = header(quantity).join(",");
+    out.push('\n');
+    let mut rows = 0usize;
+    let run = replay(raw, log, |t| {
+        if (options.every_sample && t.row.is_some()) || (!options.every_sample && t.published) {
+            out.push_str(&row(t.time_s, t.estimate, quantity.is_some()));
             out.push('\n');
             rows += 1;
         }
-    }
-    let telemetry_period = seconds(config.telemetry_every as f64 * tick);
+    })?;
     if rows == 0 {
+        let n = log.time_s.len();
         return Err(CliError::Input(format!(
-            "no telemetry tick in the log's {} s (the firmware publishes one every {telemetry_period}): no row to \
-             print; give --every-sample for one row per reading",
-            sig(log.time_s[n - 1] - t0, 8),
+            "no telemetry tick in the log's {} s (the firmware publishes one every {}): no row to print; give \
+             --every-sample for one row per reading",
+            sig(log.time_s[n - 1] - log.time_s[0], 8),
+            seconds(run.telemetry_every as f64 * run.tick),
         )));
     }
-    let note = format!(
-        "estimate: {n} readings ({name}) over {} s, one every {} (the median interval: the observer is designed \
-         for it), {} ticks of {}; {rows} rows{}",
-        sig(log.time_s[n - 1] - t0, 8),
-        seconds(sample_period),
-        last + 1,
-        seconds(tick),
-        if options.every_sample {
-            String::from(", one per reading")
-        } else {
-            format!(", one per telemetry period ({telemetry_period})")
-        }
-    );
     Ok(Replay {
         table: out,
-        sample_period,
-        ticks: last + 1,
-        note,
+        sample_period: run.sample_period,
+        ticks: run.ticks,
+        note: run.note("estimate", log, Some((rows, options.every_sample))),
     })
 }
 
@@ -480,17 +952,22 @@ fn ticks_of(log: &Log, hz: f64) -> Result<Vec<u64>, CliError> {
 /// Refuses more than `timeout` ticks without a reading between two rows
 /// (readings `timeout + 1` ticks apart keep the estimate good: the count
 /// is reset on the tick a reading arrives), naming the row after the gap.
-fn check_gaps(log: &Log, ticks: &[u64], timeout: u64, hz: f64) -> Result<(), CliError> {
-    let Some(w) = ticks.windows(2).position(|w| w[1] - w[0] - 1 > timeout) else {
+fn check_gaps(log: &Log, ticks: &[u64], probe: &[usize], timeout: u64, hz: f64) -> Result<(), CliError> {
+    let Some(w) = probe.windows(2).find(|w| ticks[w[1]] - ticks[w[0]] - 1 > timeout) else {
         return Ok(());
     };
-    let i = w + 1;
+    let (i, before) = (w[1], w[0]);
+    let after = if before + 1 == i {
+        "the row before".to_string()
+    } else {
+        format!("the probe reading before (row {})", before + 1)
+    };
     Err(CliError::Input(format!(
-        "{}: {} after the row before, longer than the estimator's fault timeout: it flags the estimate DEGRADED \
-         after {} without a reading ({timeout} ticks at estimator.tick_hz = {} Hz); split the log at this row and \
-         replay each part on its own",
+        "{}: {} after {after}, longer than the estimator's fault timeout: it flags the estimate DEGRADED after {} \
+         without a reading ({timeout} ticks at estimator.tick_hz = {} Hz); split the log at this row and replay \
+         each part on its own",
         log.at(i, TIME_COLUMN),
-        seconds(log.time_s[i] - log.time_s[i - 1]),
+        seconds(log.time_s[i] - log.time_s[before]),
         seconds(timeout as f64 * (1.0 / hz)),
         sig(hz, 6)
     )))
@@ -553,8 +1030,17 @@ mod tests {
                 c.name
             );
         }
+        for q in [
+            Quantity::PressureA,
+            Quantity::PressureB,
+            Quantity::PressureDifference,
+            Quantity::Displacement,
+        ] {
+            assert_eq!(second_column(q).quantity, q);
+            assert!(crate::data::column(second_column(q).name).is_some(), "{q:?}");
+        }
         assert_eq!(
-            header().join(","),
+            header(None).join(","),
             "time_s,t_probe_c,t_oil_c,t_oil_sd_c,x_m,x_sd_m,p_a_pa,p_a_sd_pa,p_b_pa,p_b_sd_pa,q_total_m3s,\
              q_total_sd_m3s,compensation_error_m3s,compensation_error_sd_m3s,reseats,flags"
         );

@@ -4,7 +4,8 @@
 //! * commands: [`statics`] (equilibrium, asymptotic, sensitivity),
 //!   [`dynamics`] (step, twin-config, eigen, indicators), [`sizing`]
 //!   (compensation, size), [`calibration`] (calibrate), [`identify`]
-//!   (identify), [`estimate`] (the firmware's estimator over a probe log), [`paper`] (the paper report, with the paper's tables in
+//!   (identify), [`estimate`] (the firmware's estimator over a probe log),
+//!   [`monitor`] (the condition monitor's flags over a log), [`paper`] (the paper report, with the paper's tables in
 //!   [`paper::tables`]), [`report`] (the paper's tables and figures as
 //!   files) and [`sweep`] (design variants on a grid or within tolerances);
 //! * their plumbing: [`error`] (a command's failure and exit status,
@@ -39,6 +40,7 @@ pub mod estimate;
 pub mod identify;
 pub mod input;
 pub mod lsq;
+pub mod monitor;
 pub mod paper;
 pub mod plot;
 pub mod report;

@@ -806,6 +806,85 @@ pub fn estimate(csv: &str, stroke: f64, title: &str, u: Units) -> Result<Figure,
     })
 }
 
+/// Most points a curve of [`monitor`] draws: a day of readings at 100 Hz
+/// is 8.6 million, far beyond what a figure resolves.
+pub const MONITOR_POINTS: usize = 4000;
+
+/// `monitor`: over time, the standardised innovation of each reading the
+/// monitor took (with the gate), the CUSUM (with its threshold), the
+/// health factors (divider and spring, each with its 95 % band,
+/// `exp(ln f +- 1.96 sd)`), and the reading's offset (with its band), from
+/// the monitor's `trace`; every `n`-th reading where there are more than
+/// [`MONITOR_POINTS`].
+pub fn monitor(trace: &[crate::monitor::Point], pressure: bool, title: &str) -> Figure {
+    use compensator::monitor::{CUSUM_THRESHOLD, GATE};
+    let every = trace.len().div_ceil(MONITOR_POINTS).max(1);
+    let points: Vec<&crate::monitor::Point> = trace.iter().step_by(every).collect();
+    let (t0, t1) = (
+        trace.first().map_or(0.0, |p| p.time_s),
+        trace.last().map_or(1.0, |p| p.time_s),
+    );
+    let series = |label: &str, f: &dyn Fn(&compensator::monitor::HealthEstimate) -> f64| {
+        Series::line(label, points.iter().map(|p| (p.time_s, f(&p.health))).collect())
+    };
+    let level = |label: &str, y: f64| Series {
+        dashed: true,
+        color: Some(1),
+        ..Series::line(label, vec![(t0, y), (t1, y)])
+    };
+    let factor = |label: &str, v: fn(&compensator::monitor::HealthEstimate) -> (f32, f32), color: usize| Series {
+        color: Some(color),
+        band: points
+            .iter()
+            .map(|p| {
+                let (f, sd) = v(&p.health);
+                let (ln, sd) = (f64::from(f).ln(), f64::from(sd));
+                (p.time_s, (ln - BAND_K * sd).exp(), (ln + BAND_K * sd).exp())
+            })
+            .collect(),
+        ..series(label, &|h| f64::from(v(h).0))
+    };
+    let offset = Series {
+        band: points
+            .iter()
+            .map(|p| {
+                let (o, sd) = (f64::from(p.health.offset), f64::from(p.health.sd_offset));
+                (p.time_s, o - BAND_K * sd, o + BAND_K * sd)
+            })
+            .collect(),
+        ..series("offset (band: +-1.96 sd, 95 %)", &|h| f64::from(h.offset))
+    };
+    Figure {
+        title: title.to_string(),
+        x_desc: "time [s]".into(),
+        panels: vec![
+            panel(
+                "standardised innovation [-]",
+                vec![
+                    series("innovation of each reading", &|h| f64::from(h.innovation)),
+                    level("gate +-6", f64::from(GATE)),
+                    level("", -f64::from(GATE)),
+                ],
+            ),
+            panel(
+                "CUSUM [-]",
+                vec![
+                    series("CUSUM (the larger side)", &|h| f64::from(h.cusum)),
+                    level("threshold 10: DEVICE_CHANGED", f64::from(CUSUM_THRESHOLD)),
+                ],
+            ),
+            panel(
+                "health factor [-]",
+                vec![
+                    factor("divider A / A_file (band: 95 %)", |h| (h.divider, h.sd_divider), 0),
+                    factor("spring c / c_file (band: 95 %)", |h| (h.spring, h.sd_spring), 2),
+                ],
+            ),
+            panel(if pressure { "offset [Pa]" } else { "offset [m]" }, vec![offset]),
+        ],
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::tick;

@@ -8,7 +8,7 @@ use std::process::{Command, Stdio};
 mod common;
 use common::{cli, root, run, run_in};
 
-const COMMANDS: [&str; 17] = [
+const COMMANDS: [&str; 18] = [
     "equilibrium",
     "asymptotic",
     "sensitivity",
@@ -21,6 +21,7 @@ const COMMANDS: [&str; 17] = [
     "calibrate",
     "identify",
     "estimate",
+    "monitor",
     "paper",
     "report",
     "sweep",

@@ -7,7 +7,8 @@ Usage: drive_fmu.py FMU HISTORY.csv [--csv OUT.csv] [--png OUT.png] [--no-plot]
 HISTORY.csv has columns time_s,t_c (e.g. data/fmu/oil-temperature.csv).
 FMPy's simulate_fmu steps the FMU by its tick (the model description's
 default step) and interpolates the temperature between samples; the port
-pressures p_supply, p_outlet stay at their start values. The result
+pressures p_supply, p_outlet stay at their start values, the second
+sensor's reading NaN (none). The result
 (time, T_oil, x, Q0, flags) is written as CSV; with matplotlib installed
 (and without --no-plot) also a PNG.
 """
@@ -32,9 +33,10 @@ def main():
     md = read_model_description(args.fmu)
     # The port pressures held at their start values (the file's operating point).
     start = {v.name: float(v.start) for v in md.modelVariables if v.name in ("p_supply", "p_outlet")}
+    # No second sensor's reading (NaN): the condition monitor reads nothing.
     signals = np.array(
-        [(t, c, start["p_supply"], start["p_outlet"]) for t, c in zip(history["time_s"], history["t_c"])],
-        dtype=[("time", float), ("T_oil", float), ("p_supply", float), ("p_outlet", float)],
+        [(t, c, start["p_supply"], start["p_outlet"], np.nan) for t, c in zip(history["time_s"], history["t_c"])],
+        dtype=[("time", float), ("T_oil", float), ("p_supply", float), ("p_outlet", float), ("second_reading", float)],
     )
     tick = float(md.defaultExperiment.stepSize)
     result = simulate_fmu(

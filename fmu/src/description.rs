@@ -6,8 +6,8 @@
 
 use crate::instance::{Instance, Setup};
 use crate::variables::{
-    FLAGS_OUTPUT, INPUTS, OUTPUTS, Unit, VR_FIRST_FIELD, VR_FIRST_OUTPUT, VR_MACHINE_PRESENT, VR_T_OIL, VR_TIME,
-    field_min, fields, fmi_unit, used_units,
+    FLAGS_OUTPUT, INPUTS, READING_UNIT, Unit, VR_FIRST_FIELD, VR_FIRST_OUTPUT, VR_MACHINE_PRESENT, VR_T_OIL, VR_TIME,
+    field_min, fields, fmi_unit, outputs, resolve_unit, used_units,
 };
 use compensator::RawParams;
 use compensator::dynamics::TwinConfig;
@@ -65,8 +65,7 @@ fn variable_list() -> Vec<(u32, String, Option<&'static str>)> {
             .map(|(i, v)| (VR_T_OIL + i as u32, v.name.to_string(), v.unit)),
     );
     v.extend(
-        OUTPUTS
-            .iter()
+        outputs()
             .enumerate()
             .map(|(i, o)| (VR_FIRST_OUTPUT + i as u32, o.name.to_string(), o.unit)),
     );
@@ -187,7 +186,7 @@ pub fn model_description(version: FmiVersion, raw: &RawParams, config: &TwinConf
     );
     x.push_str("  <ModelVariables>\n");
     // (value reference, index in FMI 2.0's list) of each output.
-    let mut outputs = Vec::new();
+    let mut listed = Vec::new();
     let mut index = 0u32;
     let mut var = |x: &mut String, v3: String, v2: String| {
         match version {
@@ -207,13 +206,15 @@ pub fn model_description(version: FmiVersion, raw: &RawParams, config: &TwinConf
         );
     }
     let inputs = Instance::new(raw).inputs();
+    // The second sensor's unit: the packaged file's quantity's.
+    let displacement = raw.monitor.sensor == 4.0;
     for (k, (input, start)) in INPUTS
         .iter()
-        .zip([inputs.t_oil, inputs.p_supply, inputs.p_outlet])
+        .zip([inputs.t_oil, inputs.p_supply, inputs.p_outlet, inputs.second])
         .enumerate()
     {
         let (name, vr, doc, start) = (input.name, VR_T_OIL + k as u32, attr(input.doc), number(start));
-        let unit = input.unit.unwrap_or_default();
+        let unit = resolve_unit(input.unit.unwrap_or_default(), displacement);
         var(
             &mut x,
             format!(
@@ -224,7 +225,7 @@ pub fn model_description(version: FmiVersion, raw: &RawParams, config: &TwinConf
             ),
         );
     }
-    for (i, o) in OUTPUTS.iter().enumerate() {
+    for (i, o) in outputs().enumerate() {
         let vr = VR_FIRST_OUTPUT + i as u32;
         let doc = attr(o.doc);
         let k = if i == FLAGS_OUTPUT {
@@ -240,7 +241,7 @@ pub fn model_description(version: FmiVersion, raw: &RawParams, config: &TwinConf
                 ),
             )
         } else {
-            let unit = o.unit.unwrap_or_default();
+            let unit = resolve_unit(o.unit.unwrap_or_default(), displacement);
             var(
                 &mut x,
                 format!(
@@ -253,7 +254,7 @@ pub fn model_description(version: FmiVersion, raw: &RawParams, config: &TwinConf
                 ),
             )
         };
-        outputs.push((vr, k));
+        listed.push((vr, k));
     }
     let present = if setup.machine_present { "true" } else { "false" };
     let m_doc = attr("The driven machine ([machine] section) is used: compensation_error is defined.");
@@ -296,20 +297,20 @@ pub fn model_description(version: FmiVersion, raw: &RawParams, config: &TwinConf
     match version {
         FmiVersion::V2 => {
             x.push_str("    <Outputs>\n");
-            for (_, k) in &outputs {
+            for (_, k) in &listed {
                 let _ = writeln!(x, "      <Unknown index=\"{k}\" dependencies=\"\"/>");
             }
             x.push_str("    </Outputs>\n    <InitialUnknowns>\n");
-            for (_, k) in &outputs {
+            for (_, k) in &listed {
                 let _ = writeln!(x, "      <Unknown index=\"{k}\"/>");
             }
             x.push_str("    </InitialUnknowns>\n");
         }
         FmiVersion::V3 => {
-            for (vr, _) in &outputs {
+            for (vr, _) in &listed {
                 let _ = writeln!(x, "    <Output valueReference=\"{vr}\" dependencies=\"\"/>");
             }
-            for (vr, _) in &outputs {
+            for (vr, _) in &listed {
                 let _ = writeln!(x, "    <InitialUnknown valueReference=\"{vr}\"/>");
             }
         }
@@ -328,17 +329,21 @@ pub fn variables_markdown() -> String {
         s,
         "| `time` | independent (FMI 3.0 only) | Float64 | s | {VR_TIME} | | Simulation time |"
     );
+    let unit = |u: Option<&str>| match u {
+        Some(READING_UNIT) => "Pa (m for x)".to_string(),
+        u => u.unwrap_or_default().to_string(),
+    };
     for (k, i) in INPUTS.iter().enumerate() {
         let _ = writeln!(
             s,
             "| `{}` | input | Float64 | {} | {} | | {} |",
             i.name,
-            i.unit.unwrap_or_default(),
+            unit(i.unit),
             VR_T_OIL + k as u32,
             i.doc.replace('|', "\\|")
         );
     }
-    for (i, o) in OUTPUTS.iter().enumerate() {
+    for (i, o) in outputs().enumerate() {
         let ty = if i == FLAGS_OUTPUT {
             "Int32 (FMI 2.0: Integer)"
         } else {
@@ -348,7 +353,7 @@ pub fn variables_markdown() -> String {
             s,
             "| `{}` | output | {ty} | {} | {} | | {} |",
             o.name,
-            o.unit.unwrap_or(""),
+            unit(o.unit),
             VR_FIRST_OUTPUT + i as u32,
             o.doc
         );

@@ -16,16 +16,28 @@
 //! estimator runs its jobs in rotation, an input change runs them all at
 //! once (`Plant::refresh`); the flags, flows and compensation error are
 //! the estimator's publication (`Plant::estimate`).
+//!
+//! With a second sensor in the packaged file (`[monitor]`), the core's
+//! condition monitor (`compensator::monitor::Monitor`, its settings
+//! `MonitorSettings::from_raw`) takes the input `second_reading` once per
+//! communication step, at the step's start (after the inputs are applied,
+//! before the ticks), against the twin's state and oil there, the oil's
+//! temperature known exactly (the input, not a probe's estimate); its
+//! health estimate is published with the step's outputs. The monitor's
+//! state is not part of a serialised FMU state (the core does not expose
+//! it): a state saved after the monitor took a reading is refused when set.
 
 use crate::variables::{
-    FIELD_COUNT, FLAGS_OUTPUT, INPUTS, OUTPUTS, VR_FIRST_OUTPUT, VR_MACHINE_PRESENT, VR_P_OUTLET, VR_P_SUPPLY, VR_TIME,
-    field_of, fields, input_of,
+    FIELD_COUNT, FIRST_HEALTH_OUTPUT, FLAGS_OUTPUT, INPUTS, OUTPUT_COUNT, VR_FIRST_OUTPUT, VR_MACHINE_PRESENT,
+    VR_P_OUTLET, VR_P_SUPPLY, VR_SECOND_READING, VR_TIME, field_of, fields, input_of, output,
 };
 use compensator::dynamics::config::choose;
 use compensator::dynamics::{TwinConfig, TwinMemory};
+use compensator::estimator::health::HEALTH_FIELDS;
 use compensator::estimator::{EstimatorConfig, Flags, Plant};
+use compensator::monitor::{HealthEstimate, Monitor, MonitorSettings, PER_READING, PlantView};
 use compensator::{ModelError, Params, RawParams};
-use compensator_params::{MACHINE_FIELDS, RawTolerances};
+use compensator_params::{MACHINE_FIELDS, RawMonitor, RawTolerances};
 
 /// Where an instance is in the FMI state machine.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -128,6 +140,9 @@ pub struct Setup {
     pub machine_present: bool,
     /// The packaged file's standard uncertainties and correlations.
     pub tolerances: RawTolerances,
+    /// The packaged file's second sensor (`[monitor]`; not variables
+    /// either: the monitor's settings travel with the file).
+    pub monitor: RawMonitor,
 }
 
 /// Start values of the `[machine]` fields for a file without that section
@@ -153,6 +168,7 @@ impl Setup {
             values: values.try_into().expect("one value per field"),
             machine_present: raw.machine.is_some(),
             tolerances: raw.tolerances,
+            monitor: raw.monitor,
         }
     }
 
@@ -172,9 +188,14 @@ impl Setup {
             }
             Some(self.values[i])
         })
-        .map(|raw| RawParams {
-            tolerances: self.tolerances,
-            ..raw
+        .and_then(|raw| {
+            let raw = RawParams {
+                tolerances: self.tolerances,
+                monitor: self.monitor,
+                ..raw
+            };
+            // The second sensor's rules against the device.
+            raw.validate().map(|()| raw)
         })
         .map_err(|e| e.to_string())
     }
@@ -217,7 +238,13 @@ struct Sim {
     /// The instance's time [s]: the end of the last communication step.
     time: f64,
     flags: Flags,
-    outputs: [f64; 10],
+    outputs: [f64; OUTPUT_COUNT],
+    /// The condition monitor, with a second sensor in the file.
+    monitor: Option<Monitor>,
+    /// Its estimate at its last reading.
+    health: HealthEstimate,
+    /// Readings it has taken.
+    readings: u64,
 }
 
 fn model_error(what: &str, e: ModelError) -> String {
@@ -233,6 +260,8 @@ pub struct Inputs {
     pub p_supply: f64,
     /// Outlet pressure [Pa].
     pub p_outlet: f64,
+    /// The second sensor's reading this step [Pa or m] (NaN: none).
+    pub second: f64,
 }
 
 impl Sim {
@@ -248,6 +277,10 @@ impl Sim {
         let raw = setup.to_raw()?;
         let params = Params::<f32>::new(&raw).map_err(|e| e.to_string())?;
         let estimator = EstimatorConfig::new(&raw).map_err(|e| e.to_string())?;
+        let monitor = match MonitorSettings::from_raw(&raw).map_err(|e| e.to_string())? {
+            Some(m) => Some(Monitor::new(&params, m).map_err(|e| e.to_string())?),
+            None => None,
+        };
         let config = match chosen {
             Some((r, c)) if *r == raw => c,
             _ => {
@@ -317,7 +350,10 @@ impl Sim {
             stale: false,
             time: start_time,
             flags: Flags::empty(),
-            outputs: [f64::NAN; 10],
+            outputs: [f64::NAN; OUTPUT_COUNT],
+            monitor,
+            health: HealthEstimate::NONE,
+            readings: 0,
         };
         sim.publish(Flags::empty());
         Ok(sim)
@@ -327,9 +363,12 @@ impl Sim {
     /// publication) with `flags` and the design's and inputs' own.
     fn publish(&mut self, mut flags: Flags) {
         flags.insert(self.plant.flags_at(&self.estimator, self.applied.t));
+        // The monitor's standing flags (the named faults, a change not yet
+        // named); its per-reading ones come with the step's reading.
+        flags.insert(Flags(self.health.flags.0 & !PER_READING.0));
         let e = self.plant.estimate(self.applied.t, flags);
         self.flags = e.flags;
-        self.outputs = [
+        let state = [
             e.x as f64,
             e.v as f64,
             e.p_a as f64,
@@ -341,6 +380,32 @@ impl Sim {
             e.compensation_error as f64,
             e.flags.0 as f64,
         ];
+        self.outputs[..FIRST_HEALTH_OUTPUT].copy_from_slice(&state);
+        for (out, f) in self.outputs[FIRST_HEALTH_OUTPUT..].iter_mut().zip(&HEALTH_FIELDS) {
+            *out = (f.value)(&self.health);
+        }
+    }
+
+    /// Gives the second sensor's `reading` [Pa or m] (NaN: none) to the
+    /// monitor, against the twin as it stands; the reading's own flags.
+    fn monitor_reading(&mut self, reading: f64) -> Flags {
+        let Some(monitor) = self.monitor.as_mut() else {
+            return Flags::empty();
+        };
+        if reading.is_nan() {
+            return Flags::empty();
+        }
+        let s = self.plant.twin().state();
+        let view = PlantView {
+            oil: *self.plant.oil(),
+            x: s.x,
+            p_a: s.p_a,
+            p_b: s.p_b,
+            var_t: 0.0,
+        };
+        self.health = monitor.update(self.plant.params(), &view, Ok::<f32, ()>(reading as f32));
+        self.readings += 1;
+        Flags(self.health.flags.0 & PER_READING.0)
     }
 
     /// Sets the twin's coefficients for `inputs` where they are usable
@@ -381,6 +446,7 @@ impl Sim {
     /// `n` ticks of `tick` [s] with the inputs held.
     fn step(&mut self, inputs: Inputs, n: u64, tick: f64) -> Result<(), String> {
         let mut flags = self.apply(inputs);
+        flags.insert(self.monitor_reading(inputs.second));
         let twin = self.plant.twin_mut();
         if twin.config().tick != tick {
             twin.set_tick(tick)
@@ -411,6 +477,8 @@ pub struct Instance {
     /// parameters).
     p_supply: Option<f64>,
     p_outlet: Option<f64>,
+    /// The second sensor's reading as set (NaN: none).
+    second: f64,
     start_time: f64,
     phase: Phase,
     sim: Option<Sim>,
@@ -457,6 +525,7 @@ impl Instance {
             t_oil: t,
             p_supply: None,
             p_outlet: None,
+            second: f64::NAN,
             start_time: 0.0,
             phase: Phase::Instantiated,
             sim: None,
@@ -492,6 +561,7 @@ impl Instance {
             t_oil: self.t_oil,
             p_supply: self.p_supply.unwrap_or(outlet + value("operating.pressure_drop")),
             p_outlet,
+            second: self.second,
         }
     }
 
@@ -524,6 +594,18 @@ impl Instance {
             match vr {
                 VR_P_SUPPLY => self.p_supply = Some(value),
                 VR_P_OUTLET => self.p_outlet = Some(value),
+                VR_SECOND_READING => {
+                    if !value.is_nan() && !self.setup.monitor.has_sensor() {
+                        return Err(Failure::Refused(format!(
+                            "second_reading: {value}: the packaged parameter file has no second sensor \
+                             (monitor.sensor = \"none\"); leave it NaN"
+                        )));
+                    }
+                    // A reading for the monitor, not a change of the twin's
+                    // inputs: the initialised twin stands.
+                    self.second = value;
+                    return Ok(());
+                }
                 _ => self.t_oil = value,
             }
             if self.phase == Phase::Initialization {
@@ -587,6 +669,7 @@ impl Instance {
             return Ok(match vr {
                 VR_P_SUPPLY => i.p_supply,
                 VR_P_OUTLET => i.p_outlet,
+                VR_SECOND_READING => i.second,
                 _ => i.t_oil,
             });
         }
@@ -594,7 +677,7 @@ impl Instance {
             return Ok(self.setup.values[i]);
         }
         let out = vr.wrapping_sub(VR_FIRST_OUTPUT) as usize;
-        if vr == VR_TIME || (out < OUTPUTS.len() && out != FLAGS_OUTPUT) {
+        if vr == VR_TIME || (out < OUTPUT_COUNT && out != FLAGS_OUTPUT) {
             let sim = self.initialised_sim(vr)?;
             return Ok(if vr == VR_TIME { sim.time } else { sim.outputs[out] });
         }
@@ -612,7 +695,7 @@ impl Instance {
             }
             return Err(Failure::Refused(format!(
                 "{}: outputs are defined from initialization mode on",
-                OUTPUTS[(vr - VR_FIRST_OUTPUT) as usize].name
+                output((vr - VR_FIRST_OUTPUT) as usize).map_or("an output", |o| o.name)
             )));
         }
         self.ensure_sim()
@@ -750,6 +833,7 @@ impl Instance {
         self.t_oil = self.t_oil_start;
         self.p_supply = None;
         self.p_outlet = None;
+        self.second = f64::NAN;
         self.start_time = 0.0;
         self.sim = None;
         self.phase = Phase::Instantiated;
@@ -772,6 +856,7 @@ impl Instance {
             b.push(p.is_some() as u8);
             b.extend_from_slice(&p.unwrap_or(0.0).to_le_bytes());
         }
+        b.extend_from_slice(&self.second.to_le_bytes());
         b.extend_from_slice(&self.start_time.to_le_bytes());
         match &self.sim {
             None => b.push(0),
@@ -793,6 +878,7 @@ impl Instance {
                 for v in s.outputs {
                     b.extend_from_slice(&v.to_le_bytes());
                 }
+                b.extend_from_slice(&s.readings.to_le_bytes());
             }
         }
         b
@@ -820,8 +906,9 @@ impl Instance {
         let setup = Setup {
             values,
             machine_present,
-            // Not a variable: the packaged file's, as at instantiation.
+            // Not variables: the packaged file's, as at instantiation.
             tolerances: self.start.tolerances,
+            monitor: self.start.monitor,
         };
         let t_oil = r.f64().ok_or_else(bad)?;
         let mut set = [None; 2];
@@ -830,6 +917,7 @@ impl Instance {
             let v = r.f64().ok_or_else(bad)?;
             *p = given.then_some(v);
         }
+        let second = r.f64().ok_or_else(bad)?;
         let start_time = r.f64().ok_or_else(bad)?;
         let sim = match r.u8().ok_or_else(bad)? {
             0 => None,
@@ -848,9 +936,16 @@ impl Instance {
                 let xi_carry = r.f32().ok_or_else(bad)?;
                 let abrupt = r.u8().ok_or_else(bad)? != 0;
                 let flags = Flags(r.u32().ok_or_else(bad)?);
-                let mut outputs = [0.0; 10];
+                let mut outputs = [0.0; OUTPUT_COUNT];
                 for v in &mut outputs {
                     *v = r.f64().ok_or_else(bad)?;
+                }
+                let readings = u64::from_le_bytes(r.take(8).ok_or_else(bad)?.try_into().map_err(|_| bad())?);
+                if readings > 0 {
+                    return Err(Failure::Refused(format!(
+                        "FMU state: saved after the condition monitor took {readings} readings, whose state cannot \
+                         be restored (the core does not expose it); restart from the initialisation instead"
+                    )));
                 }
                 // The twin rebuilt along the same path (built at t_init at
                 // the design's pressures, then given the last temperature
@@ -862,12 +957,14 @@ impl Instance {
                     t_oil: t_init as f64,
                     p_supply: ps,
                     p_outlet: po,
+                    second: f64::NAN,
                 };
                 let mut sim = Sim::new(&setup, designed, start_time, chosen).map_err(Failure::Refused)?;
                 let restored = sim.apply(Inputs {
                     t_oil: applied.t as f64,
                     p_supply: applied.pressures.0 as f64,
                     p_outlet: applied.pressures.1 as f64,
+                    second: f64::NAN,
                 });
                 if sim.applied != applied || !restored.is_empty() {
                     return Err(Failure::Refused(
@@ -897,6 +994,7 @@ impl Instance {
         self.setup = setup;
         self.t_oil = t_oil;
         [self.p_supply, self.p_outlet] = set;
+        self.second = second;
         self.start_time = start_time;
         self.sim = sim;
         Ok(())
@@ -911,7 +1009,7 @@ pub fn t_oil_start(raw: &RawParams) -> f64 {
 
 const MAGIC: &[u8; 4] = b"CFMU";
 /// Version of the state's byte layout.
-const FORMAT: u32 = 2;
+const FORMAT: u32 = 3;
 
 struct Reader<'a> {
     bytes: &'a [u8],

@@ -2,8 +2,11 @@
 //! causality, unit and description. The parameters are the parameter
 //! file's fields, taken from the schema (`compensator_params::CORE_FIELDS`,
 //! `MACHINE_FIELDS`, `ESTIMATOR_FIELDS`): names, units, descriptions and
-//! plausible ranges are never restated here.
+//! plausible ranges are never restated here. The condition monitor's
+//! outputs are the core's health table
+//! (`compensator::estimator::health::HEALTH_FIELDS`), likewise.
 
+use compensator::estimator::health::{HEALTH_FIELDS, HealthUnit};
 use compensator_params::{CORE_FIELDS, ESTIMATOR_FIELDS, Field, Kind, MACHINE_FIELDS, PROBE_FIELDS};
 
 /// Value reference of the independent variable `time` [s] (declared in
@@ -15,10 +18,28 @@ pub const VR_T_OIL: u32 = 1;
 pub const VR_P_SUPPLY: u32 = 2;
 /// Value reference of the input `p_outlet` [Pa].
 pub const VR_P_OUTLET: u32 = 3;
+/// Value reference of the input `second_reading` [Pa or m].
+pub const VR_SECOND_READING: u32 = 4;
+
+/// The unit of a variable in the second sensor's unit: `Pa` for a
+/// pressure, `m` for the displacement, as the packaged file's
+/// `monitor.sensor` says ([`resolve_unit`]).
+pub const READING_UNIT: &str = "Pa|m";
+
+/// The FMI unit `unit` of a variable for a packaged file whose second
+/// sensor measures a displacement (`displacement`) or not: the unit
+/// itself, or for [`READING_UNIT`] `m` or `Pa`.
+pub fn resolve_unit(unit: &'static str, displacement: bool) -> &'static str {
+    match unit {
+        READING_UNIT if displacement => "m",
+        READING_UNIT => "Pa",
+        u => u,
+    }
+}
 
 /// The inputs (continuous Float64s, held over a communication step), in
 /// value-reference order from [`VR_T_OIL`].
-pub const INPUTS: [Variable; 3] = [
+pub const INPUTS: [Variable; 4] = [
     Variable {
         name: "T_oil",
         unit: Some("degC"),
@@ -38,6 +59,13 @@ pub const INPUTS: [Variable; 3] = [
         unit: Some("Pa"),
         doc: "Outlet pressure p_c (the circuit downstream). Not finite: not used (the twin keeps the last pressures, \
               flag SENSOR_FAULT). Start: operating.outlet_pressure.",
+    },
+    Variable {
+        name: "second_reading",
+        unit: Some(READING_UNIT),
+        doc: "The condition monitor's second sensor's reading, of the quantity of the packaged file's monitor.sensor \
+              (p_a, p_b or dp_ab in Pa, x in m): one reading per communication step, taken at the step's start \
+              (NaN: no reading this step). Without a second sensor in the file only NaN is accepted. Start: NaN.",
     },
 ];
 
@@ -118,12 +146,40 @@ pub const OUTPUTS: [Variable; 10] = [
     Variable {
         name: "flags",
         unit: None,
-        doc: "Estimator flags, a bit set: 1 AT_STOP, 2 OUT_OF_RANGE, 4 NOT_UNIQUE, 8 UNSTABLE, 16 SENSOR_FAULT, 64 DEGRADED (docs/fmu.md).",
+        doc: "Estimator flags, a bit set: 1 AT_STOP, 2 OUT_OF_RANGE, 4 NOT_UNIQUE, 8 UNSTABLE, 16 SENSOR_FAULT, 64 DEGRADED; the condition monitor's 1024 DEVICE_CHANGED, 2048 CAPILLARY_RESTRICTED, 4096 ORIFICE_CLOGGED, 8192 SPRING_RELAXED, 16384 PRELOAD_LOST, 32768 PLUNGER_STICKING, 65536 SENSOR_OFFSET, 262144 INNOVATION_REJECTED (docs/fmu.md).",
     },
 ];
 
 /// Index of `flags` in [`OUTPUTS`].
 pub const FLAGS_OUTPUT: usize = 9;
+
+/// Every output: [`OUTPUTS`], then the condition monitor's health
+/// estimate, one Float64 per field of the core's `HEALTH_FIELDS` (its
+/// name, unit and description), in value-reference order from
+/// [`VR_FIRST_OUTPUT`].
+pub fn outputs() -> impl Iterator<Item = Variable> {
+    OUTPUTS.into_iter().chain(HEALTH_FIELDS.iter().map(|f| Variable {
+        name: f.name,
+        unit: Some(match f.unit {
+            HealthUnit::One | HealthUnit::Count => "1",
+            HealthUnit::Reading => READING_UNIT,
+            HealthUnit::Newton => "N",
+            HealthUnit::Kelvin => "K",
+        }),
+        doc: f.doc,
+    }))
+}
+
+/// Number of outputs ([`outputs`]).
+pub const OUTPUT_COUNT: usize = OUTPUTS.len() + HEALTH_FIELDS.len();
+
+/// Index in [`outputs`] of the first health value.
+pub const FIRST_HEALTH_OUTPUT: usize = OUTPUTS.len();
+
+/// The output of index `i` in [`outputs`].
+pub fn output(i: usize) -> Option<Variable> {
+    outputs().nth(i)
+}
 
 /// The parameter file's fields in the variables' order: core, machine,
 /// estimator, probe in file order, then the estimator's sensor-kind fields
@@ -189,7 +245,8 @@ const fn unit(name: &'static str, exponents: [i8; 8]) -> Unit {
 }
 
 /// Every unit the FMU declares: the schema's units and the outputs'.
-pub const UNITS: [Unit; 18] = [
+pub const UNITS: [Unit; 20] = [
+    unit("1", [0, 0, 0, 0, 0, 0, 0, 0]),
     unit("m", [0, 1, 0, 0, 0, 0, 0, 0]),
     unit("m/s", [0, 1, -1, 0, 0, 0, 0, 0]),
     unit("Pa", [1, -1, -2, 0, 0, 0, 0, 0]),
@@ -203,6 +260,7 @@ pub const UNITS: [Unit; 18] = [
     unit("1/K4", [0, 0, 0, 0, -4, 0, 0, 0]),
     unit("N.s/m", [1, 0, -1, 0, 0, 0, 0, 0]),
     unit("N/m", [1, 0, -2, 0, 0, 0, 0, 0]),
+    unit("N", [1, 1, -2, 0, 0, 0, 0, 0]),
     unit("s", [0, 0, 1, 0, 0, 0, 0, 0]),
     unit("Hz", [0, 0, -1, 0, 0, 0, 0, 0]),
     unit("K/s", [0, 0, -1, 0, 1, 0, 0, 0]),
@@ -246,7 +304,9 @@ pub fn fmi_unit(schema_unit: &str) -> Option<&'static str> {
 /// [`UNITS`] order.
 pub fn used_units() -> Vec<Unit> {
     let mut names: Vec<&str> = fields().filter_map(|f| fmi_unit(f.unit)).collect();
-    names.extend(OUTPUTS.iter().filter_map(|o| o.unit));
+    // The second sensor's unit is Pa or m, both declared for other variables.
+    names.extend(outputs().filter_map(|o| o.unit));
+    names.extend(["Pa", "m"]);
     names.push("degC");
     names.push("s");
     UNITS.iter().copied().filter(|u| names.contains(&u.name)).collect()
@@ -265,8 +325,10 @@ mod tests {
             let name = fmi_unit(f.unit).unwrap_or_else(|| panic!("{}: unit {} has no FMI unit", f.path, f.unit));
             assert!(UNITS.iter().any(|u| u.name == name), "{}: {name} not in UNITS", f.path);
         }
-        for o in OUTPUTS.iter().filter_map(|o| o.unit) {
-            assert!(UNITS.iter().any(|u| u.name == o));
+        for o in outputs().chain(INPUTS).filter_map(|o| o.unit) {
+            for d in [false, true] {
+                assert!(UNITS.iter().any(|u| u.name == resolve_unit(o, d)), "{o}");
+            }
         }
     }
 
@@ -275,25 +337,47 @@ mod tests {
         assert_eq!(fields().count(), FIELD_COUNT);
         let mut vrs: Vec<u32> = vec![VR_TIME, VR_MACHINE_PRESENT];
         vrs.extend((0..INPUTS.len() as u32).map(|i| VR_T_OIL + i));
-        vrs.extend((0..OUTPUTS.len() as u32).map(|i| VR_FIRST_OUTPUT + i));
+        vrs.extend((0..OUTPUT_COUNT as u32).map(|i| VR_FIRST_OUTPUT + i));
         vrs.extend((0..FIELD_COUNT as u32).map(|i| VR_FIRST_FIELD + i));
         let n = vrs.len();
         vrs.sort_unstable();
         vrs.dedup();
         assert_eq!(vrs.len(), n);
-        assert!(VR_FIRST_OUTPUT + OUTPUTS.len() as u32 <= VR_MACHINE_PRESENT);
+        assert!(VR_FIRST_OUTPUT + OUTPUT_COUNT as u32 <= VR_MACHINE_PRESENT);
+        assert_eq!(outputs().count(), OUTPUT_COUNT);
+        assert!(VR_T_OIL + INPUTS.len() as u32 <= VR_FIRST_OUTPUT);
         for (i, f) in fields().enumerate() {
             assert_eq!(field_of(VR_FIRST_FIELD + i as u32), Some((i, f)));
         }
         assert_eq!(field_of(VR_FIRST_FIELD + FIELD_COUNT as u32), None);
         assert_eq!(field_of(VR_T_OIL), None);
-        for (k, vr) in [VR_T_OIL, VR_P_SUPPLY, VR_P_OUTLET].into_iter().enumerate() {
+        for (k, vr) in [VR_T_OIL, VR_P_SUPPLY, VR_P_OUTLET, VR_SECOND_READING]
+            .into_iter()
+            .enumerate()
+        {
             assert_eq!(input_of(vr), Some(k));
             assert!(vr < VR_FIRST_OUTPUT);
         }
-        assert_eq!(input_of(VR_P_OUTLET + 1), None);
+        assert_eq!(input_of(VR_SECOND_READING + 1), None);
         assert_eq!(input_of(VR_TIME), None);
         assert_eq!(OUTPUTS[FLAGS_OUTPUT].name, "flags");
+    }
+
+    #[test]
+    fn the_flags_doc_gives_each_flags_bit() {
+        use compensator::estimator::Flags;
+        let doc = OUTPUTS[FLAGS_OUTPUT].doc;
+        let mut named = Flags(Flags::AT_STOP.0 | Flags::OUT_OF_RANGE.0 | Flags::NOT_UNIQUE.0);
+        named.insert(Flags(Flags::UNSTABLE.0 | Flags::SENSOR_FAULT.0 | Flags::DEGRADED.0));
+        // The FMU's readings are values, never the sensor's own faults.
+        named.insert(Flags(
+            compensator::estimator::health::MONITOR_FLAGS.0 & !Flags::SECOND_SENSOR_FAULT.0,
+        ));
+        for (bit, name) in Flags::NAMES.iter().enumerate() {
+            if named.0 & (1 << bit) != 0 {
+                assert!(doc.contains(&format!("{} {name}", 1u32 << bit)), "{name}");
+            }
+        }
     }
 
     #[test]

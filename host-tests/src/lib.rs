@@ -15,6 +15,7 @@ pub mod fixed_audit;
 pub mod identify_study;
 pub mod matrix;
 pub mod monitor_campaign;
+pub mod monitor_log;
 pub mod observability;
 pub mod probe;
 pub mod random;

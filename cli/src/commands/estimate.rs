@@ -23,6 +23,15 @@ timeout (0.5 s at the default tick), and exactly one of
 A reading the firmware flags (outside estimator.oil_min..oil_max, a code
 of 0 or 32767) is flagged SENSOR_FAULT the same way.
 
+With a second sensor in the file's [monitor] section, its column
+  p_a_pa, p_b_pa or dp_ab_pa [Pa], or x_m [m]   (the file's monitor.sensor)
+feeds the condition monitor on the row's tick; a row may then leave the
+probe's or the second sensor's cell empty (or NaN), not both, and the
+first row holds a probe reading. A column for another quantity, or one
+evidently in bar, MPa or mm, is refused naming the row and column (the
+file's monitor.range_min..range_max gives the plausible readings). A
+telemetry CSV's x_m, p_a_pa, p_b_pa are estimates, never readings.
+
 Output: CSV, one row per telemetry period (estimator.telemetry_hz), or
 per input row with --every-sample; SI units, every digit of the f32
 estimate:
@@ -31,7 +40,14 @@ estimate:
   x_m [m], x_sd_m [m], p_a_pa [Pa], p_a_sd_pa [Pa], p_b_pa [Pa], p_b_sd_pa [Pa],
   q_total_m3s [m^3/s], q_total_sd_m3s [m^3/s],
   compensation_error_m3s [m^3/s], compensation_error_sd_m3s [m^3/s]
-  (NaN without a [machine] section), reseats [-], flags (names joined by |)
+  (NaN without a [machine] section), reseats [-],
+  with a second sensor's column, the monitor's health estimate:
+  divider [-] (A / A_file), sd_divider [-] (of ln divider), spring [-]
+  (c / c_file), sd_spring [-], offset_pa|_m, sd_offset_pa|_m, friction_n
+  [N], predicted_pa|_m (the reading the monitor predicted), innovation [-]
+  (standardised), cusum [-], rejected [-] (readings not applied); empty
+  before the monitor's first reading,
+  flags (names joined by |, the monitor's among them)
 The *_sd_* columns are standard uncertainties (k = 1): +-1.96 of them is
 the 95 % band (docs/firmware.md). stderr: the readings, their interval and
 the ticks run.
@@ -46,7 +62,7 @@ Example:
 pub struct Args {
     #[command(flatten)]
     params: ParamsArg,
-    /// Probe log: time_s and one of t_c, t_probe_c, rtd_ohm, code (CSV); - reads standard input.
+    /// Probe log: time_s and one of t_c, t_probe_c, rtd_ohm, code, with the file's second sensor's column (CSV); - reads standard input.
     #[arg(long, value_name = "LOG.csv")]
     sensor_data: PathBuf,
     /// One row per row of the log instead of one per telemetry period.
@@ -83,7 +99,8 @@ impl Args {
             log_path.display().to_string()
         };
         let prefix = |e: String| CliError::Input(format!("--sensor-data: {shown}: {e}"));
-        let log = estimate::read_log(&text).map_err(prefix)?;
+        let sensor = estimate::SecondSensor::of(&raw)?;
+        let log = estimate::read_log(&text, sensor.as_ref()).map_err(prefix)?;
         let replay = estimate::run(
             &raw,
             &log,

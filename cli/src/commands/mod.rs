@@ -26,6 +26,7 @@ pub mod estimate;
 pub mod identify;
 pub mod indicators;
 pub mod man;
+pub mod monitor;
 pub mod paper;
 pub mod report;
 pub mod sensitivity;
@@ -71,6 +72,7 @@ pub enum Command {
     Calibrate(calibrate::Args),
     Identify(identify::Args),
     Estimate(estimate::Args),
+    Monitor(monitor::Args),
     Paper(paper::Args),
     Report(report::Args),
     Sweep(sweep::Args),
@@ -99,6 +101,7 @@ impl Command {
             Command::Calibrate(a) => a.run(),
             Command::Identify(a) => a.run(),
             Command::Estimate(a) => a.run(),
+            Command::Monitor(a) => a.run(),
             Command::Paper(a) => a.run(),
             Command::Report(a) => a.run(),
             Command::Sweep(a) => a.run(),

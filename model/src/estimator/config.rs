@@ -1,11 +1,14 @@
 //! The estimator's settings: the `[estimator]` section's, the observer's
 //! design from the `[probe]` section, and the uncertainty table from the
-//! `[tolerances]`.
+//! `[tolerances]`; the condition monitor's from the `[monitor]` section
+//! ([`MonitorSettings::from_raw`]).
 
 use super::observer::{DesignError, ObserverDesign, ObserverSettings};
 use super::spike::SpikeSettings;
 use crate::dynamics::TwinConfig;
+use crate::monitor::{MonitorSettings, Quantity};
 use crate::params::{ParamError, RawEstimator, RawParams};
+use crate::sensor::transducer::{self, SettingsError};
 use crate::uncertainty::{UncertaintyError, UncertaintyTable};
 use core::borrow::Borrow;
 
@@ -231,6 +234,53 @@ pub fn observer_settings(raw: &RawParams, sample_period: f64) -> ObserverSetting
         tick: 1.0 / e.tick_hz,
         sample_period,
         span: e.oil_max - e.oil_min,
+    }
+}
+
+/// The condition monitor's settings ([`MonitorSettings`]) from a parameter
+/// file, one function for every consumer (the CLI, the FMU, the firmware's
+/// build): what the estimator's monitor needs of the `[monitor]` section's
+/// sensor.
+impl MonitorSettings {
+    /// The monitor's settings for the validated parameter set `raw`:
+    /// `None` without a second sensor (no `[monitor]` section, or
+    /// `monitor.sensor = "none"`), else [`MonitorSettings::of_transducer`]
+    /// of its transducer ([`crate::sensor::device::monitor_settings`]).
+    ///
+    /// # Errors
+    ///
+    /// [`SettingsError::Param`] naming the field of `raw` its validation
+    /// or the transducer's settings refuse (`monitor.range_max`,
+    /// `monitor.noise`, ...).
+    pub fn from_raw(raw: &RawParams) -> Result<Option<MonitorSettings>, SettingsError> {
+        Ok(crate::sensor::device::monitor_settings(raw)?.map(|s| MonitorSettings::of_transducer(&s)))
+    }
+
+    /// The monitor's settings for a transducer channel (the driver's
+    /// settings, built from the file or by hand):
+    ///
+    /// * `sd_noise` \[Pa or m\]: the reading's noise combined with the
+    ///   ADC's quantisation, `sqrt(noise^2 + lsb^2 / 12)`, `lsb` one code
+    ///   in the reading's unit ([`transducer::Settings::units_per_code`]:
+    ///   the sensor's span over the codes its signal band covers at
+    ///   `monitor.adc_bits`);
+    /// * `sd_accuracy` \[Pa or m\]: the class as a standard uncertainty,
+    ///   `accuracy * span / sqrt(3)` (GUM 4.3.7, a uniform limit);
+    /// * `sample_period` \[s\]: `1 / monitor.sample_hz`.
+    pub fn of_transducer(s: &transducer::Settings) -> MonitorSettings {
+        let quantity = match s.quantity {
+            transducer::Quantity::PressureA => Quantity::ChamberA,
+            transducer::Quantity::PressureB => Quantity::ChamberB,
+            transducer::Quantity::PressureDifference => Quantity::Difference,
+            transducer::Quantity::Displacement => Quantity::Displacement,
+        };
+        let lsb = s.units_per_code();
+        MonitorSettings {
+            quantity,
+            sd_noise: libm::sqrtf(s.noise * s.noise + lsb * lsb / 12.0),
+            sd_accuracy: s.class_uncertainty(),
+            sample_period: s.period,
+        }
     }
 }
 

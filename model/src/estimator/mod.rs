@@ -69,6 +69,7 @@ mod config;
 mod deadline;
 mod estimate;
 mod flags;
+pub mod health;
 mod jobs;
 mod observer;
 mod plant;

@@ -1,0 +1,103 @@
+//! `monitor`: what the condition monitor made of a log with the second
+//! sensor's readings.
+
+use crate::args::{FormatArg, Output, ParamsArg, PlotArg};
+use crate::error::CliError;
+use crate::estimate;
+use std::path::PathBuf;
+
+const HELP: &str = "\
+Replays a log through the firmware's estimator with the condition monitor
+of the device file's second sensor ([monitor] section), as estimate does,
+and summarises the monitor's flags: which were raised, since when, and how
+sure it is.
+
+Log (CSV, as estimate reads it): time_s [s], the probe's column (t_c,
+rtd_ohm or code) and the second sensor's, p_a_pa, p_b_pa or dp_ab_pa [Pa]
+or x_m [m] (the file's monitor.sensor); either reading may be empty on a
+row. A column in bar, MPa or mm is refused naming its row and column.
+
+Output: CSV, one row per flag of the monitor's raised over the log
+(DEVICE_CHANGED, CAPILLARY_RESTRICTED, ORIFICE_CLOGGED, SPRING_RELAXED,
+PRELOAD_LOST, PLUNGER_STICKING, SENSOR_OFFSET, SECOND_SENSOR_FAULT,
+INNOVATION_REJECTED), in that order; none: a header alone:
+  flag, first_row [-] (the log's row on or before the tick that first
+  carried it), first_line [-] (its line in the file), first_time_s [s]
+  (that tick's start), ticks [-] (ticks that carried it),
+  parameter (the health value it is about: divider, spring, offset,
+  friction, cusum, rejected), estimate (its value at the log's end),
+  sd (its standard deviation: of the logarithm for divider and spring),
+  z [-] (how many sd the estimate lies from the file's device: ln(f)/sd
+  for a factor, offset/sd), cusum_max [-] (the largest CUSUM up to the
+  flag; DEVICE_CHANGED above 10), unit (of estimate and sd)
+stderr: what ran, and the health estimate at the log's end.
+--plot FILE.png|svg: the standardised innovations with the gate, the CUSUM
+with its threshold, the divider and spring factors and the offset, each
+with its 95 % band, over time.
+
+Example:
+  compensator monitor --params presets/paper-monitor.toml \\
+    --sensor-data log.csv --plot monitor.png --format table";
+
+/// Summarise what the condition monitor made of a log with the second sensor's readings: faults, since when, how sure.
+#[derive(clap::Args, Debug, Clone)]
+#[command(after_long_help = HELP)]
+pub struct Args {
+    #[command(flatten)]
+    params: ParamsArg,
+    /// Log: time_s, the probe's column and the second sensor's (p_a_pa, p_b_pa, dp_ab_pa or x_m; CSV); - reads standard input.
+    #[arg(long, value_name = "LOG.csv")]
+    sensor_data: PathBuf,
+    #[command(flatten)]
+    plot: PlotArg,
+    #[command(flatten)]
+    format: FormatArg,
+}
+
+impl Args {
+    /// Runs the command.
+    ///
+    /// # Errors
+    ///
+    /// Bad input (the file, the log: naming row, line and column) as
+    /// [`estimate::read_log`] and [`crate::monitor::summarise`].
+    pub fn run(self) -> Result<Output, CliError> {
+        let log_path = &self.sensor_data;
+        if log_path.as_os_str() == "-" && self.params.params.as_os_str() == "-" {
+            return Err(CliError::Input(
+                "--sensor-data: standard input is --params' already; give one of them as a file".into(),
+            ));
+        }
+        let raw = self.params.raw()?;
+        let sensor = estimate::SecondSensor::of(&raw)?;
+        let text = crate::input::bounded_text(
+            log_path,
+            "--sensor-data",
+            crate::input::MAX_LOG_BYTES,
+            &format!(": {}", estimate::SPLIT),
+        )?;
+        let shown = if log_path.as_os_str() == "-" {
+            "standard input".to_string()
+        } else {
+            log_path.display().to_string()
+        };
+        let prefix = |e: String| CliError::Input(format!("--sensor-data: {shown}: {e}"));
+        let log = estimate::read_log(&text, sensor.as_ref()).map_err(prefix)?;
+        let summary = crate::monitor::summarise(&raw, &log).map_err(|e| match e {
+            CliError::Input(m) if !m.starts_with("--params") => prefix(m),
+            e => e,
+        })?;
+        if let Some(path) = &self.plot.plot {
+            let figure = crate::plot::monitor(
+                &summary.trace,
+                summary.quantity.is_pressure(),
+                &format!("Condition monitor over {shown}"),
+            );
+            crate::plot::write(path, &figure)?;
+        }
+        for line in summary.notes(&log) {
+            eprintln!("{line}");
+        }
+        Ok(Output::si_table(summary.table, &self.format))
+    }
+}
