@@ -54,7 +54,7 @@ use compensator::Params;
 use compensator::estimator::health::{HEALTH_FIELDS, HealthUnit};
 use compensator::estimator::telemetry::{Encoding, FIELDS, Record};
 use compensator::estimator::{Estimator, EstimatorConfig, StateEstimate};
-use compensator::monitor::{HealthEstimate, MonitorSettings, Quantity as MonitorQuantity};
+use compensator::monitor::{HealthEstimate, MonitorSettings, ProbeModel, Quantity as MonitorQuantity};
 use compensator::params::RawParams;
 use compensator::sensor::max31865::Settings;
 use compensator::sensor::transducer::{self, Quantity};
@@ -171,6 +171,8 @@ pub struct SecondSensor {
     /// pressure the outlet to the supply, their difference `-dp..dp`, the
     /// displacement the stroke.
     pub physical: (f64, f64),
+    /// The oil-temperature probe the monitor tests the device with.
+    pub probe: ProbeModel,
 }
 
 impl SecondSensor {
@@ -191,7 +193,11 @@ impl SecondSensor {
             Quantity::PressureDifference => (-dp, dp),
             Quantity::Displacement => (0.0, raw.core.stroke),
         };
-        Ok(Some(SecondSensor { settings, physical }))
+        Ok(Some(SecondSensor {
+            settings,
+            physical,
+            probe: ProbeModel::new(raw),
+        }))
     }
 
     /// The readings the sensor gives as readings, its measuring band
@@ -210,7 +216,7 @@ impl SecondSensor {
     pub fn monitor(&self, period: f64) -> MonitorSettings {
         MonitorSettings {
             sample_period: period as f32,
-            ..MonitorSettings::of_transducer(&self.settings)
+            ..MonitorSettings::of_transducer(&self.settings, self.probe)
         }
     }
 }

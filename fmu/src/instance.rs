@@ -34,8 +34,8 @@ use crate::variables::{
 use compensator::dynamics::config::choose;
 use compensator::dynamics::{TwinConfig, TwinMemory};
 use compensator::estimator::health::HEALTH_FIELDS;
-use compensator::estimator::{EstimatorConfig, Flags, Plant};
-use compensator::monitor::{HealthEstimate, Monitor, MonitorSettings, PER_READING, PlantView};
+use compensator::estimator::{EstimatorConfig, Flags, NO_LAG, Plant};
+use compensator::monitor::{HealthEstimate, Monitor, MonitorSettings, PER_READING, PlantView, ProbeModel, ProbeSample};
 use compensator::{ModelError, Params, RawParams};
 use compensator_params::{MACHINE_FIELDS, RawMonitor, RawTolerances};
 
@@ -245,6 +245,8 @@ struct Sim {
     health: HealthEstimate,
     /// Readings it has taken.
     readings: u64,
+    /// The time of the monitor's last reading \[s\].
+    monitor_time: Option<f64>,
 }
 
 fn model_error(what: &str, e: ModelError) -> String {
@@ -278,7 +280,19 @@ impl Sim {
         let params = Params::<f32>::new(&raw).map_err(|e| e.to_string())?;
         let estimator = EstimatorConfig::new(&raw).map_err(|e| e.to_string())?;
         let monitor = match MonitorSettings::from_raw(&raw).map_err(|e| e.to_string())? {
-            Some(m) => Some(Monitor::new(&params, m).map_err(|e| e.to_string())?),
+            // The oil's temperature is the input itself: a probe that
+            // neither lags nor errs, read to the file's converter's
+            // resolution.
+            Some(m) => {
+                let probe = ProbeModel {
+                    time_constant: NO_LAG as f32,
+                    well_time_constant: 0.0,
+                    tolerance_a: 0.0,
+                    tolerance_b: 0.0,
+                    ..m.probe
+                };
+                Some(Monitor::new(&params, MonitorSettings { probe, ..m }).map_err(|e| e.to_string())?)
+            }
             None => None,
         };
         let config = match chosen {
@@ -354,6 +368,7 @@ impl Sim {
             monitor,
             health: HealthEstimate::NONE,
             readings: 0,
+            monitor_time: None,
         };
         sim.publish(Flags::empty());
         Ok(sim)
@@ -401,8 +416,13 @@ impl Sim {
             x: s.x,
             p_a: s.p_a,
             p_b: s.p_b,
-            var_t: 0.0,
+            dt: self.monitor_time.map_or(0.0, |t| (self.time - t) as f32),
+            probe: Some(ProbeSample {
+                value: self.applied.t,
+                age: 0.0,
+            }),
         };
+        self.monitor_time = Some(self.time);
         self.health = monitor.update(self.plant.params(), &view, Ok::<f32, ()>(reading as f32));
         self.readings += 1;
         Flags(self.health.flags.0 & PER_READING.0)

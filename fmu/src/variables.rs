@@ -165,6 +165,7 @@ pub fn outputs() -> impl Iterator<Item = Variable> {
             HealthUnit::Reading => READING_UNIT,
             HealthUnit::Newton => "N",
             HealthUnit::Kelvin => "K",
+            HealthUnit::Celsius => "degC",
         }),
         doc: f.doc,
     }))

@@ -6,7 +6,7 @@
 use super::observer::{DesignError, ObserverDesign, ObserverSettings};
 use super::spike::SpikeSettings;
 use crate::dynamics::TwinConfig;
-use crate::monitor::{MonitorSettings, Quantity};
+use crate::monitor::{MonitorSettings, ProbeModel, Quantity};
 use crate::params::{ParamError, RawEstimator, RawParams};
 use crate::sensor::transducer::{self, SettingsError};
 use crate::uncertainty::{UncertaintyError, UncertaintyTable};
@@ -253,7 +253,8 @@ impl MonitorSettings {
     /// or the transducer's settings refuse (`monitor.range_max`,
     /// `monitor.noise`, ...).
     pub fn from_raw(raw: &RawParams) -> Result<Option<MonitorSettings>, SettingsError> {
-        Ok(crate::sensor::device::monitor_settings(raw)?.map(|s| MonitorSettings::of_transducer(&s)))
+        let probe = ProbeModel::new(raw);
+        Ok(crate::sensor::device::monitor_settings(raw)?.map(|s| MonitorSettings::of_transducer(&s, probe)))
     }
 
     /// The monitor's settings for a transducer channel (the driver's
@@ -266,8 +267,10 @@ impl MonitorSettings {
     ///   `monitor.adc_bits`);
     /// * `sd_accuracy` \[Pa or m\]: the class as a standard uncertainty,
     ///   `accuracy * span / sqrt(3)` (GUM 4.3.7, a uniform limit);
-    /// * `sample_period` \[s\]: `1 / monitor.sample_hz`.
-    pub fn of_transducer(s: &transducer::Settings) -> MonitorSettings {
+    /// * `sample_period` \[s\]: `1 / monitor.sample_hz`;
+    /// * `probe`: the oil-temperature probe the monitor tests the device
+    ///   with ([`ProbeModel::new`] of the file).
+    pub fn of_transducer(s: &transducer::Settings, probe: ProbeModel) -> MonitorSettings {
         let quantity = match s.quantity {
             transducer::Quantity::PressureA => Quantity::ChamberA,
             transducer::Quantity::PressureB => Quantity::ChamberB,
@@ -280,6 +283,7 @@ impl MonitorSettings {
             sd_noise: libm::sqrtf(s.noise * s.noise + lsb * lsb / 12.0),
             sd_accuracy: s.class_uncertainty(),
             sample_period: s.period,
+            probe,
         }
     }
 }

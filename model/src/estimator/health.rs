@@ -20,6 +20,8 @@ pub enum HealthUnit {
     Newton,
     /// Kelvin (a temperature difference).
     Kelvin,
+    /// Degree Celsius (a temperature).
+    Celsius,
     /// A count.
     Count,
 }
@@ -34,6 +36,7 @@ impl HealthUnit {
             HealthUnit::Reading => "m",
             HealthUnit::Newton => "N",
             HealthUnit::Kelvin => "K",
+            HealthUnit::Celsius => "degC",
         }
     }
 
@@ -47,6 +50,7 @@ impl HealthUnit {
             HealthUnit::Reading => "_m",
             HealthUnit::Newton => "_n",
             HealthUnit::Kelvin => "_k",
+            HealthUnit::Celsius => "_c",
         }
     }
 }
@@ -67,7 +71,7 @@ pub struct HealthField {
 
 /// Every value of [`HealthEstimate`] but its flags, in the order host
 /// tables list them.
-pub const HEALTH_FIELDS: [HealthField; 11] = [
+pub const HEALTH_FIELDS: [HealthField; 14] = [
     HealthField {
         name: "divider",
         unit: HealthUnit::One,
@@ -103,6 +107,24 @@ pub const HEALTH_FIELDS: [HealthField; 11] = [
         unit: HealthUnit::Reading,
         doc: "Standard deviation of the offset.",
         value: |h| f64::from(h.sd_offset),
+    },
+    HealthField {
+        name: "probe_bias",
+        unit: HealthUnit::Kelvin,
+        doc: "The oil-temperature probe's error at the oil temperature (its place within its IEC 60751 tolerance times the tolerance).",
+        value: |h| f64::from(h.probe_bias),
+    },
+    HealthField {
+        name: "sd_probe_bias",
+        unit: HealthUnit::Kelvin,
+        doc: "Standard deviation of the probe's error.",
+        value: |h| f64::from(h.sd_probe_bias),
+    },
+    HealthField {
+        name: "oil",
+        unit: HealthUnit::Celsius,
+        doc: "The oil temperature the second sensor's reading gives through the health estimate (the twin's where it does not depend on it).",
+        value: |h| f64::from(h.oil),
     },
     HealthField {
         name: "friction",
