@@ -245,14 +245,15 @@ pub fn operations_section(fw: &Firmware) -> String {
 /// sending the record), from the bench image's pieces.
 #[cfg(feature = "host")]
 fn telemetry_section(m4: &Costs) -> String {
-    use compensator::estimator::telemetry::{Encoding, FIELDS, SIZE};
+    use compensator::estimator::telemetry::{Encoding, FIELDS, HEALTH_FROM, SIZE, SIZE_MONITOR};
     let piece = |name: &str| m4.pieces.iter().find(|p| p.name == name).map(|p| p.instructions);
     let mut t = String::new();
     let _ = writeln!(t, "\n## Telemetry record (Cortex-M4F)\n");
     let _ = writeln!(
         t,
-        "The record (`model/src/estimator/telemetry.rs`) is {SIZE} bytes: a 2-byte layout tag, {} fields, \
-         the 2-byte flags. Sending it whole (`telemetry`: packing and the defmt frame through the QEMU \
+        "The record (`model/src/estimator/telemetry.rs`) is {SIZE} bytes: a 2-byte layout tag, {HEALTH_FROM} fields, \
+         the 4-byte flags ({SIZE_MONITOR} bytes and {} fields in an image with the condition monitor, whose \
+         health parameters it adds). Sending it whole (`telemetry`: packing and the defmt frame through the QEMU \
          logger) costs {:.0} instructions, packing alone (`telemetry-pack`) {:.0}. A field costs its \
          encoding plus its bytes at `telemetry-byte` each (the QEMU logger's copy into its frame buffer; on the board, defmt-rtt's copy into its ring buffer):\n",
         FIELDS.len(),
