@@ -266,7 +266,9 @@ fn upper_gamma_q(a: f64, x: f64) -> f64 {
 
 #[test]
 fn the_noise_limit_is_the_chi_square_quantile_of_1e9() {
-    let dof = f64::from(NOISE_WINDOW - 1);
+    // The window's residuals about its least-squares line: two degrees of
+    // freedom fewer than its codes.
+    let dof = f64::from(NOISE_WINDOW - 2);
     let q = upper_gamma_q(dof / 2.0, f64::from(NOISE_CHI2) / 2.0);
     assert!((q / 1.0e-9 - 1.0).abs() < 1e-3, "{q}");
     // The check's limit: K (sigma_c + 0.5)^2.
@@ -274,6 +276,72 @@ fn the_noise_limit_is_the_chi_square_quantile_of_1e9() {
     let sigma = f64::from(100.0 / s.units_per_code());
     let limit = f64::from(NOISE_CHI2) / dof * (sigma + 0.5).powi(2);
     assert!((f64::from(s.noise_limit) / limit - 1.0).abs() < 1e-5);
+}
+
+/// The residual variance about the least-squares line of `codes`,
+/// fitted in `f64` by the normal equations (the reference for the
+/// driver's integer sums).
+fn residual_variance(codes: &[u16]) -> f64 {
+    let n = codes.len() as f64;
+    let (mx, my) = ((n - 1.0) / 2.0, codes.iter().map(|&c| f64::from(c)).sum::<f64>() / n);
+    let (mut sxx, mut sxy) = (0.0, 0.0);
+    for (i, &c) in codes.iter().enumerate() {
+        sxx += (i as f64 - mx).powi(2);
+        sxy += (i as f64 - mx) * (f64::from(c) - my);
+    }
+    let slope = sxy / sxx;
+    let rss: f64 = codes
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| (f64::from(c) - my - slope * (i as f64 - mx)).powi(2))
+        .sum();
+    rss / (n - 2.0)
+}
+
+#[test]
+fn the_noise_check_is_the_residual_variance_about_the_windows_line() {
+    let s = pressure(RATIOMETRIC);
+    // Windows of random codes, ramps and steps against the f64 fit.
+    let mut rng = host_tests::random::Rng::new(3);
+    for case in 0..200 {
+        let slope = rng.unit() * 40.0 - 20.0;
+        let noise = rng.unit() * if case % 2 == 0 { 3.0 } else { 300.0 };
+        let codes: Vec<u16> = (0..NOISE_WINDOW)
+            .map(|i| {
+                let v = 2048.0 + slope * f64::from(i) + noise * (rng.unit() - 0.5);
+                v.round().clamp(0.0, 4095.0) as u16
+            })
+            .collect();
+        let mut checks = transducer::Checks::new(&s);
+        for &c in &codes {
+            let _ = checks.update(c);
+        }
+        let got = f64::from(checks.last_variance().expect("a complete window"));
+        let want = residual_variance(&codes);
+        assert!(
+            (got - want).abs() <= 1e-5 * want.max(1.0),
+            "case {case}: {got} against {want}"
+        );
+    }
+}
+
+#[test]
+fn a_healthy_sensor_through_a_ramp_is_not_noisy() {
+    // The paper preset's p_a through a 1 C/s move at 27 C: 8.4 kPa/s, 84
+    // Pa (0.55 codes) a reading at 100 Hz, 35 codes a window: the plain
+    // sample variance of a window would be 35^2 / 12 = 102 codes^2, thirty
+    // times the limit. Thirty such ramps from 4e5 down to 1.5e5 Pa.
+    for output in [RATIOMETRIC, CURRENT] {
+        let s = pressure(output);
+        assert!(s.noise_limit < 4.0, "{}", s.noise_limit);
+        for seed in 0..30 {
+            let mut drv = transducer::simulated(s, 4.0e5, seed);
+            for k in 0..2976 {
+                drv.device_mut().registers_mut().reading = 4.0e5 - 84.0 * k as f32;
+                assert_eq!(drv.read().err(), None, "{output:?}, ramp {seed}, reading {k}");
+            }
+        }
+    }
 }
 
 // ---------------------------------------------------------------------
