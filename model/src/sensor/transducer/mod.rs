@@ -59,23 +59,25 @@
 //! below a code, or none) the check is off (`stuck_after` = 0).
 //!
 //! Over each window of [`NOISE_WINDOW`] readings the residual variance
-//! `s^2 = RSS / 62` of the codes about their least-squares line is
-//! compared with `K V_h`. The line takes out the process value's own
-//! steady change: a chamber pressure moves with the oil's temperature,
+//! `s^2 = RSS / 61` of the codes about their least-squares parabola is
+//! compared with `K V_h`. The parabola takes out the process value's own
+//! smooth change: a chamber pressure moves with the oil's temperature,
 //! 8.4 kPa/K on the paper preset at 27 C, so a 0.5 C/s warm-up sweeps a
 //! 100 Hz window over 18 codes, a spread of 26 codes^2 that the plain
-//! sample variance would read as a noisy sensor on every ramp (the QEMU
-//! twin's replay did). `V_h = (sigma_c + 0.5)^2` bounds the variance of a
-//! healthy rounded reading (the rounding error, at most half a code, adds
-//! at most 0.5 to its standard deviation: Minkowski), and
-//! `K = chi^2_62(1 - 1e-9) / 62 = 2.4766` ([`NOISE_CHI2`]): for Gaussian
-//! readings of variance `V` about a line, `RSS / V` is chi-square with
-//! 62 degrees of freedom (two taken by the line), which exceeds 153.55
-//! with probability 1e-9. A healthy sensor therefore raises
-//! [`SensorFault::Noisy`] in at most one window in 1e9
-//! ([`NOISE_FALSE_ALARM`]), at rest or through a ramp whose curvature over
-//! a window is small beside the noise; the fault holds until a window
-//! passes.
+//! sample variance read as a noisy sensor on every ramp of the QEMU
+//! twin's replay; a line took that out, but not the bend where a 1 C/s
+//! move starts or ends inside a window (0.55 codes a reading: about 6
+//! codes^2 about the line, 0.3 about the parabola). `V_h = (sigma_c +
+//! 0.5)^2` bounds the variance of a healthy rounded reading (the
+//! rounding error, at most half a code, adds at most 0.5 to its standard
+//! deviation: Minkowski), and `K = chi^2_61(1 - 1e-9) / 61 = 2.4921`
+//! ([`NOISE_CHI2`]): for Gaussian readings of variance `V` about a
+//! parabola, `RSS / V` is chi-square with 61 degrees of freedom (three
+//! taken by the fit), which exceeds 152.02 with probability 1e-9. A
+//! healthy sensor therefore raises [`SensorFault::Noisy`] in at most one
+//! window in 1e9 ([`NOISE_FALSE_ALARM`]), at rest or through a change
+//! whose departure from a parabola over a window is small beside the
+//! noise; the fault holds until a window passes.
 //!
 //! Files: `driver.rs` ([`Transducer`]), `monitor.rs` (the stuck and noise
 //! checks, [`Checks`]), `simulated.rs` ([`SimulatedTransducer`], the
@@ -103,11 +105,11 @@ pub const STUCK_FALSE_ALARM: f64 = 1.0e-9;
 /// Readings in one window of the noise check.
 pub const NOISE_WINDOW: u32 = 64;
 
-/// `chi^2` with `NOISE_WINDOW - 2` = 62 degrees of freedom (the window's
-/// residuals about its line) exceeds this with probability
-/// [`NOISE_FALSE_ALARM`] (regularised upper incomplete gamma `Q(31,
-/// 153.5473 / 2)` = 1e-9; `host-tests/tests/transducer.rs` recomputes it).
-pub const NOISE_CHI2: f32 = 153.5473;
+/// `chi^2` with `NOISE_WINDOW - 3` = 61 degrees of freedom (the window's
+/// residuals about its parabola) exceeds this with probability
+/// [`NOISE_FALSE_ALARM`] (regularised upper incomplete gamma `Q(30.5,
+/// 152.0161 / 2)` = 1e-9; `host-tests/tests/transducer.rs` recomputes it).
+pub const NOISE_CHI2: f32 = 152.0161;
 
 /// The false-alarm probability per window the noise check is designed for.
 pub const NOISE_FALSE_ALARM: f64 = 1.0e-9;
@@ -314,7 +316,7 @@ pub struct Settings {
     /// off; the module docs derive it).
     pub stuck_after: u32,
     /// Residual variance over a window of [`NOISE_WINDOW`] codes (about
-    /// its least-squares line) above which the sensor is noisy
+    /// its least-squares parabola) above which the sensor is noisy
     /// \[codes^2\] (the module docs derive it).
     pub noise_limit: f32,
 }
@@ -439,7 +441,7 @@ impl Settings {
         }
         let sigma = f64::from(s.noise / s.units_per_code());
         s.stuck_after = stuck_after(sigma);
-        s.noise_limit = (NOISE_CHI2 / (NOISE_WINDOW - 2) as f32) * (sigma as f32 + 0.5) * (sigma as f32 + 0.5);
+        s.noise_limit = (NOISE_CHI2 / (NOISE_WINDOW - 3) as f32) * (sigma as f32 + 0.5) * (sigma as f32 + 0.5);
         Ok(s)
     }
 
