@@ -135,9 +135,28 @@ pub fn build(tc: &Toolchain, root: &Path, image: &Image, params: Option<&Path>) 
     build_with(tc, root, image, Options { params, debug: false }).map(|b| b.elf)
 }
 
+/// Whether the parameter file names the condition monitor's second sensor
+/// (`None`: the paper preset, which does not; a file that cannot be read
+/// is left to the build script to refuse, naming its field).
+pub fn names_second_sensor(params: Option<&Path>) -> bool {
+    params.is_some_and(|p| compensator_params::file::load(p).is_ok_and(|raw| raw.monitor.has_sensor()))
+}
+
+/// The cargo features of `image` built for `params`: its own, and the
+/// firmware's `monitor` when the file names a second sensor (the build
+/// script requires it then, and refuses it otherwise).
+pub fn features(image: &Image, params: Option<&Path>) -> String {
+    if names_second_sensor(params) {
+        format!("{},monitor", image.features)
+    } else {
+        image.features.to_string()
+    }
+}
+
 /// Builds `image` (only it: `--package compensator-firmware --bin ...`, no host
-/// crate of the workspace); returns the ELF and the build script's output
-/// directory.
+/// crate of the workspace), with the `monitor` feature for a file that
+/// names a second sensor ([`features`]); returns the ELF and the build
+/// script's output directory.
 pub fn build_with(tc: &Toolchain, root: &Path, image: &Image, options: Options<'_>) -> Result<Built, String> {
     let mut cmd = tc.cargo();
     cmd.current_dir(root).args([
@@ -156,7 +175,7 @@ pub fn build_with(tc: &Toolchain, root: &Path, image: &Image, options: Options<'
         image.target,
         "--no-default-features",
         "--features",
-        image.features,
+        &features(image, options.params),
         "--message-format=json-render-diagnostics",
     ])
     .arg("--target-dir")
