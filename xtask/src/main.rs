@@ -746,7 +746,8 @@ fn cmd_test(bless: bool) -> Outcome {
     ntc_soak(&tc, &root, minutes(3))?;
     step("a parameter file the CLI refuses fails the firmware build in one line naming the field");
     firmware::check_refused_file(&tc, &root)?;
-    step("firmware images");
+    step("firmware images (the Cortex-M4F bench and the board for the monitor's preset first, kept apart)");
+    let monitor = bench::monitor_images(&tc, &root, None)?;
     let elfs = firmware::build_all_with(&tc, &root)?;
     let twin = firmware::build_with(&tc, &root, &firmware::Image::TWIN, firmware::Options::default())?;
     step("QEMU: the twin firmware against its snapshot");
@@ -858,7 +859,7 @@ fn cmd_test(bless: bool) -> Outcome {
     step("QEMU: the core's tests on the emulated Cortex-M4F");
     firmware::on_target_tests(&tc, &root)?;
     step("QEMU: cost, footprint and stack budgets");
-    bench::check(&elfs, &twin_runs)?;
+    bench::check(&elfs, &twin_runs, &monitor)?;
     step("QEMU: the profile runner on the Cortex-M4F (instructions per function, docs/profile.md)");
     profile::cmd(&tc, &root, None, &[firmware::M4], 5)?;
     eprintln!("\nxtask: all checks passed");

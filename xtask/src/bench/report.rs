@@ -20,12 +20,25 @@ pub fn budget_table(fw: &Firmware, budget: &Budget) -> String {
     let mut t = String::new();
     let _ = writeln!(t, "| what | measured | goal |\n| --- | --- | --- |");
     for e in &budget.estimator {
+        let built = match (&fw.monitor, e.monitor) {
+            (Some(m), true) => format!(", as built for {}", m.params),
+            _ => String::new(),
+        };
         let _ = writeln!(
             t,
-            "| {}, Cortex-M4F f32 (step and ramps) | mean {:.0}, worst {:.0} instructions | <= {BUDGET_INSTRUCTIONS:.0} |",
+            "| {}{built}, Cortex-M4F f32 (step and ramps) | mean {:.0}, worst {:.0} instructions | <= {BUDGET_INSTRUCTIONS:.0} |",
             e.what(),
             e.mean,
             e.worst
+        );
+    }
+    if let Some(m) = &fw.monitor {
+        let piece = |name: &str| m.costs.piece(name).unwrap_or(f64::NAN);
+        let _ = writeln!(
+            t,
+            "| the monitor's update alone (one reading: filter, tests, isolation), Cortex-M4F f32 | mean {:.0}, worst {:.0} instructions | measured (in a job's place) |",
+            piece("monitor-update-mean"),
+            piece("monitor-update-worst")
         );
     }
     let twin = &budget.twin;
