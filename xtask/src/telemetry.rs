@@ -308,24 +308,19 @@ mod tests {
     }
 
     /// `e` with a health estimate, as the monitor publishes it.
-    fn monitored(e: StateEstimate) -> StateEstimate {
-        StateEstimate {
-            health: compensator::monitor::HealthEstimate {
-                divider: 1.0123,
-                sd_divider: 0.0456,
-                spring: 1.0,
-                sd_spring: 0.05,
-                offset: -12.345678,
-                sd_offset: 250.5,
-                friction: 0.0,
-                predicted: 1.9e5,
-                innovation: 0.4,
-                cusum: 2.25,
-                rejected: 3,
-                flags: Flags::empty(),
-            },
-            ..e
-        }
+    fn monitored(mut e: StateEstimate) -> StateEstimate {
+        // Field by field: a parameter the monitor adds keeps its NONE.
+        let h = &mut e.health;
+        h.divider = 1.0123;
+        h.sd_divider = 0.0456;
+        h.spring = 1.0;
+        h.sd_spring = 0.05;
+        h.offset = -12.345678;
+        h.sd_offset = 250.5;
+        h.friction = 0.0;
+        h.cusum = 2.25;
+        h.rejected = 3;
+        e
     }
 
     /// The bits of a record's values (NaN equal to itself), its flags.
