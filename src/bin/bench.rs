@@ -289,17 +289,23 @@ fn second_reading(e: &compensator::estimator::StateEstimate, fault: f32) -> f32 
 /// `monitor-update-worst`): 400 readings at the closed-form equilibrium
 /// over a 4 K warming, the second half moved by a tenth of the pressure
 /// drop (or of the stroke), so that the change is detected, fitted over
-/// the span by every hypothesis and named: every path of the update.
+/// the span by every hypothesis and named: every path of the update. The
+/// probe reads with every reading (the worst case: each update tests),
+/// through its lag (backward Euler of its time constant).
 #[cfg(feature = "monitor")]
 fn monitor_pieces(params: &Params<f32>) -> Result<(), &'static str> {
-    use compensator::monitor::{Monitor, PlantView, Quantity};
+    use compensator::monitor::{Monitor, PlantView, ProbeSample, Quantity};
     use core::hint::black_box;
     let settings = MONITOR.ok_or("the monitor's bench without a second sensor")?;
     let mut monitor = Monitor::new(params, settings).map_err(|_| "monitor settings")?;
     let n = 400u32;
+    let dt = settings.sample_period;
+    let lag = dt / (settings.probe.time_constant + dt);
+    let mut probe = 40.0f32;
     let (mut total, mut worst) = (0u32, 0u32);
     for k in 0..n {
         let t = 40.0 + 0.01 * k as f32;
+        probe += lag * (t - probe);
         let point = params.oil.point(t).map_err(|_| "fluid point")?;
         let eq = compensator::equilibrium::equilibrium(params, t).map_err(|_| "equilibrium")?;
         let view = PlantView {
@@ -307,7 +313,8 @@ fn monitor_pieces(params: &Params<f32>) -> Result<(), &'static str> {
             x: eq.x,
             p_a: eq.p_a,
             p_b: eq.p_b,
-            var_t: 1e-4,
+            dt: if k == 0 { 0.0 } else { dt },
+            probe: Some(ProbeSample { value: probe, age: 0.0 }),
         };
         let y = match settings.quantity {
             Quantity::ChamberA => eq.p_a,

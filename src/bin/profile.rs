@@ -87,7 +87,7 @@ fn run() -> Result<(), &'static str> {
 
     #[cfg(feature = "monitor")]
     {
-        use compensator::monitor::{Monitor, PlantView, Quantity};
+        use compensator::monitor::{Monitor, PlantView, ProbeSample, Quantity};
         let settings = MONITOR.ok_or("the monitor's image without a second sensor")?;
         let mut monitor = Monitor::new(&params, settings).map_err(|_| "monitor settings")?;
         let n = 400u32;
@@ -109,7 +109,8 @@ fn run() -> Result<(), &'static str> {
                 x: eq.x,
                 p_a: eq.p_a,
                 p_b: eq.p_b,
-                var_t: 1e-4,
+                dt: settings.sample_period,
+                probe: None,
             };
             *v = Some((view, y));
         }
@@ -118,11 +119,17 @@ fn run() -> Result<(), &'static str> {
         } else {
             0.1 * params.pressure_drop
         };
+        // The probe reads with every reading, through its lag (backward
+        // Euler of its time constant), as the bench's monitor pieces.
+        let lag = settings.sample_period / (settings.probe.time_constant + settings.sample_period);
+        let mut probe = 40.0f32;
         profile_mark(3);
         for k in 0..n {
-            let Some((view, y)) = views[(k / 50) as usize % 8] else {
+            let Some((mut view, y)) = views[(k / 50) as usize % 8] else {
                 return Err("a view");
             };
+            probe += lag * (view.oil.state.temperature - probe);
+            view.probe = Some(ProbeSample { value: probe, age: 0.0 });
             let y = if k >= n / 2 { y + step } else { y };
             profile_tick();
             core::hint::black_box(monitor.update(&params, core::hint::black_box(&view), Ok::<f32, ()>(y)));

@@ -513,6 +513,13 @@ fn wide_device_file(root: &Path) -> Result<PathBuf, String> {
 /// bench's budget for the RTD device).
 const TWIN_STACK_BUDGET: u64 = 6 << 10;
 
+/// The same for the twin built with the condition monitor: the estimator
+/// carries the monitor's state (the probe's lag of 11 signals through two
+/// stages, the 5-state health filter, a reading's pending stages), which
+/// start-up builds on its frames before it moves in: 6,240 bytes measured
+/// for `presets/paper-monitor.toml`, of the STM32F405's 128 KiB \[bytes\].
+const TWIN_MONITOR_STACK_BUDGET: u64 = 7 << 10;
+
 /// The soak image built for the NTC preset (`presets/paper-ntc.toml`: the
 /// NTC on the STM32F4's ADC, simulated at register level), run on QEMU: it
 /// exits 0 (no check violated; the host soak of `host-tests/tests/soak.rs`
@@ -545,7 +552,8 @@ fn ntc_soak(tc: &toolchain::Toolchain, root: &Path, timeout: Duration) -> Result
 }
 
 /// The twin built for a preset, run on QEMU: its self-checks pass, its
-/// peak stack is within [`TWIN_STACK_BUDGET`], its output matches its
+/// peak stack is within [`TWIN_STACK_BUDGET`] ([`TWIN_MONITOR_STACK_BUDGET`]
+/// for the `monitor` label), its output matches its
 /// snapshot (`tests/snapshots/<snapshot>.log`; `bless` rewrites it) when
 /// it has one, and its telemetry is the host replica's, row by row;
 /// nothing reachable from its tick paths, nor from the board image's built
@@ -592,10 +600,13 @@ fn preset_twin(
                 .ok()
         })
         .ok_or(format!("the {label} twin reported no peak stack"))?;
-    if stack > TWIN_STACK_BUDGET {
-        return Err(format!(
-            "the {label} twin's peak stack {stack} bytes exceeds {TWIN_STACK_BUDGET}"
-        ));
+    let budget = if label == "monitor" {
+        TWIN_MONITOR_STACK_BUDGET
+    } else {
+        TWIN_STACK_BUDGET
+    };
+    if stack > budget {
+        return Err(format!("the {label} twin's peak stack {stack} bytes exceeds {budget}"));
     }
     if let Some((name, bless)) = snapshot {
         let shown: Vec<String> = run.lines.iter().map(|l| telemetry::humanize(l)).collect();
