@@ -49,8 +49,16 @@
 //!    the lag's memory. A Kalman filter of the health parameters
 //!    ([`filter`]: the divider `theta_A = ln(A / A_file)`, the spring
 //!    `theta_k = ln(c / c_file)`, the reading's offset `delta`, the probe's
-//!    `beta`, each a slow random walk) updates with it; a change of the
-//!    parameters moves the lagged temperature by the lagged Jacobian. An
+//!    `beta`, each a slow random walk, and the twin's error) updates with
+//!    it; a change of the parameters moves the lagged temperature by the
+//!    lagged Jacobian. The second sensor's noise through the lag is a state
+//!    of the filter too, not a white noise: the lag remembers it for its
+//!    time constant, and a probe whose time constant is comparable with the
+//!    readings' period (a bare fast probe) passes as much of it as its own
+//!    noise, correlated from one probe reading to the next ([`filter`],
+//!    "The lag's noise"); taken as white it made the innovations of such a
+//!    probe correlated (lag-1 0.17-0.30 at 0.01-0.05 s) and their variance
+//!    wrong, and the CUSUM raised `DEVICE_CHANGED` on healthy devices. An
 //!    innovation beyond [`GATE`] standard deviations is counted
 //!    ([`HealthEstimate::rejected`]), not applied; with more than
 //!    [`MAX_UNINFORMED`] of the lag's memory uninformed there is no test.
@@ -64,9 +72,15 @@
 //!    other's by [`ISOLATION_MARGIN`] in log-likelihood, over at least
 //!    [`ISOLATION_SPAN`] of oil temperature, is named (its flag latches),
 //!    its parameter moves by the fitted size and its variance reopens, and
-//!    watching resumes. While a change is detected and not yet isolated
-//!    the filter is frozen, so that it does not absorb the change it is
-//!    trying to name.
+//!    watching resumes. While a change is detected and not yet isolated,
+//!    or a CUSUM run is past a quarter of the threshold, the health
+//!    parameters are held, so that the filter does not absorb the change it
+//!    is trying to name; the lag's noise still follows the readings (a
+//!    zero-mean state that forgets within the probe's time constant cannot
+//!    absorb a change), or a held filter would make the innovations of a
+//!    fast probe correlated just when a run has started. The model error
+//!    decorrelates with the twin's oil temperature's travel through a play
+//!    of [`TRAVEL_PLAY`], so that the observer's noise is no travel.
 //!
 //! The second sensor's own faults (`crate::sensor::SensorFault`) skip its
 //! reading and raise `SECOND_SENSOR_FAULT`; the lag then runs on the
@@ -101,6 +115,7 @@ use crate::estimator::{Flags, clamp};
 use crate::fluid::FluidPoint;
 use crate::params::Params;
 use crate::scalar::Real;
+use filter::{Measured, NOISE, STATES};
 use lag::{Decay, Lag};
 use signature::{DIVIDER, MODEL, OFFSET, PARAMETERS, PROBE, SPRING, exp, play};
 
@@ -112,9 +127,10 @@ pub const GATE: f32 = 6.0;
 /// Drift `k` of the CUSUM, in innovation standard deviations: it detects
 /// a shift of the innovation's mean by `2 k` fastest (Page 1954). The
 /// innovations of healthy devices are close to white unit normal (over
-/// the campaign's seeded histories: mean 0.00, variance 0.91-0.96, lag-1
-/// correlation under 0.06 in magnitude, none beyond 5 standard deviations;
-/// `cargo run --release -p host-tests --example monitor_innovations`), so
+/// the campaign's seeded histories: mean 0.00, variance 0.97, lag-1
+/// correlation under 0.03 in magnitude, none beyond 5 standard deviations;
+/// `cargo run --release -p host-tests --example monitor_innovations`; and
+/// for probes from 0.01 s to 20 s, `tests/monitor_fast_probe.rs`), so
 /// the drift need not cover a bias of the model.
 pub const CUSUM_DRIFT: f32 = 1.0;
 
@@ -208,6 +224,21 @@ pub const MODEL_ACCURACY: f32 = 1e-3;
 /// Oil temperature travel \[K\] over which the twin's error decorrelates
 /// (the model-error state is Gauss-Markov in the temperature).
 pub const MODEL_CORRELATION: f32 = 5.0;
+
+/// The share of the probe lag's memory from its start at rest below which
+/// the lag's noise is updated alone while the tests hold the parameters.
+/// The start at rest puts the first reading's whole noise into the lag,
+/// the filter takes it apart from the parameters only as they converge
+/// from their priors, and an update of the noise alone while the two are
+/// entangled moves the prediction along what the parameters would have
+/// undone (a slow probe keeps that start for seconds).
+pub const REST_FORGOTTEN: f32 = 0.01;
+
+/// Half width \[K\] of the play through which the twin's oil temperature
+/// counts as travel for the model error's decorrelation: the observer's
+/// noise (with a fast probe, its readings' noise passes through) is not
+/// the oil's travel.
+pub const TRAVEL_PLAY: f32 = 0.25;
 
 /// The friction the sticking test is designed for, as a fraction of the
 /// spring's force at mid-stroke (`F = f c (x0 + x_max / 2)`): the play
@@ -421,8 +452,8 @@ const SIGNALS: usize = UNINFORMED + 1;
 
 /// The condition monitor (see the module docs). `f32`; one reading costs
 /// two exponentials and a square root (three more of each while a change
-/// is being isolated), the lag of 11 signals, and at a probe reading a
-/// 4-state filter update.
+/// is being isolated), the lag of 11 signals, the lag's noise state's
+/// step, and at a probe reading a 6-state filter update.
 #[derive(Clone, Copy, Debug)]
 pub struct Monitor {
     design: Design,
@@ -433,9 +464,18 @@ pub struct Monitor {
     /// The probe's lag of the signals, and its decay for the last step.
     lag: Lag<SIGNALS>,
     decay: Decay,
-    /// The variance the second sensor's noise leaves in the lagged
-    /// temperature \[K^2\].
-    lag_variance: f32,
+    /// The variance of the second sensor's temperature's noise at the
+    /// last reading \[K^2\] (0: uninformed), which drives the lag's noise
+    /// at the next step ([`filter`]).
+    last_fresh: f32,
+    /// The last update, if at the last reading: its Jacobian, measurement
+    /// noise variance, residual after the update, and the share `c` of the
+    /// reading's noise in it; its measurement noise drives the lag's noise
+    /// at the next step.
+    pending: Option<(Measured, f32)>,
+    /// The share of the probe lag's memory still from its start at rest
+    /// (`p^k` after `k` steps).
+    rest_share: f32,
     /// The first reading has set the lag at rest.
     started: bool,
     /// The play band's half width of an isolated sticking fault \[m\].
@@ -470,7 +510,8 @@ pub struct Monitor {
     reference: [f32; PARAMETERS],
     /// The model-error state's stationary standard deviation \[Pa or m\].
     sd_model: f32,
-    /// The twin's oil temperature at the last reading \[C\].
+    /// The twin's oil temperature at the last reading through the play of
+    /// [`TRAVEL_PLAY`] \[C\].
     last_oil: f32,
 }
 
@@ -532,7 +573,9 @@ impl Monitor {
             filter,
             lag: Lag::at_rest([0.0; SIGNALS]),
             decay: Decay::new(&settings.probe, settings.sample_period),
-            lag_variance: 0.0,
+            last_fresh: 0.0,
+            pending: None,
+            rest_share: 1.0,
             started: false,
             friction_width: 0.0,
             held: f32::NAN,
@@ -689,6 +732,12 @@ impl Monitor {
             if !u[OIL].is_finite() {
                 return self.publish(estimate, flags, t_twin);
             }
+            // The lag at rest holds all of this reading's noise, `x_0 = n_0`:
+            // its Markov part is `e_0 = (1 - c) n_0` ([`filter`]).
+            let fresh = if informed { sd_t * sd_t } else { 0.0 };
+            let c = 0.5 * (1.0 - self.decay.probe);
+            self.filter.restart_noise((1.0 - c) * (1.0 - c) * fresh);
+            self.last_fresh = fresh;
             self.lag = Lag::at_rest(u);
             self.started = true;
         } else if view.dt > 0.0 && view.dt.is_finite() {
@@ -696,17 +745,38 @@ impl Monitor {
                 self.decay = Decay::new(&self.settings.probe, view.dt);
             }
             self.lag.step(&u, &self.decay);
+            // The lag's noise: `e_k = p e_(k-1) + c (1 + p) n_(k-1)`.
             let p = self.decay.probe;
-            let fresh = if informed { sd_t * sd_t } else { 0.0 };
-            self.lag_variance = p * p * self.lag_variance + (1.0 - p) * (1.0 - p) * fresh;
-            self.filter.predict(view.dt * (1.0 / 3600.0));
-            let travel = libm::fabsf(t_twin - self.last_oil);
-            if travel > 0.0 {
-                let phi = exp(-travel * (1.0 / MODEL_CORRELATION));
-                self.filter.decay(MODEL, phi, self.sd_model * self.sd_model);
+            let drive = 0.5 * (1.0 - p) * (1.0 + p);
+            let q = drive * drive * self.last_fresh;
+            self.rest_share *= p;
+            match self.pending.take() {
+                // The last update's measurement noise held `-c n_(k-1)`.
+                Some((last, c)) => {
+                    let m = -drive * c * self.last_fresh;
+                    self.filter.fade_correlated(NOISE, p, q, m, &last);
+                }
+                None => self.filter.fade(NOISE, p, q),
             }
+            self.last_fresh = if informed { sd_t * sd_t } else { 0.0 };
+            self.filter.predict(view.dt * (1.0 / 3600.0));
         }
-        self.last_oil = t_twin;
+        // The model error decorrelates with the oil's travel; the twin's
+        // oil temperature moves through a play, so that the observer's
+        // noise (all of a fast probe's readings' noise) is no travel.
+        let held = if self.last_oil.is_finite() {
+            clamp(self.last_oil, t_twin - TRAVEL_PLAY, t_twin + TRAVEL_PLAY)
+        } else {
+            t_twin
+        };
+        let travel = libm::fabsf(held - self.last_oil);
+        if travel > 0.0 && self.started {
+            let phi = exp(-travel * (1.0 / MODEL_CORRELATION));
+            self.filter.decay(MODEL, phi, self.sd_model * self.sd_model);
+        }
+        if held.is_finite() {
+            self.last_oil = held;
+        }
         if let Some(sample) = view.probe {
             self.test(sample, t_twin, &mut estimate, &mut flags);
         }
@@ -767,16 +837,22 @@ impl Monitor {
         // probe's error), by far more than the tolerance's slope suggests.
         let tolerance = probe.tolerance_at(t_oil);
         let theta = self.filter.theta();
-        let nu = sample.value - t_probe - theta[PROBE] * tolerance;
-        let mut h = [tolerance; PARAMETERS];
+        // The lag's noise estimated so far enters as `-e` ([`filter`]).
+        let nu = sample.value - t_probe - theta[PROBE] * tolerance + self.filter.noise();
+        let mut h = [tolerance; STATES];
         for (k, h) in h.iter_mut().enumerate().take(OFFSET + 1) {
             *h = self.lag.probe(D_THETA + k);
         }
         // The model error moves the reading as the offset does.
         h[MODEL] = h[OFFSET];
+        h[NOISE] = -1.0;
+        // The probe's noise, this reading's share of the lag's noise
+        // (`c n_k`), the uninformed share's error.
         let spread = uninformed * UNINFORMED_ERROR;
-        let r = probe.reading_sd * probe.reading_sd + self.lag_variance + spread * spread;
+        let c = 0.5 * (1.0 - self.decay.probe);
+        let r = probe.reading_sd * probe.reading_sd + c * c * self.last_fresh + spread * spread;
         let s = self.filter.innovation_variance(&h) + r;
+        self.pending = None;
         let z = nu / <f32 as Real>::sqrt(s);
         if !z.is_finite() {
             return;
@@ -785,7 +861,7 @@ impl Monitor {
         self.innovation = z;
         if self.settling > 0 {
             self.settling -= 1;
-            self.learn(&h, nu, s);
+            self.learn(&h, nu, s, r);
             return;
         }
         // Detection: the two-sided CUSUM; a run starting from zero starts
@@ -818,6 +894,13 @@ impl Monitor {
         if self.cusum[0] > CUSUM_THRESHOLD || self.cusum[1] > CUSUM_THRESHOLD {
             self.detected = true;
         }
+        let suspicious = self.cusum[0] > 0.25 * CUSUM_THRESHOLD || self.cusum[1] > 0.25 * CUSUM_THRESHOLD;
+        if z * z <= GATE * GATE && (self.detected || suspicious) && self.rest_share < REST_FORGOTTEN {
+            // The parameters are held; the lag's noise follows the reading.
+            let residual = self.filter.update_noise(&h, nu, s);
+            let c = 0.5 * (1.0 - self.decay.probe);
+            self.pending = Some((Measured { h, r, residual }, c));
+        }
         if self.detected {
             flags.insert(Flags::DEVICE_CHANGED);
             if let Some(h) = self.isolated() {
@@ -828,18 +911,21 @@ impl Monitor {
         } else if z * z > GATE * GATE {
             self.rejected = self.rejected.saturating_add(1);
             flags.insert(Flags::INNOVATION_REJECTED);
-        } else if !(self.cusum[0] > 0.25 * CUSUM_THRESHOLD || self.cusum[1] > 0.25 * CUSUM_THRESHOLD) {
+        } else if !suspicious {
             // A suspicious run holds the filter: it must not learn the
             // change before the tests have named it.
-            self.learn(&h, nu, s);
+            self.learn(&h, nu, s, r);
         }
     }
 
     /// The filter's update; the lagged temperature follows the parameters'
     /// change through the lagged Jacobian (as if the new parameters had
     /// read every past reading).
-    fn learn(&mut self, h: &[f32; PARAMETERS], nu: f32, s: f32) {
+    fn learn(&mut self, h: &[f32; STATES], nu: f32, s: f32, r: f32) {
         let change = self.filter.update(h, nu, s);
+        let c = 0.5 * (1.0 - self.decay.probe);
+        let residual = nu * r / s;
+        self.pending = Some((Measured { h: *h, r, residual }, c));
         for (k, c) in change.iter().enumerate().take(OFFSET + 1) {
             self.lag.add_scaled(OIL, D_THETA + k, *c);
         }
