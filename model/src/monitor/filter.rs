@@ -325,4 +325,70 @@ mod tests {
             assert!((got - want).abs() < 1e-3, "{:?}", f.theta());
         }
     }
+
+    /// The second sensor's white noise through the midpoint lag, read by
+    /// the probe every second step: with the lag's noise as a state (its
+    /// correlated step after each update), the innovations are white and
+    /// of unit variance for a lag as fast as the readings.
+    #[test]
+    fn the_lags_noise_leaves_white_innovations() {
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut normal = || {
+            let mut u = || {
+                seed ^= seed << 13;
+                seed ^= seed >> 7;
+                seed ^= seed << 17;
+                ((seed >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+            };
+            let (a, b) = (u(), u());
+            (libm::sqrt(-2.0 * libm::log(a)) * libm::cos(2.0 * core::f64::consts::PI * b)) as f32
+        };
+        for p in [0.37f32, 0.82, 0.98] {
+            let (sigma, r) = (1.0f32, 0.05f32);
+            let c = 0.5 * (1.0 - p);
+            let drive = c * (1.0 + p);
+            let mut f = HealthFilter::new([1e-3; PARAMETERS], [0.0; PARAMETERS]);
+            f.restart_noise((1.0 - c) * (1.0 - c) * sigma * sigma);
+            let mut n_prev = sigma * normal();
+            let mut x = n_prev;
+            let mut pending: Option<Measured> = None;
+            let (mut s1, mut s2, mut lag1, mut last, mut count) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0u32);
+            for k in 1..40_000 {
+                let n = sigma * normal();
+                x = p * x + c * (n + n_prev);
+                n_prev = n;
+                let q = drive * drive * sigma * sigma;
+                match pending.take() {
+                    Some(m) => f.fade_correlated(NOISE, p, q, -drive * c * sigma * sigma, &m),
+                    None => f.fade(NOISE, p, q),
+                }
+                if k % 2 == 0 {
+                    let mut h = [0.0; STATES];
+                    h[NOISE] = -1.0;
+                    let rr = r * r + c * c * sigma * sigma;
+                    let nu = -x + r * normal() + f.noise();
+                    let s = f.innovation_variance(&h) + rr;
+                    let z = f64::from(nu / s.sqrt());
+                    f.update(&h, nu, s);
+                    pending = Some(Measured {
+                        h,
+                        r: rr,
+                        residual: nu * rr / s,
+                    });
+                    s1 += z;
+                    s2 += z * z;
+                    lag1 += z * last;
+                    last = z;
+                    count += 1;
+                }
+            }
+            let n = f64::from(count);
+            let var = s2 / n - (s1 / n) * (s1 / n);
+            let corr = lag1 / s2;
+            assert!(
+                (var - 1.0).abs() < 0.05 && corr.abs() < 0.03,
+                "p {p}: variance {var}, lag-1 {corr}"
+            );
+        }
+    }
 }
