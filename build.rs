@@ -17,7 +17,9 @@
 //!    writes `$OUT_DIR/params.rs` (`compensator_codegen::params_rs`: the
 //!    constants and the twin's configuration chosen for the design). A
 //!    refused file fails the build with one line naming the field
-//!    (`cargo::error`, no backtrace).
+//!    (`cargo::error`, no backtrace). The firmware's `monitor` feature
+//!    is required exactly when the file names the condition monitor's
+//!    second sensor (`monitor.sensor`), and refused otherwise.
 //! 3. For the QEMU images only (feature `qemu`): the twin's replay adapted
 //!    to the device's ranges, with the bounds it checks itself against
 //!    (`$OUT_DIR/replay.rs`, and its schedule as text in
@@ -128,6 +130,25 @@ fn main() {
     };
     for w in &generated.warnings {
         println!("cargo::warning=parameter file {}: {w}", params.display());
+    }
+    // The monitor is built in exactly when the file names its second
+    // sensor: an image without one keeps its flash and its ticks, and an
+    // image with one never ignores it.
+    let monitor = env::var_os("CARGO_FEATURE_MONITOR").is_some();
+    if raw.monitor.has_sensor() && !monitor {
+        println!(
+            "cargo::error=parameter file {}: monitor.sensor names a second sensor: build with the firmware's `monitor` feature (cargo xtask adds it; with cargo, --features {},monitor)",
+            params.display(),
+            if board { "board" } else { "qemu" }
+        );
+        return;
+    }
+    if monitor && !raw.monitor.has_sensor() {
+        println!(
+            "cargo::error=parameter file {}: the firmware's `monitor` feature needs a second sensor, and monitor.sensor is \"none\"",
+            params.display()
+        );
+        return;
     }
     fs::write(out.join("params.rs"), generated.code).expect("write params.rs");
     // The sensor the file chose: the images compile its driver alone.

@@ -8,7 +8,9 @@
 //! * [`params_rs`]: the parameter set as constants (`RAW_PARAMS`, by field
 //!   name) and the twin's configuration for the design, chosen from its
 //!   own dynamics (`compensator::dynamics::config::choose`), so that the
-//!   cost per tick is decided before anything is flashed.
+//!   cost per tick is decided before anything is flashed; with a second
+//!   sensor, its transducer's and the condition monitor's settings
+//!   ([`monitor_settings`]).
 //! * [`replay`]: the QEMU twin's replay schedule adapted to the device's
 //!   ranges ([`replay::adapt`]), its text form for the host-side replica
 //!   ([`replay::Schedule`]), and (feature `replay`) the bounds the twin
@@ -22,6 +24,8 @@
 
 pub mod replay;
 
+use compensator::monitor::{MonitorSettings, ProbeModel};
+use compensator::sensor::transducer;
 use compensator_params::{Field, Named, RawCore, RawEstimator, RawMachine, RawMonitor, RawParams, RawProbe};
 
 /// The generated `params.rs` and what the build should say about it.
@@ -29,7 +33,7 @@ use compensator_params::{Field, Named, RawCore, RawEstimator, RawMachine, RawMon
 pub struct ParamsRs {
     /// The Rust source: `RAW_PARAMS`, `OBSERVER`, `OBSERVER_WITHOUT_LAG`,
     /// `UNCERTAINTY`, `PARAMS_SOURCE`, `TWIN_SCHEME`, `TWIN_SUBSTEPS`,
-    /// `TWIN_ESTIMATED_ERROR_PCT`.
+    /// `TWIN_ESTIMATED_ERROR_PCT`, `MONITOR_TRANSDUCER`, `MONITOR`.
     pub code: String,
     /// Warnings for the build (the twin's accuracy target not met).
     pub warnings: Vec<String>,
@@ -90,6 +94,81 @@ pub fn rust_literal(debug: &str) -> String {
     out
 }
 
+/// The condition monitor's settings for the file's second sensor, from
+/// its transducer's: the noise of one reading with the ADC's quantisation
+/// (`lsb^2 / 12`), the accuracy class as a uniform limit (GUM 4.3.7), the
+/// reading period. `None` without a sensor.
+///
+/// The monitor's settings are the core's own conversion of the file
+/// ([`MonitorSettings::of_transducer`] with the file's probe,
+/// [`ProbeModel::new`]), the one the CLI and the FMU use.
+///
+/// # Errors
+///
+/// The section's validation or the transducer's settings refuse a field
+/// (the message names it).
+pub fn monitor_settings(raw: &RawParams) -> Result<Option<(transducer::Settings, MonitorSettings)>, String> {
+    let Some(t) = compensator::sensor::device::monitor_settings(raw).map_err(|e| e.to_string())? else {
+        return Ok(None);
+    };
+    let settings = MonitorSettings::of_transducer(&t, ProbeModel::new(raw));
+    Ok(Some((t, settings)))
+}
+
+/// `MONITOR_TRANSDUCER` and `MONITOR`, the second sensor's driver
+/// settings and the monitor's, as Rust constants (`None` without one).
+fn monitor_rs(raw: &RawParams) -> Result<String, String> {
+    let (transducer, monitor) = match monitor_settings(raw)? {
+        Some((t, m)) => {
+            let output = match t.output {
+                transducer::Output::Ratiometric { divider } => format!("Ratiometric {{ divider: {divider:?} }}"),
+                transducer::Output::Current { shunt } => format!("Current {{ shunt: {shunt:?} }}"),
+            };
+            let t = format!(
+                "Some(::compensator::sensor::transducer::Settings {{ \
+                 quantity: ::compensator::sensor::transducer::Quantity::{:?}, \
+                 output: ::compensator::sensor::transducer::Output::{output}, range: ({:?}, {:?}), \
+                 noise: {:?}, accuracy: {:?}, bits: {}, reference: {:?}, period: {:?}, stuck_after: {}, \
+                 noise_limit: {:?} }})",
+                t.quantity,
+                t.range.0,
+                t.range.1,
+                t.noise,
+                t.accuracy,
+                t.bits,
+                t.reference,
+                t.period,
+                t.stuck_after,
+                t.noise_limit
+            );
+            let m = format!(
+                "Some(::compensator::monitor::MonitorSettings {{ \
+                 quantity: ::compensator::monitor::Quantity::{:?}, sd_noise: {:?}, sd_accuracy: {:?}, \
+                 sample_period: {:?}, probe: ::compensator::monitor::ProbeModel {{ time_constant: {:?}, \
+                 well_time_constant: {:?}, reading_sd: {:?}, tolerance_a: {:?}, tolerance_b: {:?} }} }})",
+                m.quantity,
+                m.sd_noise,
+                m.sd_accuracy,
+                m.sample_period,
+                m.probe.time_constant,
+                m.probe.well_time_constant,
+                m.probe.reading_sd,
+                m.probe.tolerance_a,
+                m.probe.tolerance_b
+            );
+            (rust_literal(&t), rust_literal(&m))
+        }
+        None => ("None".to_string(), "None".to_string()),
+    };
+    Ok(format!(
+        "/// The condition monitor's second sensor, its transducer's settings\n\
+         /// (`None`: the file names none; the images then build no monitor).\n\
+         pub const MONITOR_TRANSDUCER: Option<::compensator::sensor::transducer::Settings> = {transducer};\n\
+         /// The condition monitor's settings for that sensor.\n\
+         pub const MONITOR: Option<::compensator::monitor::MonitorSettings> = {monitor};\n"
+    ))
+}
+
 /// The firmware's constants for the validated parameter set `raw`, read
 /// from `path` (shown in the generated comment) named `source` (its file
 /// name, what the firmware prints).
@@ -134,6 +213,7 @@ pub fn params_rs(raw: &RawParams, path: &str, source: &str) -> Result<ParamsRs, 
     let observer = rust_literal(&format!("{:?}", config.observer));
     let direct = rust_literal(&format!("{direct:?}"));
     let uncertainty = rust_literal(&format!("{:?}", config.uncertainty));
+    let monitor_consts = monitor_rs(raw)?;
     let code = format!(
         "// Generated by build.rs (compensator-codegen) from {path}\n\
          /// The parameter set the firmware was built with (validated at build time;\n\
@@ -160,7 +240,8 @@ pub fn params_rs(raw: &RawParams, path: &str, source: &str) -> Result<ParamsRs, 
          /// file from its own dynamics (`compensator::dynamics::config::choose`).\n\
          pub const TWIN_SUBSTEPS: u8 = {};\n\
          /// The chooser's estimate of the twin's error [% of a step].\n\
-         pub const TWIN_ESTIMATED_ERROR_PCT: f32 = {:?};\n",
+         pub const TWIN_ESTIMATED_ERROR_PCT: f32 = {:?};\n\
+         {monitor_consts}",
         choice.config.scheme.name(),
         choice.config.substeps,
         choice.estimated_error_pct as f32,
@@ -198,6 +279,47 @@ mod tests {
         ));
         assert!(g.code.contains("hold: ::compensator::estimator::ModeGains {"));
         assert!(g.code.contains("pub static UNCERTAINTY: ::compensator::uncertainty::UncertaintyTable = ::compensator::uncertainty::UncertaintyTable {"));
+    }
+
+    #[test]
+    fn a_second_sensor_gives_the_monitors_constants() {
+        assert!(
+            params_rs(&paper(), "p", "p")
+                .unwrap()
+                .code
+                .contains("pub const MONITOR: Option<::compensator::monitor::MonitorSettings> = None;")
+        );
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../presets/paper-monitor.toml");
+        let raw = compensator_params::file::load(std::path::Path::new(path)).unwrap();
+        let (t, m) = monitor_settings(&raw).unwrap().unwrap();
+        // 0.5-4.5 V through 0.66 into 3.3 V at 12 bits: 4 V x 0.66 / 3.3 V
+        // of 4096 codes span 5e5 Pa, 152.6 Pa a code; 100 Pa of noise with
+        // the code's lsb^2 / 12; class 0.1 % of 5e5 Pa as a uniform limit.
+        let lsb = 5e5 / (4.0 * 0.66 / 3.3 * 4096.0);
+        assert!((f64::from(t.units_per_code()) / lsb - 1.0).abs() < 1e-6);
+        let sd = (100.0f64 * 100.0 + lsb * lsb / 12.0).sqrt();
+        assert!((f64::from(m.sd_noise) / sd - 1.0).abs() < 1e-6, "{}", m.sd_noise);
+        assert!((f64::from(m.sd_accuracy) / (500.0 / 3f64.sqrt()) - 1.0).abs() < 1e-6);
+        assert_eq!(m.sample_period, 0.01);
+        assert_eq!(m.quantity, compensator::monitor::Quantity::ChamberA);
+        // The probe the monitor tests the device with is the file's.
+        assert_eq!(m.probe, ProbeModel::new(&raw));
+        assert_eq!(m.probe.time_constant, 6.0);
+        let code = params_rs(&raw, path, "paper-monitor.toml").unwrap().code;
+        assert!(code.contains(&format!(
+            "pub const MONITOR: Option<::compensator::monitor::MonitorSettings> = Some(::compensator::monitor::MonitorSettings {{ quantity: ::compensator::monitor::Quantity::ChamberA, sd_noise: {:?},",
+            m.sd_noise
+        )));
+        assert!(code.contains(&format!(
+            "probe: ::compensator::monitor::ProbeModel {{ time_constant: 6.0, well_time_constant: {:?}, reading_sd: {:?},",
+            m.probe.well_time_constant, m.probe.reading_sd
+        )));
+        assert!(code.contains("output: ::compensator::sensor::transducer::Output::Ratiometric { divider: 0.66 }"));
+        // A refused section fails the build naming its field.
+        let mut bad = raw;
+        bad.monitor.range_max = 1e5;
+        let e = params_rs(&bad, path, "x").unwrap_err();
+        assert!(e.contains("monitor.range_max"), "{e}");
     }
 
     #[test]

@@ -7,6 +7,15 @@
 //! The faults the replay injects are the shared table of
 //! `compensator_testbench::faults`; their times are the template's, the
 //! temperatures are adapted.
+//!
+//! A device file that names the condition monitor's second sensor gets
+//! its readings too ([`MonitorTrack`]): the true device's reading at the
+//! oil's temperature, healthy and with its capillary restricted
+//! ([`RESTRICTION`]), tabulated by the independent reference; the replay
+//! ends with [`MONITOR_TAIL`], whose first hold restricts the capillary
+//! half-way through and whose ramp lets the monitor name the fault; and
+//! the transducer's loop opens for [`OPEN_LOOP_SECONDS`] in the middle of
+//! the [`OPEN_LOOP_HOLD`]-th hold.
 
 use compensator_params::{RawEstimator, RawParams};
 use compensator_testbench::faults::{FAULTS, Injected};
@@ -27,6 +36,35 @@ pub const LEVELS: [f64; 10] = [
     // window closed), then warming back onto the closed stop.
     80.0, 10.0, 30.0, 30.0,
 ];
+
+/// Levels a replay with the condition monitor's second sensor adds after
+/// [`LEVELS`] (at the transition rate, each held): the capillary is
+/// restricted half-way through the first hold, and the move to the second
+/// spans the temperature the monitor's isolation needs
+/// (`compensator::monitor::ISOLATION_SPAN`, 1 K).
+pub const MONITOR_TAIL: [f64; 2] = [40.0, 50.0];
+
+/// The capillary's conductance after its restriction, a fraction of the
+/// file's (the goal's 20 % restriction: `laminar_throttle.diameter` x
+/// 0.8^(1/4)).
+pub const RESTRICTION: f64 = 0.8;
+
+/// The hold (0-based, in time order) in whose middle the transducer's loop
+/// opens: the 60 C hold of the template.
+pub const OPEN_LOOP_HOLD: usize = 3;
+
+/// How long the transducer's loop stays open \[s\].
+pub const OPEN_LOOP_SECONDS: f64 = 1.0;
+
+/// The truth table's first spacing \[C\], halved until linear
+/// interpolation between its rows is within [`TRUTH_TOLERANCE`] of the
+/// sensor's noise at every midpoint.
+pub const TRUTH_STEP: f64 = 0.5;
+
+/// The truth table's interpolation error allowed, in the second sensor's
+/// noise standard deviations (`monitor.noise`; its span's 1e-4 when the
+/// file gives none).
+pub const TRUTH_TOLERANCE: f64 = 0.05;
 
 /// The warm-up's rate [C/s].
 pub const WARM_UP_RATE: f64 = 0.5;
@@ -106,6 +144,24 @@ pub struct Schedule<T = f64> {
     pub pieces: Vec<(T, T, T, T)>,
     /// What the injected spike adds to the temperature \[C\].
     pub spike: T,
+    /// The second sensor's readings, for a device file that names one.
+    pub monitor: Option<MonitorTrack<T>>,
+}
+
+/// What the condition monitor's second sensor reads in the replay.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MonitorTrack<T = f64> {
+    /// From this time on \[s\] the device's capillary is restricted to
+    /// [`RESTRICTION`] of its conductance.
+    pub restricted_from: T,
+    /// The transducer's loop is open (a NAMUR fault low) over (from s,
+    /// to s).
+    pub open_loop: (T, T),
+    /// The true device's reading \[Pa or m\] at oil temperatures over the
+    /// replay's: (t C, healthy, restricted), evenly spaced, from the
+    /// independent reference's equilibrium, each value rounded to `f32`
+    /// (filled with the `replay` feature; empty without it).
+    pub truth: Vec<(T, T, T)>,
 }
 
 impl Schedule<f64> {
@@ -129,6 +185,13 @@ impl<T: Copy + Default + core::fmt::Debug + core::str::FromStr> Schedule<T> {
             s += &format!("piece {a:?} {b:?} {c:?} {d:?}\n");
         }
         s += &format!("spike_delta {:?}\n", self.spike);
+        if let Some(m) = &self.monitor {
+            s += &format!("monitor_restricted_from {:?}\n", m.restricted_from);
+            s += &format!("monitor_open_loop {:?} {:?}\n", m.open_loop.0, m.open_loop.1);
+            for (t, a, b) in &m.truth {
+                s += &format!("monitor_truth {t:?} {a:?} {b:?}\n");
+            }
+        }
         s
     }
 
@@ -141,7 +204,9 @@ impl<T: Copy + Default + core::fmt::Debug + core::str::FromStr> Schedule<T> {
         let mut s = Schedule {
             pieces: vec![],
             spike: T::default(),
+            monitor: None,
         };
+
         for line in text.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty()) {
             let w: Vec<&str> = line.split_whitespace().collect();
             let num = |i: usize| -> Result<T, String> {
@@ -152,6 +217,18 @@ impl<T: Copy + Default + core::fmt::Debug + core::str::FromStr> Schedule<T> {
             match w.first().copied() {
                 Some("piece") => s.pieces.push((num(1)?, num(2)?, num(3)?, num(4)?)),
                 Some("spike_delta") => s.spike = num(1)?,
+                Some("monitor_restricted_from") => {
+                    let v = num(1)?;
+                    monitor_of(&mut s).restricted_from = v;
+                }
+                Some("monitor_open_loop") => {
+                    let v = (num(1)?, num(2)?);
+                    monitor_of(&mut s).open_loop = v;
+                }
+                Some("monitor_truth") => {
+                    let v = (num(1)?, num(2)?, num(3)?);
+                    monitor_of(&mut s).truth.push(v);
+                }
                 _ => return Err(format!("replay schedule: {line}")),
             }
         }
@@ -160,6 +237,15 @@ impl<T: Copy + Default + core::fmt::Debug + core::str::FromStr> Schedule<T> {
         }
         Ok(s)
     }
+}
+
+/// The schedule's monitor track, started empty by its first line.
+fn monitor_of<T: Copy + Default>(s: &mut Schedule<T>) -> &mut MonitorTrack<T> {
+    s.monitor.get_or_insert_with(|| MonitorTrack {
+        restricted_from: T::default(),
+        open_loop: (T::default(), T::default()),
+        truth: vec![],
+    })
 }
 
 /// The replay as run for one device.
@@ -212,7 +298,11 @@ pub fn adapt(raw: &RawParams) -> Replay {
             est.max_oil_rate
         ));
     }
+    let monitored = raw.monitor.has_sensor();
     let mut levels: Vec<f64> = LEVELS.iter().map(|&t| clamp(t)).collect();
+    if monitored {
+        levels.extend(MONITOR_TAIL.iter().map(|&t| clamp(t)));
+    }
     let outside = |t: f64| !(valid_lo..=valid_hi).contains(&t);
     if !levels.iter().any(|&t| outside(t)) {
         let above = oil_hi - valid_hi;
@@ -236,7 +326,36 @@ pub fn adapt(raw: &RawParams) -> Replay {
         .iter()
         .find(|p| is_hold(p) && outside(p.3))
         .map(|p| (p.0 + (OUT_OF_RANGE_LAGS * lag).min(0.5 * (p.1 - p.0)), p.1));
-    let mut schedule = Schedule { pieces, spike: 0.0 };
+    let monitor = if monitored {
+        let holds: Vec<&(f64, f64, f64, f64)> = pieces.iter().filter(|p| is_hold(p)).collect();
+        let tail = holds.len().saturating_sub(MONITOR_TAIL.len());
+        let restricted_from = holds.get(tail).map_or(0.0, |h| 0.5 * (h.0 + h.1));
+        let open = holds.get(OPEN_LOOP_HOLD).map_or(0.0, |h| 0.5 * (h.0 + h.1));
+        Some(MonitorTrack {
+            restricted_from,
+            open_loop: (open, open + OPEN_LOOP_SECONDS),
+            truth: vec![],
+        })
+    } else {
+        None
+    };
+    let mut schedule = Schedule {
+        pieces,
+        spike: 0.0,
+        monitor,
+    };
+    #[cfg(feature = "replay")]
+    if let Some(m) = schedule.monitor.as_mut() {
+        let (lo, hi) = schedule
+            .pieces
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p.2).min(p.3), hi.max(p.2).max(p.3))
+            });
+        let (truth, note) = monitor_truth(raw, lo, hi);
+        m.truth = truth;
+        notes.extend(note);
+    }
     // The spike: out of the gate's band (more than spike_threshold away),
     // inside the oil range (else it is a sensor fault, not a spike).
     let at = FAULTS
@@ -278,6 +397,72 @@ pub fn half_code(est: &RawEstimator, t: f64) -> f64 {
         0.5 * est.resolution(t)
     } else {
         (est.rtd_reference / 65536.0) / est.rtd_slope(t)
+    }
+}
+
+/// The second sensor's true reading \[Pa or m\] of the file's device at
+/// `t` \[C\], healthy and with its capillary restricted to [`RESTRICTION`]
+/// of its conductance (the bore by its fourth root), from the independent
+/// reference's equilibrium.
+#[cfg(feature = "replay")]
+pub fn monitor_reading(raw: &RawParams, t: f64) -> (f64, f64) {
+    let mut restricted = raw.core;
+    restricted.laminar_diameter *= RESTRICTION.powf(0.25);
+    use compensator::sensor::transducer::Quantity;
+    let quantity = Quantity::of(raw.monitor.sensor);
+    let reading = |core: &compensator_params::RawCore| {
+        let e = compensator_reference::statics::equilibrium(core, t);
+        match quantity {
+            Some(Quantity::PressureB) => e.p_b,
+            Some(Quantity::PressureDifference) => e.p_b - e.p_a,
+            Some(Quantity::Displacement) => e.x,
+            Some(Quantity::PressureA) | None => e.p_a,
+        }
+    };
+    (reading(&raw.core), reading(&restricted))
+}
+
+/// The truth table of [`MonitorTrack::truth`] over `lo..=hi` \[C\]: rows
+/// [`TRUTH_STEP`] apart, halved until linear interpolation is within
+/// [`TRUTH_TOLERANCE`] of the noise at every midpoint (at most 1/64 C);
+/// and a note if even that is not enough.
+#[cfg(feature = "replay")]
+pub fn monitor_truth(raw: &RawParams, lo: f64, hi: f64) -> (Vec<(f64, f64, f64)>, Option<String>) {
+    let m = &raw.monitor;
+    let tolerance = TRUTH_TOLERANCE * if m.noise > 0.0 { m.noise } else { 1e-4 * m.span() };
+    let mut step = TRUTH_STEP;
+    loop {
+        let n = ((hi - lo) / step).ceil().max(1.0) as usize;
+        // Rounded to f32 where they are made: the twin's constants (f32
+        // literals) and the replica's text (read as f32) hold the same
+        // values, with no second rounding.
+        let f = |v: f64| f64::from(v as f32);
+        let rows: Vec<(f64, f64, f64)> = (0..=n)
+            .map(|i| {
+                let t = lo + i as f64 * step;
+                let (a, b) = monitor_reading(raw, t);
+                (f(t), f(a), f(b))
+            })
+            .collect();
+        let worst = rows
+            .windows(2)
+            .map(|w| {
+                let (a, b) = monitor_reading(raw, 0.5 * (w[0].0 + w[1].0));
+                (a - 0.5 * (w[0].1 + w[1].1))
+                    .abs()
+                    .max((b - 0.5 * (w[0].2 + w[1].2)).abs())
+            })
+            .fold(0.0, f64::max);
+        if worst <= tolerance {
+            return (rows, None);
+        }
+        if step <= 1.0 / 64.0 {
+            let note = format!(
+                "the second sensor's truth table interpolates within {worst:.3e}, beyond {TRUTH_TOLERANCE} of its noise"
+            );
+            return (rows, Some(note));
+        }
+        step *= 0.5;
     }
 }
 
@@ -365,6 +550,26 @@ impl Replay {
             );
         }
         s += "];\n";
+        if let Some(m) = &self.schedule.monitor {
+            s += "/// The condition monitor's second sensor: from this time on [s] the\n";
+            s += "/// device's capillary is restricted to MONITOR_RESTRICTION of its\n";
+            s += "/// conductance.\n";
+            s += &format!("const MONITOR_RESTRICTED_FROM: f32 = {:?};\n", m.restricted_from);
+            s += "/// The restricted capillary's conductance, a fraction of the file's.\n";
+            s += &format!("const MONITOR_RESTRICTION: f32 = {RESTRICTION:?};\n");
+            s += "/// The transducer's loop is open over (from s, to s).\n";
+            s += &format!(
+                "const MONITOR_OPEN_LOOP: (f32, f32) = ({:?}, {:?});\n",
+                m.open_loop.0, m.open_loop.1
+            );
+            s += "/// The true device's reading [Pa or m] from the f64 reference: (oil C,\n";
+            s += "/// healthy, restricted), evenly spaced.\n";
+            s += &format!("const MONITOR_TRUTH: [(f32, f32, f32); {}] = [\n", m.truth.len());
+            for &(t, a, b) in &m.truth {
+                s += &format!("    ({:?}, {:?}, {:?}),\n", t as f32, a as f32, b as f32);
+            }
+            s += "];\n";
+        }
         s
     }
 }

@@ -90,3 +90,71 @@ fn a_healthy_device_raises_nothing() {
     assert_eq!(run(Quantity::ChamberA, |_| {}), None);
     assert_eq!(run(Quantity::Displacement, |_| {}), None);
 }
+
+/// The monitor's stages run one per call (`begin`, then `advance` until it
+/// returns the estimate) give `update`'s estimates bit for bit: the
+/// estimator spreads a reading over its job ticks without changing what
+/// the monitor computes.
+#[test]
+fn the_staged_update_is_the_update() {
+    use compensator::monitor::{HealthEstimate, Monitor, PlantView, ProbeSample};
+    let raw = compensator_cli::load(&repo_root().join("presets/paper-monitor.toml")).unwrap();
+    let p = Params::<f32>::new(&raw).unwrap();
+    let settings = MonitorSettings::from_raw(&raw).unwrap().expect("a second sensor");
+    let mut whole = Monitor::new(&p, settings).unwrap();
+    let mut staged = whole;
+    let mut bad = raw.core;
+    bad.laminar_diameter *= 0.8f64.powf(0.25);
+    let mut rng = Rng::new(11);
+    let bits = |e: &HealthEstimate| {
+        [
+            e.divider,
+            e.sd_divider,
+            e.spring,
+            e.offset,
+            e.sd_offset,
+            e.probe_bias,
+            e.oil,
+            e.predicted,
+            e.innovation,
+            e.cusum,
+        ]
+        .map(f32::to_bits)
+    };
+    let (mut probe, mut named) = (60.0f64, false);
+    for k in 0..6000u32 {
+        let t = f64::from(k) * 0.01;
+        let temp = if t < 20.0 { 60.0 } else { 60.0 - 0.1 * (t - 20.0) };
+        probe += (temp - probe) * 0.01 / (6.0 + 0.01);
+        let core = if t >= 20.0 { &bad } else { &raw.core };
+        let pt = equilibrium(&raw.core, temp);
+        let view = PlantView {
+            oil: p.oil.point(temp as f32).unwrap(),
+            x: pt.x as f32,
+            p_a: pt.p_a as f32,
+            p_b: pt.p_b as f32,
+            dt: if k == 0 { 0.0 } else { 0.01 },
+            probe: k.is_multiple_of(2).then_some(ProbeSample {
+                value: probe as f32,
+                age: 0.0,
+            }),
+        };
+        let y = equilibrium(core, temp).p_a + 100.0 * (rng.unit() - 0.5) * 12f64.sqrt();
+        let want = whole.update(&p, &view, Ok::<f32, ()>(y as f32));
+        staged.begin(&p, &view, Ok::<f32, ()>(y as f32));
+        let mut got = None;
+        for _ in 0..3 {
+            got = staged.advance();
+            if got.is_some() {
+                break;
+            }
+        }
+        let got = got.expect("done within three stages");
+        assert!(!staged.pending());
+        assert_eq!(bits(&got), bits(&want), "reading {k}");
+        assert_eq!(got.flags, want.flags, "reading {k}");
+        named |= got.flags.contains(Flags::CAPILLARY_RESTRICTED);
+    }
+    // The run took every stage: the change was watched and named.
+    assert!(named, "the restriction is named");
+}

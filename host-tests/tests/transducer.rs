@@ -266,7 +266,9 @@ fn upper_gamma_q(a: f64, x: f64) -> f64 {
 
 #[test]
 fn the_noise_limit_is_the_chi_square_quantile_of_1e9() {
-    let dof = f64::from(NOISE_WINDOW - 1);
+    // The window's residuals about its least-squares parabola: three
+    // degrees of freedom fewer than its codes.
+    let dof = f64::from(NOISE_WINDOW - 3);
     let q = upper_gamma_q(dof / 2.0, f64::from(NOISE_CHI2) / 2.0);
     assert!((q / 1.0e-9 - 1.0).abs() < 1e-3, "{q}");
     // The check's limit: K (sigma_c + 0.5)^2.
@@ -274,6 +276,96 @@ fn the_noise_limit_is_the_chi_square_quantile_of_1e9() {
     let sigma = f64::from(100.0 / s.units_per_code());
     let limit = f64::from(NOISE_CHI2) / dof * (sigma + 0.5).powi(2);
     assert!((f64::from(s.noise_limit) / limit - 1.0).abs() < 1e-5);
+}
+
+/// The residual variance about the least-squares parabola of `codes`,
+/// fitted in `f64` by the normal equations on `x = i - (n - 1) / 2`
+/// (solved by Cramer's rule: the reference for the driver's integer sums).
+fn residual_variance(codes: &[u16]) -> f64 {
+    let n = codes.len();
+    let x = |i: usize| i as f64 - (n as f64 - 1.0) / 2.0;
+    let (mut m, mut b) = ([[0.0f64; 3]; 3], [0.0f64; 3]);
+    for (i, &c) in codes.iter().enumerate() {
+        let p = [1.0, x(i), x(i) * x(i)];
+        for r in 0..3 {
+            b[r] += p[r] * f64::from(c);
+            for k in 0..3 {
+                m[r][k] += p[r] * p[k];
+            }
+        }
+    }
+    let det = |a: &[[f64; 3]; 3]| {
+        a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+            + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
+    };
+    let d = det(&m);
+    let coef: Vec<f64> = (0..3)
+        .map(|k| {
+            let mut a = m;
+            for r in 0..3 {
+                a[r][k] = b[r];
+            }
+            det(&a) / d
+        })
+        .collect();
+    let rss: f64 = codes
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| (f64::from(c) - coef[0] - coef[1] * x(i) - coef[2] * x(i) * x(i)).powi(2))
+        .sum();
+    rss / (n as f64 - 3.0)
+}
+
+#[test]
+fn the_noise_check_is_the_residual_variance_about_the_windows_parabola() {
+    let s = pressure(RATIOMETRIC);
+    // Windows of random codes, ramps, bends and noise against the f64 fit.
+    let mut rng = host_tests::random::Rng::new(3);
+    for case in 0..200 {
+        let slope = rng.unit() * 40.0 - 20.0;
+        let bend = rng.unit() * 1.0 - 0.5;
+        let noise = rng.unit() * if case % 2 == 0 { 3.0 } else { 300.0 };
+        let codes: Vec<u16> = (0..NOISE_WINDOW)
+            .map(|i| {
+                let i = f64::from(i);
+                let v = 2048.0 + slope * i + bend * (i - 32.0).powi(2) + noise * (rng.unit() - 0.5);
+                v.round().clamp(0.0, 4095.0) as u16
+            })
+            .collect();
+        let mut checks = transducer::Checks::new(&s);
+        for &c in &codes {
+            let _ = checks.update(c);
+        }
+        let got = f64::from(checks.last_variance().expect("a complete window"));
+        let want = residual_variance(&codes);
+        assert!(
+            (got - want).abs() <= 1e-5 * want.max(1.0),
+            "case {case}: {got} against {want}"
+        );
+    }
+}
+
+#[test]
+fn a_healthy_sensor_through_a_ramp_is_not_noisy() {
+    // The paper preset's p_a through a 1 C/s move at 27 C: 8.4 kPa/s, 84
+    // Pa (0.55 codes) a reading at 100 Hz, 35 codes a window: the plain
+    // sample variance of a window would be 35^2 / 12 = 102 codes^2, thirty
+    // times the limit; a bend into and out of the move, about a line, 6.
+    // Thirty holds at 4e5 Pa, each followed by such a ramp down to 1.5e5
+    // Pa, then a hold there, the bends at every phase of the window.
+    for output in [RATIOMETRIC, CURRENT] {
+        let s = pressure(output);
+        assert!(s.noise_limit < 4.0, "{}", s.noise_limit);
+        for seed in 0..30 {
+            let mut drv = transducer::simulated(s, 4.0e5, seed);
+            let hold = 100 + 2 * seed as u32;
+            for k in 0..hold + 2976 + 200 {
+                let ramp = k.saturating_sub(hold).min(2976);
+                drv.device_mut().registers_mut().reading = 4.0e5 - 84.0 * ramp as f32;
+                assert_eq!(drv.read().err(), None, "{output:?}, ramp {seed}, reading {k}");
+            }
+        }
+    }
 }
 
 // ---------------------------------------------------------------------

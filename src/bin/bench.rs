@@ -19,6 +19,12 @@
 //! the whole estimator tick (mean and worst, with and without telemetry)
 //! with its twin in `f32` and in Q12.20. On the Cortex-M4F also the twin
 //! through ramps across the opening (releases and impacts).
+//!
+//! Built for a device file with the condition monitor's second sensor
+//! (feature `monitor`), the Cortex-M4F's `f32` estimator also runs its
+//! workloads with the monitor (`monitor=true`: a reading every
+//! `1 / monitor.sample_hz` in a job's place), and the monitor's update
+//! alone is measured (`monitor-update-*`).
 #![no_std]
 #![no_main]
 
@@ -259,6 +265,79 @@ fn pieces(params: &Params<f32>) -> Result<(), &'static str> {
     }
     info!("[measure] piece name=estimator-reseat-tick total={=u32}", worst);
 
+    #[cfg(feature = "monitor")]
+    monitor_pieces(params)?;
+    Ok(())
+}
+
+/// The reading the monitor's sensor gives of estimate `e` (the twin's own:
+/// a device as the file's), moved by `fault` \[Pa or m\].
+#[cfg(feature = "monitor")]
+fn second_reading(e: &compensator::estimator::StateEstimate, fault: f32) -> f32 {
+    use compensator::monitor::Quantity;
+    let settings = MONITOR.map_or(Quantity::ChamberA, |m| m.quantity);
+    fault
+        + match settings {
+            Quantity::ChamberA => e.p_a,
+            Quantity::ChamberB => e.p_b,
+            Quantity::Difference => e.p_b - e.p_a,
+            Quantity::Displacement => e.x,
+        }
+}
+
+/// The monitor's update alone, per reading (`monitor-update-mean`,
+/// `monitor-update-worst`): 400 readings at the closed-form equilibrium
+/// over a 4 K warming, the second half moved by a tenth of the pressure
+/// drop (or of the stroke), so that the change is detected, fitted over
+/// the span by every hypothesis and named: every path of the update. The
+/// probe reads with every reading (the worst case: each update tests),
+/// through its lag (backward Euler of its time constant).
+#[cfg(feature = "monitor")]
+fn monitor_pieces(params: &Params<f32>) -> Result<(), &'static str> {
+    use compensator::monitor::{Monitor, PlantView, ProbeSample, Quantity};
+    use core::hint::black_box;
+    let settings = MONITOR.ok_or("the monitor's bench without a second sensor")?;
+    let mut monitor = Monitor::new(params, settings).map_err(|_| "monitor settings")?;
+    let n = 400u32;
+    let dt = settings.sample_period;
+    let lag = dt / (settings.probe.time_constant + dt);
+    let mut probe = 40.0f32;
+    let (mut total, mut worst) = (0u32, 0u32);
+    for k in 0..n {
+        let t = 40.0 + 0.01 * k as f32;
+        probe += lag * (t - probe);
+        let point = params.oil.point(t).map_err(|_| "fluid point")?;
+        let eq = compensator::equilibrium::equilibrium(params, t).map_err(|_| "equilibrium")?;
+        let view = PlantView {
+            oil: point,
+            x: eq.x,
+            p_a: eq.p_a,
+            p_b: eq.p_b,
+            dt: if k == 0 { 0.0 } else { dt },
+            probe: Some(ProbeSample { value: probe, age: 0.0 }),
+        };
+        let y = match settings.quantity {
+            Quantity::ChamberA => eq.p_a,
+            Quantity::ChamberB => eq.p_b,
+            Quantity::Difference => eq.p_b - eq.p_a,
+            Quantity::Displacement => eq.x,
+        };
+        let step = if settings.quantity == Quantity::Displacement {
+            0.1 * params.plunger.stroke
+        } else {
+            0.1 * params.pressure_drop
+        };
+        let y = if k >= n / 2 { y + step } else { y };
+        let (h, c) = counts(|| monitor.update(params, black_box(&view), black_box(Ok::<f32, ()>(y))));
+        black_box(h);
+        total += c;
+        worst = worst.max(c);
+    }
+    info!(
+        "[measure] piece name=monitor-update-mean calls={=u32} total={=u32}",
+        n, total
+    );
+    info!("[measure] piece name=monitor-update-worst total={=u32}", worst);
     Ok(())
 }
 
@@ -304,6 +383,83 @@ fn estimator_cost<T: Real>(params: &Params<f32>, scalar: &str) -> Result<(), &'s
             }
             info!(
                 "[measure] estimator workload={=str} scheme={=str} substeps={=u8} scalar={=str} telemetry={=bool} ticks={=u32} total={=u32} worst={=u32} worst_tick={=u32}",
+                workload,
+                config.twin.scheme.name(),
+                config.twin.substeps,
+                scalar,
+                telemetry,
+                n,
+                total,
+                worst,
+                worst_tick
+            );
+        }
+    }
+    Ok(())
+}
+
+/// [`estimator_cost`] with the condition monitor (the image built for a
+/// second sensor), its twin in `f32`: the monitor fitted, a reading of its
+/// sensor offered every `1 / monitor.sample_hz` (the twin's own reading of
+/// the last estimate, moved by a tenth of the pressure drop, or of the
+/// stroke, over the workload's second half: the change detected, fitted
+/// and named), the offer counted in the tick (the board makes it in its
+/// tick path); the lines marked `monitor=true`.
+#[cfg(feature = "monitor")]
+fn estimator_cost_monitor(params: &Params<f32>, scalar: &str) -> Result<(), &'static str> {
+    use compensator::estimator::{Estimator, EstimatorConfig};
+    use core::hint::black_box;
+    let settings = MONITOR.ok_or("the monitor's bench without a second sensor")?;
+    let mut config = EstimatorConfig::from_parts(&RAW_PARAMS.estimator, &OBSERVER, &UNCERTAINTY)
+        .map_err(|_| "estimator settings")?;
+    compensator_firmware::use_built_twin(&mut config, TWIN_SCHEME, TWIN_SUBSTEPS)?;
+    let second_every = config.ticks_per(settings.sample_period);
+    let step = if settings.quantity == compensator::monitor::Quantity::Displacement {
+        0.1 * params.plunger.stroke
+    } else {
+        0.1 * params.pressure_drop
+    };
+    for (workload, n) in [("step", 1000u32), ("ramps", 10_000u32)] {
+        for telemetry in [true, false] {
+            let mut config = config;
+            config.telemetry_every = if telemetry { 100 } else { 0 };
+            let start = if workload == "step" { 30.0 } else { 26.0 };
+            let mut est = Estimator::new(params, config, start)
+                .map_err(|_| "estimator cannot start")?
+                .with_monitor(settings)
+                .map_err(|_| "monitor settings")?;
+            let mut last = est.tick(Ok(None));
+            let (mut total, mut worst, mut worst_tick) = (0u32, 0u32, 0u32);
+            for k in 0..n {
+                let temperature = if workload == "step" {
+                    40.0f32
+                } else {
+                    let s = k as f32 * 1e-3;
+                    26.0 + 4.0 * if s < 5.0 { s } else { 10.0 - s }
+                };
+                let sample = if k % 20 == 0 { Ok(Some(temperature)) } else { Ok(None) };
+                let second = k
+                    .is_multiple_of(second_every)
+                    .then(|| second_reading(&last, if k >= n / 2 { step } else { 0.0 }));
+                let (e, c) = counts(|| {
+                    if let Some(y) = second {
+                        est.offer_second(Ok(black_box(y)));
+                    }
+                    let e = est.tick(black_box(sample));
+                    if est.telemetry_due() {
+                        info!("estimate {}", e);
+                    }
+                    e
+                });
+                last = e;
+                total += c;
+                if c > worst {
+                    worst = c;
+                    worst_tick = k;
+                }
+            }
+            info!(
+                "[measure] estimator workload={=str} scheme={=str} substeps={=u8} scalar={=str} monitor=true telemetry={=bool} ticks={=u32} total={=u32} worst={=u32} worst_tick={=u32}",
                 workload,
                 config.twin.scheme.name(),
                 config.twin.substeps,
@@ -495,6 +651,10 @@ fn main() -> ! {
         pieces(&params)?;
         estimator_cost::<f32>(&params, f32_name)?;
         estimator_cost::<Fixed>(&params, "q12.20")?;
+        // With the monitor: the Cortex-M4F's f32 estimator, whose budget
+        // it shares.
+        #[cfg(all(feature = "monitor", target_abi = "eabihf"))]
+        estimator_cost_monitor(&params, f32_name)?;
         Ok(())
     };
     match run() {

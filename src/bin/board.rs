@@ -25,6 +25,16 @@
 //! (`compensator::sensor::ntc::RegisterAdc`: SWSTART, a bounded EOC poll,
 //! DR), since the HAL's `convert` waits for EOC without a bound.
 //!
+//! The condition monitor's second sensor (feature `monitor`: the device
+//! file's `[monitor]` names one; `build.rs` requires the feature then): a
+//! pressure or displacement transducer into PA2 (ADC2_IN2; ratiometric
+//! through its divider, or 4-20 mA across its shunt), read through the
+//! transducer driver (`compensator::sensor::transducer`: NAMUR NE 43 fault
+//! levels, stuck and noise checks) over the same register driver as the
+//! NTC, on ADC2 (so that an NTC on ADC1 keeps its channel), every
+//! `1 / monitor.sample_hz` and offered to the estimator, whose monitor
+//! takes it in a job's place.
+//!
 //! Deadlines: a tick that starts after the next one was due is counted,
 //! flagged `DEADLINE_MISSED` and caught up (`Estimator::tick_after`). The
 //! independent watchdog (frozen under the debugger) resets a loop that
@@ -59,7 +69,9 @@ use compensator::sensor::device::sample_period;
 #[cfg(not(sensor_ntc))]
 use compensator::sensor::max31865::{Max31865, Settings};
 #[cfg(sensor_ntc)]
-use compensator::sensor::ntc::{self, AdcRegisters, Ntc, RegisterAdc, reg};
+use compensator::sensor::ntc::{self, Ntc};
+#[cfg(any(sensor_ntc, feature = "monitor"))]
+use compensator::sensor::ntc::{AdcRegisters, RegisterAdc, reg};
 use compensator_firmware::clock::TickClock;
 use compensator_firmware::deadline::TickPace;
 use core::sync::atomic::{AtomicU32, Ordering};
@@ -228,6 +240,37 @@ fn main() -> ! {
         core::mem::forget(adc);
         Ntc::new(RegisterAdc::new(Adc1, settings.bits), settings)
     };
+    // The condition monitor's transducer on PA2, ADC2. The HAL's
+    // `Adc::new` takes ADC1 only (its VREFINT calibration), and its reset
+    // is every ADC's: ADC2 is clocked and set up here at register level
+    // (RM0090 section 13.13), then driven by the register driver.
+    #[cfg(feature = "monitor")]
+    let mut second = {
+        use compensator::sensor::transducer::Transducer;
+        use stm32f4xx_hal::rcc::Enable;
+        let Some(settings) = MONITOR_TRANSDUCER else {
+            defmt::panic!("monitor.sensor: the monitor's image without a second sensor");
+        };
+        let _pa2 = gpioa.pa2.into_analog();
+        pac::ADC2::enable(&mut rcc);
+        // SAFETY: raw register values, each a valid setting: ADC_CCR
+        // ADCPRE = 01 (ADCCLK = PCLK2 / 4 = 21 MHz, at most 36 MHz:
+        // DS8626), the ADCs' common prescaler (ADC1's too, the same); SMPR2
+        // SMP2 = 100 (84 cycles of sampling, 4 us at the pin: the
+        // divider's or the shunt's source); SQR1 L = 0 (one conversion);
+        // SQR3 SQ1 = 2 (channel 2, PA2).
+        unsafe {
+            dp.ADC_COMMON
+                .ccr()
+                .modify(|r, w| w.bits((r.bits() & !(0b11 << 16)) | (0b01 << 16)));
+            dp.ADC2
+                .smpr2()
+                .modify(|r, w| w.bits((r.bits() & !(0b111 << 6)) | (0b100 << 6)));
+            dp.ADC2.sqr1().write(|w| w.bits(0));
+            dp.ADC2.sqr3().write(|w| w.bits(2));
+        }
+        Transducer::new(RegisterAdc::new(Adc2, settings.bits), settings)
+    };
 
     // The start-up fault-detection cycle, then the first good sample starts
     // the estimator at its equilibrium (a reading every conversion period,
@@ -253,9 +296,35 @@ fn main() -> ! {
             config.valid.min
         }
     };
+    #[cfg_attr(
+        feature = "monitor",
+        allow(unused_mut, reason = "the monitor's image moves it into its own")
+    )]
     let mut estimator = match Estimator::new(&params, config, start) {
         Ok(e) => e,
         Err(e) => defmt::panic!("estimator: {}", e),
+    };
+    #[cfg(feature = "monitor")]
+    let (mut estimator, second_every) = {
+        let Some(settings) = MONITOR else {
+            defmt::panic!("monitor.sensor: the monitor's image without a second sensor");
+        };
+        let estimator = match estimator.with_monitor(settings) {
+            Ok(e) => e,
+            Err(compensator::monitor::MonitorError::NotPositive(field)) => {
+                defmt::panic!("{=str} must be finite and positive", field)
+            }
+        };
+        let s = second.settings();
+        info!(
+            "second sensor: {=str} transducer on PA2 (ADC2_IN2), {=u8} bits, range {=f32}..{=f32}, read every {=f32} ms",
+            s.quantity.name(),
+            s.bits,
+            s.range.0,
+            s.range.1,
+            s.period * 1e3
+        );
+        (estimator, config.ticks_per(s.period))
     };
 
     // SysTick counts 24 bits: at 168 MHz a tick of at most ~99.8 ms.
@@ -319,14 +388,26 @@ fn main() -> ! {
         } else {
             Flags::empty()
         };
-        if tick_path(
+        #[cfg(not(feature = "monitor"))]
+        let published = tick_path(
             &mut sensor,
             &mut estimator,
             now,
             elapsed,
-            now % sensor_every == 0,
+            now.is_multiple_of(sensor_every),
             extra,
-        ) {
+        );
+        #[cfg(feature = "monitor")]
+        let published = tick_path(
+            &mut sensor,
+            &mut second,
+            &mut estimator,
+            now,
+            elapsed,
+            (now.is_multiple_of(sensor_every), now.is_multiple_of(second_every)),
+            extra,
+        );
+        if published {
             first_record = false;
         }
         watchdog.feed();
@@ -340,6 +421,7 @@ fn main() -> ! {
 /// `elapsed`: the tick periods since the last tick (more than one: this
 /// tick is late); `extra`: flags the firmware adds to the record published
 /// (the watchdog's reset on the first). Returns whether a record went out.
+#[cfg(not(feature = "monitor"))]
 #[inline(never)]
 fn tick_path<S: TemperatureSource>(
     sensor: &mut S,
@@ -361,39 +443,78 @@ fn tick_path<S: TemperatureSource>(
     false
 }
 
-/// ADC1's registers (RM0090 section 13.13), as the NTC's register driver
-/// drives them after the HAL set the ADC up.
-#[cfg(sensor_ntc)]
-struct Adc1;
-
-#[cfg(sensor_ntc)]
-impl AdcRegisters for Adc1 {
-    fn read(&mut self, offset: u32) -> u32 {
-        // SAFETY: ADC1's register block, always mapped; the HAL's driver
-        // was forgotten after the set-up, this is its only user.
-        let adc = unsafe { &*pac::ADC1::ptr() };
-        match offset {
-            reg::SR => adc.sr().read().bits(),
-            reg::CR1 => adc.cr1().read().bits(),
-            reg::CR2 => adc.cr2().read().bits(),
-            reg::DR => adc.dr().read().bits(),
-            _ => 0,
-        }
+/// [`tick_path`] with the condition monitor: the second sensor read when
+/// due (`read.1`, the temperature's `read.0`) and offered to the
+/// estimator, whose monitor takes it in a job's place.
+#[cfg(feature = "monitor")]
+#[inline(never)]
+fn tick_path<S: TemperatureSource>(
+    sensor: &mut S,
+    second: &mut compensator::sensor::transducer::Transducer<RegisterAdc<Adc2>>,
+    estimator: &mut compensator_firmware::BuiltEstimator,
+    now: u32,
+    elapsed: u32,
+    read: (bool, bool),
+    extra: Flags,
+) -> bool {
+    let sample = if read.0 { sensor.read() } else { Ok(None) };
+    if read.1 {
+        estimator.offer_second(second.read());
     }
-
-    fn write(&mut self, offset: u32, value: u32) {
-        // SAFETY: as in `read`; every value the driver writes is a valid
-        // setting of these registers (RES, ADON, SWSTART; SR's rc_w0 bits).
-        let adc = unsafe { &*pac::ADC1::ptr() };
-        #[allow(
-            unused_unsafe,
-            reason = "bits() is unsafe on some registers of the PAC, safe on others"
-        )]
-        match offset {
-            reg::SR => adc.sr().write(|w| unsafe { w.bits(value) }),
-            reg::CR1 => adc.cr1().write(|w| unsafe { w.bits(value) }),
-            reg::CR2 => adc.cr2().write(|w| unsafe { w.bits(value) }),
-            _ => return,
-        };
+    let mut estimate = estimator.tick_after(sample, elapsed);
+    if estimator.telemetry_due() {
+        estimate.flags.insert(extra);
+        // The same line as the QEMU twin's: `cargo xtask` decodes it.
+        let ms = clock().map_or(0, |c| c.millis(now));
+        info!("{=u32} ms {}", ms, estimate);
+        return true;
     }
+    false
 }
+
+/// An ADC's registers (RM0090 section 13.13), as the register driver
+/// drives them after the HAL set the ADC up: a unit struct per ADC
+/// (`Adc1` for the NTC, `Adc2` for the monitor's transducer).
+#[cfg(any(sensor_ntc, feature = "monitor"))]
+macro_rules! adc_registers {
+    ($name:ident, $adc:ident) => {
+        #[doc = concat!(stringify!($adc), "'s registers.")]
+        struct $name;
+
+        impl AdcRegisters for $name {
+            fn read(&mut self, offset: u32) -> u32 {
+                // SAFETY: the ADC's register block, always mapped; the HAL's
+                // driver was forgotten after the set-up, this is its only user.
+                let adc = unsafe { &*pac::$adc::ptr() };
+                match offset {
+                    reg::SR => adc.sr().read().bits(),
+                    reg::CR1 => adc.cr1().read().bits(),
+                    reg::CR2 => adc.cr2().read().bits(),
+                    reg::DR => adc.dr().read().bits(),
+                    _ => 0,
+                }
+            }
+
+            fn write(&mut self, offset: u32, value: u32) {
+                // SAFETY: as in `read`; every value the driver writes is a valid
+                // setting of these registers (RES, ADON, SWSTART; SR's rc_w0 bits).
+                let adc = unsafe { &*pac::$adc::ptr() };
+                #[allow(
+                    unused_unsafe,
+                    reason = "bits() is unsafe on some registers of the PAC, safe on others"
+                )]
+                match offset {
+                    reg::SR => adc.sr().write(|w| unsafe { w.bits(value) }),
+                    reg::CR1 => adc.cr1().write(|w| unsafe { w.bits(value) }),
+                    reg::CR2 => adc.cr2().write(|w| unsafe { w.bits(value) }),
+                    _ => return,
+                };
+            }
+        }
+    };
+}
+
+#[cfg(sensor_ntc)]
+adc_registers!(Adc1, ADC1);
+#[cfg(feature = "monitor")]
+adc_registers!(Adc2, ADC2);

@@ -10,7 +10,12 @@
 //!    bench's 30 -> 40 C step after its graded first tick;
 //! 2. `estimator`: the estimator's tick (twin, filter, rotating job,
 //!    consistency check; telemetry packed every 100 ticks) over the
-//!    bench's step workload, 200 ticks.
+//!    bench's step workload, 200 ticks;
+//! 3. with the condition monitor (feature `monitor`: the file names a
+//!    second sensor), `monitor`: its update, one reading a tick, over the
+//!    bench's monitor sequence (400 readings at the closed-form
+//!    equilibrium over a 4 K warming, the second half moved by a tenth of
+//!    the pressure drop or the stroke: detected, fitted, named).
 #![no_std]
 #![no_main]
 
@@ -79,6 +84,60 @@ fn run() -> Result<(), &'static str> {
         }
     }
     profile_mark(2);
+
+    #[cfg(feature = "monitor")]
+    {
+        use compensator::monitor::{Monitor, PlantView, ProbeSample, Quantity};
+        let settings = MONITOR.ok_or("the monitor's image without a second sensor")?;
+        let mut monitor = Monitor::new(&params, settings).map_err(|_| "monitor settings")?;
+        let n = 400u32;
+        // The inputs, outside the readings' ticks: the plant at eight
+        // temperatures 0.5 K apart, each held for 50 readings.
+        let mut views = [None; 8];
+        for (j, v) in views.iter_mut().enumerate() {
+            let t = 40.0 + 0.5 * j as f32;
+            let point = params.oil.point(t).map_err(|_| "fluid point")?;
+            let eq = compensator::equilibrium::equilibrium(&params, t).map_err(|_| "equilibrium")?;
+            let y = match settings.quantity {
+                Quantity::ChamberA => eq.p_a,
+                Quantity::ChamberB => eq.p_b,
+                Quantity::Difference => eq.p_b - eq.p_a,
+                Quantity::Displacement => eq.x,
+            };
+            let view = PlantView {
+                oil: point,
+                x: eq.x,
+                p_a: eq.p_a,
+                p_b: eq.p_b,
+                dt: settings.sample_period,
+                probe: None,
+            };
+            *v = Some((view, y));
+        }
+        let step = if settings.quantity == Quantity::Displacement {
+            0.1 * params.plunger.stroke
+        } else {
+            0.1 * params.pressure_drop
+        };
+        // The probe reads with every reading, through its lag (backward
+        // Euler of its time constant), as the bench's monitor pieces.
+        let lag = settings.sample_period / (settings.probe.time_constant + settings.sample_period);
+        let mut probe = 40.0f32;
+        profile_mark(3);
+        for k in 0..n {
+            let Some((mut view, y)) = views[(k / 50) as usize % 8] else {
+                return Err("a view");
+            };
+            probe += lag * (view.oil.state.temperature - probe);
+            view.probe = Some(ProbeSample { value: probe, age: 0.0 });
+            let y = if k >= n / 2 { y + step } else { y };
+            profile_tick();
+            core::hint::black_box(monitor.update(&params, core::hint::black_box(&view), Ok::<f32, ()>(y)));
+        }
+        // The last reading's tick ends here.
+        profile_tick();
+        profile_mark(3);
+    }
     Ok(())
 }
 

@@ -22,6 +22,20 @@
 //!    followed, not rejected); no NaN; no re-seat of the twin. Reports the
 //!    peak stack measured by stack painting, and exits 0 (all checks pass)
 //!    or 1.
+//!
+//! With the condition monitor (feature `monitor`: the device file names a
+//! second sensor) the replay also reads the true device through the
+//! file's transducer, simulated at register level on the STM32F4 ADC and
+//! read by its real driver (`compensator_testbench::monitor`: the
+//! reference's reading at the oil's temperature), offers each reading to
+//! the estimator, and checks the chain: after the first hold the healthy
+//! device's divider factor is 1 and the sensor's offset 0 within their
+//! bands (the readings reach the monitor in their unit); the transducer's
+//! open loop raises `SECOND_SENSOR_FAULT` then and only then; the health
+//! estimate stays finite. It reports the monitor's verdicts on the
+//! healthy device and on the capillary restricted at the replay's last
+//! levels (the algorithm's, `docs/monitoring.md`; the snapshot keeps
+//! them).
 #![no_std]
 #![no_main]
 
@@ -34,6 +48,8 @@ use compensator::{Params, asymptotic};
 use compensator_firmware::qemu::{CORE, TwinScalar, exit};
 use compensator_firmware::{BuiltConfig, BuiltEstimator};
 use compensator_testbench::faults::{Expected, FAULTS, Injected, fault_at};
+#[cfg(feature = "monitor")]
+use compensator_testbench::monitor::Track;
 use compensator_testbench::probe::SimulatedProbe;
 use cortex_m as _; // links the critical-section implementation defmt needs
 use cortex_m_rt::entry;
@@ -49,6 +65,11 @@ type Sensor = compensator::sensor::simulated::SimulatedRtd;
 /// ... or the NTC on the STM32F4's ADC (`estimator.sensor = "ntc"`).
 #[cfg(sensor_ntc)]
 type Sensor = compensator::sensor::simulated::SimulatedNtc;
+
+/// The condition monitor's second sensor: the file's transducer on the
+/// simulated STM32F4 ADC, read by its driver.
+#[cfg(feature = "monitor")]
+type Second = compensator::sensor::transducer::SimulatedMonitor;
 
 /// The simulated element's fault band \[C\]: wide, so that the
 /// estimator's oil range is what rejects samples.
@@ -224,6 +245,10 @@ fn replay(params: &Params<f32>, config: BuiltConfig) -> bool {
         overflow: 0,
     };
     checks.check(sensor.start().is_ok(), "sensor configuration", 0.0);
+    #[cfg_attr(
+        feature = "monitor",
+        allow(unused_mut, reason = "the monitor's image moves it into its own")
+    )]
     let mut estimator = match Estimator::<TwinScalar, _, _>::with_scalar(params, config, start) {
         Ok(e) => e,
         Err(e) => {
@@ -231,6 +256,40 @@ fn replay(params: &Params<f32>, config: BuiltConfig) -> bool {
             return false;
         }
     };
+    #[cfg(feature = "monitor")]
+    let (mut estimator, mut second, track, second_every) = {
+        let (Some(transducer), Some(settings)) = (MONITOR_TRANSDUCER, MONITOR) else {
+            error!("the monitor's image without a second sensor");
+            return false;
+        };
+        let estimator = match estimator.with_monitor(settings) {
+            Ok(e) => e,
+            Err(compensator::monitor::MonitorError::NotPositive(field)) => {
+                error!("monitor: {=str} must be finite and positive", field);
+                return false;
+            }
+        };
+        let track = Track {
+            truth: &MONITOR_TRUTH,
+            restricted_from: MONITOR_RESTRICTED_FROM,
+            open_loop: MONITOR_OPEN_LOOP,
+        };
+        let second = compensator::sensor::transducer::simulated(
+            transducer,
+            track.reading(0.0, start),
+            compensator_testbench::monitor::SEED,
+        );
+        info!(
+            "second sensor: {=str} transducer on the STM32F4 ADC, {=u8} bits, {=f32} Pa or m a code, read every {=f32} ms",
+            transducer.quantity.name(),
+            transducer.bits,
+            transducer.units_per_code(),
+            transducer.period * 1e3
+        );
+        (estimator, second, track, config.ticks_per(transducer.period))
+    };
+    #[cfg(feature = "monitor")]
+    let mut watch = MonitorWatch::new();
     let end = REPLAY_PIECES[REPLAY_PIECES.len() - 1].1;
     let ticks = (end / tick) as u32;
     let sensor_every = config.ticks_per(sensor.sample_period());
@@ -265,7 +324,21 @@ fn replay(params: &Params<f32>, config: BuiltConfig) -> bool {
         };
         sensor.set_temperature(reading + delta);
         sensor.inject(injected.and_then(Injected::injection));
+        #[cfg(not(feature = "monitor"))]
         let e = tick_path(&mut sensor, &mut estimator, k % sensor_every == 0);
+        #[cfg(feature = "monitor")]
+        let e = {
+            track.drive(&mut second, time, oil);
+            let e = tick_path(
+                &mut sensor,
+                &mut second,
+                &mut estimator,
+                k % sensor_every == 0,
+                k % second_every == 0,
+            );
+            watch.tick(&track, time, &e);
+            e
+        };
         if let Some(i) = fault_now {
             seen[i].insert(e.flags);
         }
@@ -344,6 +417,8 @@ fn replay(params: &Params<f32>, config: BuiltConfig) -> bool {
         OUT_OF_RANGE_HOLD.0,
     );
     checks.check(nan_ticks == 0, "no NaN in any estimate", end);
+    #[cfg(feature = "monitor")]
+    watch.check(&mut checks, &track, end);
     info!("checks: {=u32} passed, {=u32} failed", checks.passed, checks.failures());
     for what in checks.failed.iter() {
         error!("failed: {=str}", what);
@@ -354,10 +429,195 @@ fn replay(params: &Params<f32>, config: BuiltConfig) -> bool {
 /// One controller tick as the board runs it: the sensor read when due
 /// (`read`), then the estimator (filter, twin, job). Not inlined, so that
 /// `cargo xtask test` can check that nothing reachable from it panics.
+#[cfg(not(feature = "monitor"))]
 #[inline(never)]
 fn tick_path(sensor: &mut Sensor, estimator: &mut BuiltEstimator<TwinScalar>, read: bool) -> StateEstimate {
     let sample = if read { sensor.read() } else { Ok(None) };
     estimator.tick(sample)
+}
+
+/// One controller tick with the condition monitor: the sensor read when
+/// due (`read`), the second sensor when due (`read_second`, offered to the
+/// estimator, whose monitor takes it in a job's place), then the
+/// estimator. Not inlined (the panic-free check).
+#[cfg(feature = "monitor")]
+#[inline(never)]
+fn tick_path(
+    sensor: &mut Sensor,
+    second: &mut Second,
+    estimator: &mut BuiltEstimator<TwinScalar>,
+    read: bool,
+    read_second: bool,
+) -> StateEstimate {
+    let sample = if read { sensor.read() } else { Ok(None) };
+    if read_second {
+        estimator.offer_second(second.read());
+    }
+    estimator.tick(sample)
+}
+
+/// The monitor's alarms: a change detected or a fault named.
+#[cfg(feature = "monitor")]
+const ALARMS: Flags = Flags(Flags::DEVICE_CHANGED.0 | compensator::monitor::LATCHED.0);
+
+/// Time after the open loop's end in which its flag may still show \[s\]
+/// (the window's last reading is taken on a later tick).
+#[cfg(feature = "monitor")]
+const OPEN_LOOP_TAIL: f32 = 0.05;
+
+/// What the replay saw of the condition monitor.
+///
+/// Checked: the transducer's chain (readings reach the monitor in their
+/// unit: after the first hold, before any ramp, the healthy device's
+/// divider factor is 1 and the offset 0, each within 1.96 of the filter's
+/// own standard deviation; its open loop raises `SECOND_SENSOR_FAULT`
+/// then and only then; the health estimate stays finite). Reported, for
+/// the snapshot: the monitor's verdicts on the healthy device and on the
+/// restricted capillary, which are its algorithm's (`docs/monitoring.md`).
+#[cfg(feature = "monitor")]
+struct MonitorWatch {
+    /// The health estimate at the end of the first hold.
+    settled: compensator::monitor::HealthEstimate,
+    /// Ticks with a health estimate not finite after the first reading.
+    not_finite: u32,
+    /// Flags seen while the transducer's loop was open.
+    open_flags: Flags,
+    /// Ticks flagged `SECOND_SENSOR_FAULT` outside the open loop, the
+    /// first \[s\].
+    stray_sensor_faults: u32,
+    first_stray: f32,
+    /// Ticks with an alarm while the device was healthy, and the first \[s\].
+    false_alarms: u32,
+    first_false_alarm: f32,
+    /// The alarms raised while the device was healthy.
+    false_flags: Flags,
+    /// After the restriction: when a change was first flagged and a fault
+    /// first named \[s\] (NaN: never), and the faults named.
+    detected: f32,
+    named: f32,
+    named_flags: Flags,
+    /// The health estimate just before the restriction, and at the end.
+    healthy: compensator::monitor::HealthEstimate,
+    last: compensator::monitor::HealthEstimate,
+}
+
+#[cfg(feature = "monitor")]
+impl MonitorWatch {
+    fn new() -> Self {
+        MonitorWatch {
+            settled: compensator::monitor::HealthEstimate::NONE,
+            not_finite: 0,
+            open_flags: Flags::empty(),
+            stray_sensor_faults: 0,
+            first_stray: f32::NAN,
+            false_alarms: 0,
+            first_false_alarm: f32::NAN,
+            false_flags: Flags::empty(),
+            detected: f32::NAN,
+            named: f32::NAN,
+            named_flags: Flags::empty(),
+            healthy: compensator::monitor::HealthEstimate::NONE,
+            last: compensator::monitor::HealthEstimate::NONE,
+        }
+    }
+
+    fn tick(&mut self, track: &Track<'_>, time: f32, e: &StateEstimate) {
+        let h = &e.health;
+        if time < REPLAY_PIECES[0].1 {
+            self.settled = *h;
+        }
+        if time >= 1.0
+            && ![h.divider, h.sd_divider, h.spring, h.offset, h.sd_offset, h.cusum]
+                .iter()
+                .all(|v| v.is_finite())
+        {
+            self.not_finite += 1;
+        }
+        let alarm = Flags(e.flags.0 & ALARMS.0);
+        if !track.restricted(time) {
+            self.healthy = *h;
+            if !alarm.is_empty() {
+                if self.false_alarms == 0 {
+                    self.first_false_alarm = time;
+                }
+                self.false_alarms += 1;
+                self.false_flags.insert(alarm);
+            }
+        } else {
+            if !alarm.is_empty() && self.detected.is_nan() {
+                self.detected = time;
+            }
+            let named = Flags(e.flags.0 & compensator::monitor::LATCHED.0);
+            if !named.is_empty() && self.named.is_nan() {
+                self.named = time;
+            }
+            self.named_flags.insert(named);
+        }
+        if track.open(time) {
+            self.open_flags.insert(e.flags);
+        } else if e.flags.contains(Flags::SECOND_SENSOR_FAULT)
+            && !(time >= track.open_loop.0 && time < track.open_loop.1 + OPEN_LOOP_TAIL)
+        {
+            if self.stray_sensor_faults == 0 {
+                self.first_stray = time;
+            }
+            self.stray_sensor_faults += 1;
+        }
+        self.last = *h;
+    }
+
+    fn check(&self, checks: &mut Checks, track: &Track<'_>, end: f32) {
+        let at = REPLAY_PIECES[0].1;
+        let s = &self.settled;
+        info!(
+            "monitor after the first hold ({=f32} s): divider {=f32} (sd of its log {=f32}), offset {=f32} +- {=f32} (sd), spring {=f32}",
+            at, s.divider, s.sd_divider, s.offset, s.sd_offset, s.spring
+        );
+        checks.check(
+            libm::fabsf(libm::logf(s.divider)) <= BAND * s.sd_divider,
+            "the healthy device's divider factor is 1 within its band",
+            at,
+        );
+        checks.check(
+            libm::fabsf(s.offset) <= BAND * s.sd_offset,
+            "the second sensor's offset is 0 within its band",
+            at,
+        );
+        checks.check(self.not_finite == 0, "the health estimate is finite", end);
+        info!(
+            "transducer loop open {=f32}-{=f32} s: [{}]; SECOND_SENSOR_FAULT outside it: {=u32} ticks (the first at {=f32} s)",
+            track.open_loop.0, track.open_loop.1, self.open_flags, self.stray_sensor_faults, self.first_stray
+        );
+        checks.check(
+            self.open_flags.contains(Flags::SECOND_SENSOR_FAULT) && self.stray_sensor_faults == 0,
+            "SECOND_SENSOR_FAULT exactly while the transducer's loop is open",
+            track.open_loop.0,
+        );
+        // The monitor's verdicts: its algorithm's, reported, not checked.
+        let h = &self.healthy;
+        info!(
+            "monitor verdict, healthy device until {=f32} s: {=u32} ticks alarmed [{}], the first at {=f32} s; divider {=f32} (sd of its log {=f32}), offset {=f32}, {=u32} readings rejected",
+            track.restricted_from,
+            self.false_alarms,
+            self.false_flags,
+            self.first_false_alarm,
+            h.divider,
+            h.sd_divider,
+            h.offset,
+            h.rejected
+        );
+        let l = &self.last;
+        info!(
+            "monitor verdict, capillary at {=f32} of its conductance from {=f32} s: alarm at {=f32} s, named [{}] first at {=f32} s; divider at the end {=f32} (sd of its log {=f32})",
+            MONITOR_RESTRICTION,
+            track.restricted_from,
+            self.detected,
+            self.named_flags,
+            self.named,
+            l.divider,
+            l.sd_divider
+        );
+    }
 }
 
 /// The telemetry record of `e` at `ms`, packed by defmt (checked as

@@ -12,12 +12,15 @@
 //!   host soak of `host-tests`);
 //! * [`probe`]: the probe the replay reads its oil through (a lag and
 //!   noise);
-//! * [`temperature_at`]: the replay's piecewise-linear profile.
+//! * [`temperature_at`]: the replay's piecewise-linear profile;
+//! * [`monitor`]: the condition monitor's second sensor in the replay (the
+//!   true device's reading, its restriction, the transducer's open loop).
 #![no_std]
 #![deny(missing_docs)]
 #![forbid(unsafe_code)]
 
 pub mod faults;
+pub mod monitor;
 pub mod probe;
 pub mod soak;
 

@@ -135,9 +135,28 @@ pub fn build(tc: &Toolchain, root: &Path, image: &Image, params: Option<&Path>) 
     build_with(tc, root, image, Options { params, debug: false }).map(|b| b.elf)
 }
 
+/// Whether the parameter file names the condition monitor's second sensor
+/// (`None`: the paper preset, which does not; a file that cannot be read
+/// is left to the build script to refuse, naming its field).
+pub fn names_second_sensor(params: Option<&Path>) -> bool {
+    params.is_some_and(|p| compensator_params::file::load(p).is_ok_and(|raw| raw.monitor.has_sensor()))
+}
+
+/// The cargo features of `image` built for `params`: its own, and the
+/// firmware's `monitor` when the file names a second sensor (the build
+/// script requires it then, and refuses it otherwise).
+pub fn features(image: &Image, params: Option<&Path>) -> String {
+    if names_second_sensor(params) {
+        format!("{},monitor", image.features)
+    } else {
+        image.features.to_string()
+    }
+}
+
 /// Builds `image` (only it: `--package compensator-firmware --bin ...`, no host
-/// crate of the workspace); returns the ELF and the build script's output
-/// directory.
+/// crate of the workspace), with the `monitor` feature for a file that
+/// names a second sensor ([`features`]); returns the ELF and the build
+/// script's output directory.
 pub fn build_with(tc: &Toolchain, root: &Path, image: &Image, options: Options<'_>) -> Result<Built, String> {
     let mut cmd = tc.cargo();
     cmd.current_dir(root).args([
@@ -156,7 +175,7 @@ pub fn build_with(tc: &Toolchain, root: &Path, image: &Image, options: Options<'
         image.target,
         "--no-default-features",
         "--features",
-        image.features,
+        &features(image, options.params),
         "--message-format=json-render-diagnostics",
     ])
     .arg("--target-dir")
@@ -222,7 +241,9 @@ pub fn build_all_params(tc: &Toolchain, root: &Path, params: Option<&Path>) -> R
         .map(|img| {
             eprintln!(
                 "xtask: building {} ({}, features {})",
-                img.bin, img.target, img.features
+                img.bin,
+                img.target,
+                features(img, params)
             );
             build(tc, root, img, params).map(|p| (*img, p))
         })
@@ -244,6 +265,8 @@ pub fn build_all(root: &Path, params: Option<&Path>) -> Result<(), String> {
 /// plain `cargo build` of the board image, run from `presets/` with the
 /// file's path relative to there, with one line naming the field and no
 /// panic: the build script's contract, for users who build without xtask.
+/// So does a file that names a second sensor built without the firmware's
+/// `monitor` feature, naming `monitor.sensor`.
 pub fn check_refused_file(tc: &Toolchain, root: &Path) -> Result<(), String> {
     let text = std::fs::read_to_string(root.join("presets/paper.toml")).map_err(|e| e.to_string())?;
     let file = root.join("target/xtask/pt1000-on-430-ohm.toml");
@@ -278,6 +301,34 @@ pub fn check_refused_file(tc: &Toolchain, root: &Path) -> Result<(), String> {
     if out.code == Some(0) || naming.len() != 1 || !naming[0].contains(&expected) || out.stderr.contains("panicked") {
         return Err(format!(
             "a refused parameter file should fail the build with one line naming estimator.rtd_reference; cargo said (exit {:?}):\n{}",
+            out.code, out.stderr
+        ));
+    }
+    eprintln!("xtask: {}", naming[0].trim());
+    // A file that names a second sensor, built without the monitor (a
+    // plain `cargo build --features board`): refused naming monitor.sensor,
+    // never an image that ignores the sensor.
+    let mut cmd = tc.cargo();
+    cmd.current_dir(root)
+        .env("COMPENSATOR_PARAMS", root.join("presets/paper-monitor.toml"))
+        .args([
+            "build",
+            "--quiet",
+            "--release",
+            "--package",
+            "compensator-firmware",
+            "--bin",
+            "board",
+        ])
+        .args(["--target", M4, "--no-default-features", "--features", "board"])
+        .arg("--target-dir")
+        .arg(target_dir(root))
+        .args(tc.build_args());
+    let out = process::capture(&mut cmd, Duration::from_secs(600));
+    let naming: Vec<&str> = out.stderr.lines().filter(|l| l.contains("monitor.sensor")).collect();
+    if out.code == Some(0) || naming.len() != 1 || !naming[0].contains("`monitor` feature") {
+        return Err(format!(
+            "a file naming a second sensor, built without the monitor, should fail in one line naming monitor.sensor; cargo said (exit {:?}):\n{}",
             out.code, out.stderr
         ));
     }

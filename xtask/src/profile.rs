@@ -34,8 +34,19 @@ const MESSAGES: usize = 6;
 /// takes about 30 s).
 const TIMEOUT: Duration = Duration::from_secs(300);
 
-/// The sections, in the order the image runs them.
-pub const SECTIONS: [&str; 2] = ["twin tick", "estimator tick"];
+/// The sections, in the order the image runs them: the first two in
+/// every image, the third (the condition monitor's update, a reading a
+/// "tick") in an image built for a second sensor.
+pub const SECTIONS: [&str; 3] = ["twin tick", "estimator tick", "monitor update (a tick is one reading)"];
+
+/// The sections the profile image built for `params` runs.
+pub fn sections_for(params: Option<&Path>) -> usize {
+    if firmware::names_second_sensor(params) {
+        SECTIONS.len()
+    } else {
+        2
+    }
+}
 
 /// The function symbols of an ELF: `(start, end, name)`, sorted by start,
 /// the Thumb bit cleared, names demangled without their hash.
@@ -359,7 +370,8 @@ pub fn shorten<'a>(file: &'a str, root: &str) -> &'a str {
     }
 }
 
-/// Runs the profile image `elf` on `machine` and charges its instructions.
+/// Runs the profile image `elf` on `machine` and charges its instructions
+/// to its `sections` ([`sections_for`]).
 ///
 /// # Errors
 ///
@@ -371,6 +383,7 @@ pub fn run(
     timing: Option<&Timing>,
     machine: Machine,
     timeout: Duration,
+    sections: usize,
 ) -> Result<Vec<Section>, String> {
     let mark = symbols
         .address("profile_mark")
@@ -407,7 +420,7 @@ pub fn run(
     });
     let stderr = BufReader::with_capacity(1 << 20, child.stderr.take().expect("piped"));
     let mut messages = Vec::new();
-    let sections = attribute(stderr, symbols, mark, tick, SECTIONS.len(), timing, &mut messages);
+    let sections = attribute(stderr, symbols, mark, tick, sections, timing, &mut messages);
     // The trace ended (QEMU closed its log) or could not be read: the
     // watchdog is told before `wait`, so that it never kills a reused pid,
     // and QEMU is stopped if its log was abandoned.
@@ -590,7 +603,14 @@ fn profile_target(
     let bytes = std::fs::read(&elf).map_err(|e| format!("{}: {e}", elf.display()))?;
     let symbols = Symbols::of_elf(&bytes).map_err(|e| format!("{}: {e}", elf.display()))?;
     let timing = Timing::of_elf(&elf, Core::of_target(target))?;
-    let sections = run(&elf, &symbols, Some(&timing), image.machine(), TIMEOUT)?;
+    let sections = run(
+        &elf,
+        &symbols,
+        Some(&timing),
+        image.machine(),
+        TIMEOUT,
+        sections_for(params),
+    )?;
     Ok((elf, symbols, sections))
 }
 

@@ -9,7 +9,11 @@
 //! columns, flags) and the firmware's arithmetic are both checked. The
 //! replica's records are its estimates as the wire carries them
 //! (`telemetry::Record::of`), never decoded text, so a column the decoder
-//! drops or misplaces shows.
+//! drops or misplaces shows. For a device file with the condition
+//! monitor's second sensor, the replica reads it as the twin image does
+//! (the same transducer on the simulated ADC, driven by the schedule's
+//! `compensator_testbench::monitor` track) and its records carry the
+//! health columns.
 
 use crate::telemetry::Record;
 use compensator::Params;
@@ -19,6 +23,7 @@ use compensator::params::RawParams;
 use compensator::sensor::device::SensorKind;
 use compensator::sensor::simulated::{SimulatedNtc, SimulatedRtd, SimulatedSource};
 use compensator_testbench::faults::{FAULTS, Injected, fault_at};
+use compensator_testbench::monitor::{SEED, Track};
 use compensator_testbench::probe::{REPLAY_SEED, SimulatedProbe};
 use compensator_testbench::temperature_at;
 use std::path::Path;
@@ -58,6 +63,30 @@ fn run_with<S: SimulatedSource>(raw: &RawParams, schedule: &Schedule) -> Result<
     sensor.start().map_err(|e| format!("sensor: {e}"))?;
     let mut estimator = Estimator::new(&params, config, start).map_err(|e| e.to_string())?;
     let tick = config.tick();
+    // The second sensor, as the twin image with the monitor reads it.
+    let monitor = compensator_codegen::monitor_settings(raw)?;
+    let track = match (&monitor, &schedule.monitor) {
+        (Some(_), Some(m)) => Some(Track {
+            truth: &m.truth,
+            restricted_from: m.restricted_from,
+            open_loop: m.open_loop,
+        }),
+        (None, None) => None,
+        _ => return Err("the replay schedule and the device file disagree on a second sensor".into()),
+    };
+    let mut second = match (monitor, &track) {
+        (Some((transducer, settings)), Some(track)) => {
+            estimator = estimator.with_monitor(settings).map_err(|e| e.to_string())?;
+            let sim = compensator::sensor::transducer::simulated(transducer, track.reading(0.0, start), SEED);
+            Some((sim, config.ticks_per(transducer.period)))
+        }
+        _ => None,
+    };
+    let layout = if second.is_some() {
+        wire::Layout::Monitor
+    } else {
+        wire::Layout::Plain
+    };
     // The probe the twin image reads the oil through (its lag and noise).
     let p = &raw.probe;
     let mut probe = SimulatedProbe::new(
@@ -74,12 +103,19 @@ fn run_with<S: SimulatedSource>(raw: &RawParams, schedule: &Schedule) -> Result<
     let mut out = Vec::new();
     for k in 0..ticks {
         let time = k as f32 * tick;
-        let reading = probe.advance(temperature_at(pieces, time));
+        let oil = temperature_at(pieces, time);
+        let reading = probe.advance(oil);
         let injected = fault_at(time).map(|i| FAULTS[i].injected);
         let delta = if injected == Some(Injected::Spike) { spike } else { 0.0 };
         sensor.set_temperature(reading + delta);
         sensor.inject(injected.and_then(Injected::injection));
         let sample = if k % sensor_every == 0 { sensor.read() } else { Ok(None) };
+        if let (Some((sim, every)), Some(track)) = (second.as_mut(), &track) {
+            track.drive(sim, time, oil);
+            if k % *every == 0 {
+                estimator.offer_second(sim.read());
+            }
+        }
         let e = estimator.tick(sample);
         if estimator.telemetry_due() {
             let ms = (k as f32 * tick * 1e3 + 0.5) as u32;
@@ -89,7 +125,7 @@ fn run_with<S: SimulatedSource>(raw: &RawParams, schedule: &Schedule) -> Result<
             // differs).
             out.push(Record {
                 time_s: f64::from(ms) * 1e-3,
-                values: wire::Record::of(&e),
+                values: wire::Record::of_layout(&e, layout),
             });
         }
     }
@@ -182,8 +218,10 @@ mod tests {
         b[1].values.p_a_pa += 50.0;
         let e = compare(&b, &a).unwrap_err();
         assert!(e.contains("p_a_pa"), "{e}");
-        // Every column is compared: one the decoder lost (NaN) is found.
-        for (c, field) in FIELDS.iter().enumerate() {
+        // Every column the record carries is compared: one the decoder
+        // lost (NaN) is found (a plain record's health columns are NaN on
+        // both sides).
+        for (c, field) in wire::Layout::Plain.fields().iter().enumerate() {
             let mut values = a[2].values.values();
             values[c] = f64::NAN;
             let mut b = a.clone();
@@ -192,5 +230,40 @@ mod tests {
             assert!(e.contains(field.column), "{e}");
         }
         assert!(compare(&a[..2], &a).is_err());
+    }
+
+    #[test]
+    fn a_replica_with_the_monitor_carries_its_columns() {
+        // Two seconds at 30 C of the monitor's preset: its transducer
+        // reads 2.4e5 Pa (the schedule's truth, not the device's: the
+        // replica reads what it is given), its loop open from 1.0 to 1.2 s.
+        let raw = compensator_params::file::load(&crate::root().join("presets/paper-monitor.toml")).unwrap();
+        let text = "piece 0.0 2.0 30.0 30.0\nspike_delta 40.0\nmonitor_restricted_from 100.0\n\
+                    monitor_open_loop 1.0 1.2\nmonitor_truth 20.0 240000.0 250000.0\n\
+                    monitor_truth 40.0 240000.0 250000.0\n";
+        let s = Schedule::parse(text).unwrap();
+        let a = run(&raw, &s).unwrap();
+        assert_eq!(a.len(), 3);
+        assert!(a.iter().all(|r| r.values.layout() == wire::Layout::Monitor));
+        // The monitor took readings (its divider's standard deviation
+        // shrank from its prior, 0.1) and read no fault but the open loop.
+        assert!(a[2].values.divider_sd < 0.1, "{}", a[2].values.divider_sd);
+        assert_eq!(a[2].values.rejected, 0.0);
+        assert!(
+            compare(&a, &run(&raw, &s).unwrap())
+                .unwrap()
+                .contains("3 bit-identical")
+        );
+        for (c, field) in FIELDS.iter().enumerate().skip(wire::HEALTH_FROM) {
+            let mut values = a[1].values.values();
+            values[c] = f64::NAN;
+            let mut b = a.clone();
+            b[1].values = wire::Record::from_values(values, a[1].values.flags);
+            let e = compare(&b, &a).unwrap_err();
+            assert!(e.contains(field.column), "{e}");
+        }
+        // A schedule without the track for a file with the sensor is refused.
+        let plain = Schedule::parse("piece 0.0 2.0 30.0 30.0\nspike_delta 40.0\n").unwrap();
+        assert!(run(&raw, &plain).is_err());
     }
 }

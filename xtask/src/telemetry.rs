@@ -52,13 +52,16 @@ impl Record {
         self.values.flags.names().collect::<Vec<_>>().join("|")
     }
 
-    /// The human-readable line, rounded (see the module docs).
+    /// The human-readable line, rounded (see the module docs): the fields
+    /// of the record's layout (the condition monitor's only in a record
+    /// that carries them).
     pub fn display(&self) -> String {
         let mut s = format!("{} ms", (self.time_s * 1e3).round());
         let values = self.values.values();
-        for (i, (f, v)) in FIELDS.iter().zip(values).enumerate() {
+        let fields = self.values.layout().fields();
+        for (i, (f, v)) in fields.iter().zip(values).enumerate() {
             s += &format!(" {}={}", f.key, fixed(v * f.scale, f.decimals));
-            let last_of_unit = FIELDS.get(i + 1).is_none_or(|g| g.shown_unit != f.shown_unit);
+            let last_of_unit = fields.get(i + 1).is_none_or(|g| g.shown_unit != f.shown_unit);
             if last_of_unit && !f.shown_unit.is_empty() {
                 s += &format!(" {}", f.shown_unit);
             }
@@ -228,15 +231,22 @@ fn columns_markdown() -> String {
         "| column | unit | sent as | shown as | description |\n| --- | --- | --- | --- | --- |\n\
          | `time_s` | s | the line's time in ms (`u32`) | `499 ms` | Time since start. |\n",
     );
-    for f in &FIELDS {
+    for (i, f) in FIELDS.iter().enumerate() {
         let step = fixed(f.resolution() * f.scale, f.decimals);
+        // The monitor's columns: sent by an image with a second sensor
+        // only, NaN in the CSV of one without.
+        let only = if i >= telemetry::HEALTH_FROM {
+            ", with a second sensor only (else NaN)"
+        } else {
+            ""
+        };
         let shown = if f.shown_unit.is_empty() {
             format!("`{}=`, to {step}", f.key)
         } else {
             format!("`{}=` in {}, to {step}", f.key, f.shown_unit)
         };
         s += &format!(
-            "| `{}` | {} | {} | {} | {} |\n",
+            "| `{}` | {} | {}{only} | {} | {} |\n",
             f.column,
             f.unit,
             f.encoding.describe(),
@@ -245,7 +255,7 @@ fn columns_markdown() -> String {
         );
     }
     // `\|`: a bar inside a table cell, even in code.
-    s + "| `flags` | - | `u16` bits | `[AT_STOP\\|SPIKE]`, `[-]` for none | The condition flags' names joined by `\\|`. |\n"
+    s + "| `flags` | - | `u32` bits | `[AT_STOP\\|SPIKE]`, `[-]` for none | The condition flags' names joined by `\\|`. |\n"
 }
 
 #[cfg(test)]
@@ -292,6 +302,35 @@ mod tests {
         format!("{prefix}{ms} ms telemetry {:?}", telemetry::encode(e))
     }
 
+    /// The line of an image with the condition monitor.
+    fn monitor_line(prefix: &str, ms: u32, e: &StateEstimate) -> String {
+        format!("{prefix}{ms} ms telemetry {:?}", telemetry::encode_monitor(e))
+    }
+
+    /// `e` with a health estimate, as the monitor publishes it.
+    fn monitored(mut e: StateEstimate) -> StateEstimate {
+        // Field by field: a parameter the monitor adds keeps its NONE.
+        let h = &mut e.health;
+        h.divider = 1.0123;
+        h.sd_divider = 0.0456;
+        h.spring = 1.0;
+        h.sd_spring = 0.05;
+        h.offset = -12.345678;
+        h.sd_offset = 250.5;
+        h.friction = 0.0;
+        h.cusum = 2.25;
+        h.rejected = 3;
+        h.probe_bias = -0.125;
+        h.sd_probe_bias = 0.25;
+        h.oil = 47.5;
+        e
+    }
+
+    /// The bits of a record's values (NaN equal to itself), its flags.
+    fn bits(r: &telemetry::Record) -> (Vec<u64>, Flags) {
+        (r.values().iter().map(|v| v.to_bits()).collect(), r.flags)
+    }
+
     #[test]
     fn a_telemetry_line_decodes_to_si_units() {
         let e = estimate(Flags::empty());
@@ -304,7 +343,8 @@ mod tests {
         assert_eq!(r.values.x_m, f64::from(12.860147e-6f32));
         assert_eq!(r.values.p_a_pa, f64::from(196205.72f32));
         assert_eq!(r.values.reseats, 2.0);
-        assert_eq!(r.values, telemetry::Record::of(&e));
+        assert_eq!(bits(&r.values), bits(&telemetry::Record::of(&e)));
+        assert!(r.values.divider.is_nan() && r.values.rejected.is_nan());
         assert!(r.flags().is_empty());
         let mut flagged = estimate(Flags::AT_STOP);
         flagged.flags.insert(Flags::SPIKE);
@@ -314,7 +354,20 @@ mod tests {
         assert!(r.values.compensation_error_m3s.is_nan());
         // A probe-rs line (timestamp and level first) decodes the same.
         let board = line("0.500000 INFO ", 12999, &e);
-        assert_eq!(parse(&board).unwrap().unwrap().values, telemetry::Record::of(&e));
+        assert_eq!(
+            bits(&parse(&board).unwrap().unwrap().values),
+            bits(&telemetry::Record::of(&e))
+        );
+        // A record with the monitor's columns decodes them.
+        let m = monitored(e);
+        let r = parse(&monitor_line("INFO  ", 12999, &m)).unwrap().unwrap();
+        assert_eq!(r.values.divider, f64::from(1.0123f32));
+        assert_eq!(r.values.sensor_offset, f64::from(-12.345678f32));
+        assert_eq!(r.values.rejected, 3.0);
+        assert_eq!(
+            bits(&r.values),
+            bits(&telemetry::Record::of_layout(&m, telemetry::Layout::Monitor))
+        );
         assert!(parse("INFO  checkpoint 26.0 C: x 0.0 um").unwrap().is_none());
         assert!(parse("INFO  replaying 74.0 s: ticks of 1.0 ms").unwrap().is_none());
     }
@@ -322,7 +375,8 @@ mod tests {
     #[test]
     fn a_line_that_is_not_a_record_of_this_table_is_an_error() {
         let l = line("INFO  ", 5, &estimate(Flags::empty()));
-        let short = l.replacen("[", "[1, ", 1);
+        // A byte more than its tag's layout packs.
+        let short = format!("{}, 1]", l.strip_suffix(']').unwrap());
         assert!(
             parse(&short).unwrap_err().contains("bytes"),
             "{}",
@@ -341,6 +395,11 @@ mod tests {
         assert_eq!(
             humanize(&line("INFO  ", 12999, &estimate(Flags::empty()))),
             "INFO  12999 ms t_probe=35.31 t=35.79 u_t=0.310 C x=12.9 u_x=7.80 um v=0.038 mm/s p_a=196.2 u_p_a=1.28 p_b=203.8 u_p_b=1.28 kPa Q_a=0.307 Q_b=0.307 Q_throt=0.092 Q0=0.706 u_Q0=0.0582 err=-1.028 u_err=0.0126 l/min reseats=2 missed=0 lost=0 [-]"
+        );
+        // With the monitor: its fields after the plain ones.
+        assert_eq!(
+            humanize(&monitor_line("INFO  ", 12999, &monitored(estimate(Flags::empty())))),
+            "INFO  12999 ms t_probe=35.31 t=35.79 u_t=0.310 C x=12.9 u_x=7.80 um v=0.038 mm/s p_a=196.2 u_p_a=1.28 p_b=203.8 u_p_b=1.28 kPa Q_a=0.307 Q_b=0.307 Q_throt=0.092 Q0=0.706 u_Q0=0.0582 err=-1.028 u_err=0.0126 l/min reseats=2 missed=0 lost=0 A=1.0123 u_A=0.0456 k=1.0000 u_k=0.0500 off=-12.3456783 u_off=250.5000000 F=0.000 N cusum=2.25 rejected=3 dT_p=-0.125 u_dT_p=0.250 K T_s=47.500 C [-]"
         );
         assert_eq!(fixed(-0.0001, 3), "0.000");
         assert_eq!(fixed(-0.0006, 3), "-0.001");
@@ -362,7 +421,7 @@ mod tests {
         let text = std::fs::read_to_string(&path).unwrap();
         assert_eq!(
             text.lines().next().unwrap(),
-            "time_s,t_probe_c,t_oil_c,t_oil_sd_c,x_m,x_sd_m,v_m_s,p_a_pa,p_a_sd_pa,p_b_pa,p_b_sd_pa,q_a_m3s,q_b_m3s,q_throt_m3s,q_total_m3s,q_total_sd_m3s,compensation_error_m3s,compensation_error_sd_m3s,reseats,deadline_misses,lost_ticks,flags"
+            "time_s,t_probe_c,t_oil_c,t_oil_sd_c,x_m,x_sd_m,v_m_s,p_a_pa,p_a_sd_pa,p_b_pa,p_b_sd_pa,q_a_m3s,q_b_m3s,q_throt_m3s,q_total_m3s,q_total_sd_m3s,compensation_error_m3s,compensation_error_sd_m3s,reseats,deadline_misses,lost_ticks,divider,divider_sd,spring,spring_sd,sensor_offset,sensor_offset_sd,friction_n,cusum,rejected,probe_bias_k,probe_bias_sd_k,t_monitor_c,flags"
         );
         assert!(
             text.lines()
@@ -371,13 +430,41 @@ mod tests {
                 .starts_with("12.999,35.31,35.789177,0.31,0.000012860147,")
         );
         let back = read_csv(&path).unwrap();
-        assert_eq!(
-            back,
-            vec![
-                parse(&line("", 12999, &a)).unwrap().unwrap(),
-                parse(&line("", 13499, &b)).unwrap().unwrap()
-            ]
+        let sent = [
+            parse(&line("", 12999, &a)).unwrap().unwrap(),
+            parse(&line("", 13499, &b)).unwrap().unwrap(),
+        ];
+        assert_eq!(back.len(), 2);
+        for (r, s) in back.iter().zip(&sent) {
+            assert_eq!(r.time_s, s.time_s);
+            assert_eq!(bits(&r.values), bits(&s.values));
+        }
+        // Without a monitor the health cells are NaN; with one, numbers.
+        assert!(
+            text.lines()
+                .nth(1)
+                .unwrap()
+                .ends_with(",NaN,NaN,NaN,NaN,NaN,NaN,NaN,NaN,NaN,NaN,NaN,NaN,")
         );
+        let path_m = path.with_extension("monitor.csv");
+        let mut csv = CsvFile::create(&path_m).unwrap();
+        let m = monitored(estimate(Flags::CAPILLARY_RESTRICTED));
+        csv.line(&monitor_line("INFO  ", 500, &m)).unwrap();
+        drop(csv);
+        let text = std::fs::read_to_string(&path_m).unwrap();
+        assert!(
+            text.lines()
+                .nth(1)
+                .unwrap()
+                .ends_with(",1.0123,0.0456,1,0.05,-12.345678,250.5,0,2.25,3,-0.125,0.25,47.5,CAPILLARY_RESTRICTED"),
+            "{text}"
+        );
+        let back = read_csv(&path_m).unwrap();
+        assert_eq!(
+            bits(&back[0].values),
+            bits(&telemetry::Record::of_layout(&m, telemetry::Layout::Monitor))
+        );
+        let _ = std::fs::remove_file(&path_m);
         let _ = std::fs::remove_file(&path);
     }
 

@@ -112,15 +112,20 @@ impl StateEstimate {
 
 /// The telemetry record: the estimate's fields as the table in
 /// [`telemetry`](super::telemetry) lists them, packed by
-/// [`telemetry::encode`](super::telemetry::encode) and sent as one byte
-/// string (the host decodes it with
+/// [`telemetry::encode`](super::telemetry::encode) (with the `monitor`
+/// feature, the condition monitor's health rows too:
+/// [`telemetry::encode_monitor`](super::telemetry::encode_monitor)) and
+/// sent as one byte string (the host decodes either with
 /// [`telemetry::Record::decode`](super::telemetry::Record::decode)). One
 /// argument instead of one per field: defmt's per-argument cost was about
 /// 66 instructions.
 #[cfg(feature = "defmt")]
 impl defmt::Format for StateEstimate {
     fn format(&self, f: defmt::Formatter) {
+        #[cfg(not(feature = "monitor"))]
         let record = super::telemetry::encode(self);
+        #[cfg(feature = "monitor")]
+        let record = super::telemetry::encode_monitor(self);
         defmt::write!(f, "telemetry {=[u8]}", &record[..]);
     }
 }

@@ -322,11 +322,25 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
         }
     }
 
-    /// Gives a waiting reading of the second sensor to the monitor (in a
-    /// job's place); `false` when there is none.
+    /// The monitor's next stage in a job's place: the pending reading's
+    /// next stage ([`Monitor::advance`]; its health estimate published when
+    /// done), else a waiting reading of the second sensor begun
+    /// ([`Monitor::begin`]); `false` when there is neither. A reading's
+    /// stages run on consecutive job ticks, so that no tick carries the
+    /// whole update.
     #[cfg(feature = "monitor")]
     fn take_second(&mut self) -> bool {
-        let (Some(monitor), Some(reading)) = (self.monitor.as_mut(), self.second.take()) else {
+        let Some(monitor) = self.monitor.as_mut() else {
+            return false;
+        };
+        if monitor.pending() {
+            if let Some(health) = monitor.advance() {
+                self.health = health;
+                self.health_flags = health.flags;
+            }
+            return true;
+        }
+        let Some(reading) = self.second.take() else {
             return false;
         };
         let s = self.plant.twin().state();
@@ -343,8 +357,7 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
             }),
         };
         self.monitor_tick = self.tick;
-        self.health = monitor.update(self.plant.params(), &view, reading);
-        self.health_flags = self.health.flags;
+        monitor.begin(self.plant.params(), &view, reading);
         true
     }
 

@@ -20,10 +20,27 @@
 //! table, travels in every record: a decoder built from another table
 //! refuses the record ([`DecodeError::Layout`]) rather than misread it.
 //!
+//! # The condition monitor's rows
+//!
+//! The table has two parts: the rows every image sends, then, after
+//! `@monitor:`, the condition monitor's health parameters
+//! ([`crate::monitor::HealthEstimate`]), which only an image with a second
+//! sensor sends ([`Layout::Monitor`]: the core's `monitor` feature, which
+//! the firmware enables exactly when its device file names a sensor). An
+//! image without one packs the same record as before the monitor existed
+//! ([`Layout::Plain`]: its bytes, its tag [`LAYOUT`], its cost per
+//! telemetry tick), so the health rows cost it nothing; each row would
+//! have cost it about 15 instructions a record (`docs/bench.md`), and its
+//! worst tick has no room for nine. The host decodes both layouts, by
+//! their tags ([`Record::decode`]); a [`Record`] has every column, the
+//! health ones NaN for a record without them ([`Record::layout`]).
+//!
 //! # Wire format
 //!
-//! Little-endian: [`LAYOUT`] (`u16`), then each field in table order in its
-//! [`Encoding`], then the [`Flags`] bits (`u32`); [`SIZE`] bytes in all.
+//! Little-endian: the layout's tag ([`LAYOUT`] or [`LAYOUT_MONITOR`],
+//! `u16`), then each field of the layout in table order in its
+//! [`Encoding`], then the [`Flags`] bits (`u32`); [`SIZE`] or
+//! [`SIZE_MONITOR`] bytes in all.
 //! Packing costs a store per field (plus a scale and a saturation for the
 //! 16-bit encodings), where defmt's per-argument formatting cost about 66
 //! instructions per field; the figures per encoding are in the project's
@@ -262,6 +279,53 @@ impl fmt::Display for DecodeError {
 
 impl core::error::Error for DecodeError {}
 
+/// Which rows a record carries: the table's first part alone, or the
+/// condition monitor's health rows too (module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layout {
+    /// The rows every image sends ([`encode`], [`LAYOUT`], [`SIZE`]).
+    Plain,
+    /// Those and the monitor's health rows ([`encode_monitor`],
+    /// [`LAYOUT_MONITOR`], [`SIZE_MONITOR`]): an image with a second sensor.
+    Monitor,
+}
+
+impl Layout {
+    /// The layout a firmware image packs: [`Layout::Monitor`] with the
+    /// core's `monitor` feature (the images built for a device file that
+    /// names a second sensor), else [`Layout::Plain`]. On the host the
+    /// feature says nothing of a log: a decoder takes the record's own tag.
+    pub const BUILT: Layout = if cfg!(feature = "monitor") {
+        Layout::Monitor
+    } else {
+        Layout::Plain
+    };
+
+    /// The fields the layout carries, in wire order.
+    pub fn fields(self) -> &'static [Field] {
+        match self {
+            Layout::Plain => FIELDS.split_at(HEALTH_FROM).0,
+            Layout::Monitor => &FIELDS,
+        }
+    }
+
+    /// The layout's tag, sent first in its records.
+    pub const fn tag(self) -> u16 {
+        match self {
+            Layout::Plain => LAYOUT,
+            Layout::Monitor => LAYOUT_MONITOR,
+        }
+    }
+
+    /// Bytes in a record of the layout.
+    pub const fn size(self) -> usize {
+        match self {
+            Layout::Plain => SIZE,
+            Layout::Monitor => SIZE_MONITOR,
+        }
+    }
+}
+
 /// Packs values into a record of `N` bytes, in order; never panics (a
 /// full buffer, impossible with the table's [`SIZE`], would drop the
 /// bytes).
@@ -412,17 +476,26 @@ macro_rules! carried {
 /// Makes the record from the table: rows
 /// `column [SI unit, encoding] shown [key, unit, scale, decimals] = |e| value;`,
 /// each with its doc comment (one line: it is the documentation's
-/// description of the column).
+/// description of the column); then `@monitor:` and the rows only an image
+/// with the condition monitor sends ([`Layout::Monitor`]).
 macro_rules! telemetry_table {
     ($(
         $(#[doc = $doc:literal])*
         $column:ident [$unit:literal, $wire:ident $($step:literal)?]
             shown [$key:literal, $shown:literal, $scale:literal, $decimals:literal]
             = $value:expr;
+    )*
+    @monitor:
+    $(
+        $(#[doc = $mdoc:literal])*
+        $mcolumn:ident [$munit:literal, $mwire:ident $($mstep:literal)?]
+            shown [$mkey:literal, $mshown:literal, $mscale:literal, $mdecimals:literal]
+            = $mvalue:expr;
     )*) => {
         /// One telemetry record in SI units, a field per column of the
         /// table (`f64`: a decoded record, or an estimate as the wire
-        /// carries it), and the flags.
+        /// carries it; the monitor's columns NaN in a record without them),
+        /// and the flags.
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub struct Record {
             $(
@@ -430,12 +503,18 @@ macro_rules! telemetry_table {
                 #[doc = concat!("Unit: ", $unit, "; sent as ", stringify!($wire $($step)?), ".")]
                 pub $column: f64,
             )*
+            $(
+                $(#[doc = $mdoc])*
+                #[doc = concat!("Unit: ", $munit, "; sent as ", stringify!($mwire $($mstep)?), ", by an image with the condition monitor only (NaN in a record without it).")]
+                pub $mcolumn: f64,
+            )*
             /// Conditions.
             pub flags: Flags,
         }
 
-        /// The fields of the record, in wire order.
-        pub const FIELDS: [Field; [$(stringify!($column)),*].len()] = [$(
+        /// The fields of the record, in wire order: the plain layout's,
+        /// then from [`HEALTH_FROM`] on the monitor's.
+        pub const FIELDS: [Field; [$(stringify!($column),)* $(stringify!($mcolumn)),*].len()] = [$(
             Field {
                 column: stringify!($column),
                 unit: $unit,
@@ -446,17 +525,39 @@ macro_rules! telemetry_table {
                 decimals: $decimals,
                 doc: concat!($($doc),*),
             },
+        )* $(
+            Field {
+                column: stringify!($mcolumn),
+                unit: $munit,
+                encoding: encoding!($mwire $($mstep)?),
+                key: $mkey,
+                shown_unit: $mshown,
+                scale: $mscale,
+                decimals: $mdecimals,
+                doc: concat!($($mdoc),*),
+            },
         )*];
 
-        /// The table's layout tag: sent first in every record.
-        pub const LAYOUT: u16 = layout_of(&FIELDS);
+        /// Index in [`FIELDS`] of the first of the monitor's fields (the
+        /// plain layout's count).
+        pub const HEALTH_FROM: usize = [$(stringify!($column)),*].len();
 
-        /// Bytes in a record: the layout tag, the fields, the flags.
+        /// The plain layout's tag ([`Layout::Plain`]): sent first in every
+        /// record of an image without the monitor.
+        pub const LAYOUT: u16 = layout_of(FIELDS.split_at(HEALTH_FROM).0);
+
+        /// The monitor layout's tag ([`Layout::Monitor`]).
+        pub const LAYOUT_MONITOR: u16 = layout_of(&FIELDS);
+
+        /// Bytes in a plain record: the layout tag, the fields, the flags.
         pub const SIZE: usize = 2 $(+ encoding!($wire $($step)?).size())* + 4;
 
-        /// The bytes of `e`'s telemetry record (see the module docs). A
-        /// store per field, no branch but the 16-bit encodings' saturation:
-        /// the firmware calls it on a telemetry tick.
+        /// Bytes in a record with the monitor's fields.
+        pub const SIZE_MONITOR: usize = SIZE $(+ encoding!($mwire $($mstep)?).size())*;
+
+        /// The bytes of `e`'s plain telemetry record (see the module docs).
+        /// A store per field, no branch but the 16-bit encodings'
+        /// saturation: the firmware calls it on a telemetry tick.
         #[inline]
         pub fn encode(e: &StateEstimate) -> [u8; SIZE] {
             let mut w = Writer { bytes: [0; SIZE], at: 0 };
@@ -469,53 +570,104 @@ macro_rules! telemetry_table {
             w.bytes
         }
 
+        /// The bytes of `e`'s record with the monitor's fields (an image
+        /// with a second sensor), as [`encode`].
+        #[inline]
+        pub fn encode_monitor(e: &StateEstimate) -> [u8; SIZE_MONITOR] {
+            let mut w = Writer { bytes: [0; SIZE_MONITOR], at: 0 };
+            w.put(LAYOUT_MONITOR.to_le_bytes());
+            $(
+                let get: fn(&StateEstimate) -> wire_type!($wire) = $value;
+                put!(w, get(e), $wire $($step)?);
+            )*
+            $(
+                let get: fn(&StateEstimate) -> wire_type!($mwire) = $mvalue;
+                put!(w, get(e), $mwire $($mstep)?);
+            )*
+            w.put(e.flags.0.to_le_bytes());
+            w.bytes
+        }
+
         impl Record {
-            /// The record of `bytes`, packed by [`encode`].
+            /// The record of `bytes`, packed by [`encode`] or
+            /// [`encode_monitor`] (told apart by their tags).
             ///
             /// # Errors
             ///
+            /// [`DecodeError::Layout`] for a record of another table,
             /// [`DecodeError::Length`] for a byte string of another length
-            /// than [`SIZE`], [`DecodeError::Layout`] for a record of another
-            /// table.
+            /// than its tag's layout packs ([`SIZE`], [`SIZE_MONITOR`]).
             pub fn decode(bytes: &[u8]) -> Result<Record, DecodeError> {
-                if bytes.len() != SIZE {
-                    return Err(DecodeError::Length { expected: SIZE, got: bytes.len() });
-                }
                 let mut r = Reader { bytes, at: 0 };
                 let layout = u16::from_le_bytes(r.take());
-                if layout != LAYOUT {
+                let (monitored, expected) = if bytes.len() < 2 {
+                    (false, SIZE)
+                } else if layout == LAYOUT {
+                    (false, SIZE)
+                } else if layout == LAYOUT_MONITOR {
+                    (true, SIZE_MONITOR)
+                } else {
                     return Err(DecodeError::Layout { expected: LAYOUT, got: layout });
+                };
+                if bytes.len() != expected {
+                    return Err(DecodeError::Length { expected, got: bytes.len() });
                 }
                 // Struct fields are evaluated in the order written: wire order.
                 Ok(Record {
                     $( $column: get!(r, $wire $($step)?), )*
+                    $( $mcolumn: if monitored { get!(r, $mwire $($mstep)?) } else { f64::NAN }, )*
                     flags: Flags(u32::from_le_bytes(r.take())),
                 })
             }
 
-            /// `e` as its record carries it (quantised as the wire
-            /// quantises), computed from the estimate without the byte
-            /// layout.
+            /// `e` as a record of an image without the monitor carries it
+            /// ([`Record::of_layout`] with [`Layout::Plain`]: the monitor's
+            /// columns NaN).
             pub fn of(e: &StateEstimate) -> Record {
+                Record::of_layout(e, Layout::Plain)
+            }
+
+            /// `e` as its record of `layout` carries it (quantised as the
+            /// wire quantises), computed from the estimate without the byte
+            /// layout; the monitor's columns NaN in [`Layout::Plain`].
+            pub fn of_layout(e: &StateEstimate, layout: Layout) -> Record {
+                let monitored = layout == Layout::Monitor;
                 Record {
                     $( $column: {
                         let get: fn(&StateEstimate) -> wire_type!($wire) = $value;
                         carried!(get(e), $wire $($step)?)
                     }, )*
+                    $( $mcolumn: if monitored {
+                        let get: fn(&StateEstimate) -> wire_type!($mwire) = $mvalue;
+                        carried!(get(e), $mwire $($mstep)?)
+                    } else {
+                        f64::NAN
+                    }, )*
                     flags: e.flags,
+                }
+            }
+
+            /// The layout the record came in: [`Layout::Monitor`] when any
+            /// of the monitor's columns holds a number (its `u32` count
+            /// always does), else [`Layout::Plain`].
+            pub fn layout(&self) -> Layout {
+                if false $(|| !self.$mcolumn.is_nan())* {
+                    Layout::Monitor
+                } else {
+                    Layout::Plain
                 }
             }
 
             /// The values, in the order of [`FIELDS`].
             pub fn values(&self) -> [f64; FIELDS.len()] {
-                [$(self.$column),*]
+                [$(self.$column,)* $(self.$mcolumn),*]
             }
 
             /// The record of `values` (in the order of [`FIELDS`]) and
             /// `flags`.
             pub fn from_values(values: [f64; FIELDS.len()], flags: Flags) -> Record {
-                let [$($column),*] = values;
-                Record { $($column,)* flags }
+                let [$($column,)* $($mcolumn),*] = values;
+                Record { $($column,)* $($mcolumn,)* flags }
             }
         }
     };
@@ -569,6 +721,35 @@ telemetry_table! {
     deadline_misses ["-", u32] shown ["missed", "", 1.0, 0] = |e| e.deadline_misses;
     /// Ticks of real time the twin did not advance through since start.
     lost_ticks ["-", u32] shown ["lost", "", 1.0, 0] = |e| e.lost_ticks;
+@monitor:
+    // The condition monitor's health parameters at its last reading
+    // (`crate::monitor::HealthEstimate`; NaN until its first). The offset
+    // is in the second sensor's unit, Pa or m: seven decimals show 0.1 um
+    // of a displacement sensor's zero.
+    /// The divider factor A / A_file the monitor estimates (above 1: a restricted capillary or a worn orifice).
+    divider ["-", f32] shown ["A", "", 1.0, 4] = |e| e.health.divider;
+    /// Standard deviation of ln(divider): the divider factor's relative standard uncertainty.
+    divider_sd ["-", f32] shown ["u_A", "", 1.0, 4] = |e| e.health.sd_divider;
+    /// The spring rate's factor c / c_file (1 from a pressure sensor, which does not see the spring).
+    spring ["-", f32] shown ["k", "", 1.0, 4] = |e| e.health.spring;
+    /// Standard deviation of ln(spring): the spring factor's relative standard uncertainty.
+    spring_sd ["-", f32] shown ["u_k", "", 1.0, 4] = |e| e.health.sd_spring;
+    /// The second sensor's reading offset, in its unit (Pa for a pressure, m for x).
+    sensor_offset ["Pa or m", f32] shown ["off", "", 1.0, 7] = |e| e.health.offset;
+    /// Standard deviation of the offset, in the second sensor's unit.
+    sensor_offset_sd ["Pa or m", f32] shown ["u_off", "", 1.0, 7] = |e| e.health.sd_offset;
+    /// The friction force holding the plunger (0 until sticking is named).
+    friction_n ["N", f32] shown ["F", "N", 1.0, 3] = |e| e.health.friction;
+    /// The larger of the monitor's two CUSUM statistics, in innovation standard deviations.
+    cusum ["-", f32] shown ["cusum", "", 1.0, 2] = |e| e.health.cusum;
+    /// Second-sensor readings the monitor did not apply since start (beyond its gate, or not finite).
+    rejected ["-", u32] shown ["rejected", "", 1.0, 0] = |e| e.health.rejected;
+    /// The oil-temperature probe's error at the oil temperature, its place within its IEC 60751 tolerance times the tolerance.
+    probe_bias_k ["K", f32] shown ["dT_p", "K", 1.0, 3] = |e| e.health.probe_bias;
+    /// Standard deviation of the probe's error.
+    probe_bias_sd_k ["K", f32] shown ["u_dT_p", "K", 1.0, 3] = |e| e.health.sd_probe_bias;
+    /// The oil temperature the second sensor's reading gives through the health estimate (the twin's where it does not depend on it).
+    t_monitor_c ["C", f32] shown ["T_s", "C", 1.0, 3] = |e| e.health.oil;
 }
 
 #[cfg(test)]
@@ -625,14 +806,22 @@ mod tests {
 
     #[test]
     fn the_layout_follows_the_table() {
+        let plain = &FIELDS[..HEALTH_FROM];
+        assert_eq!(layout_of(plain), LAYOUT);
+        assert_eq!(layout_of(&FIELDS), LAYOUT_MONITOR);
+        assert_ne!(LAYOUT, LAYOUT_MONITOR);
         let mut other = FIELDS;
-        assert_eq!(layout_of(&other), LAYOUT);
         other.swap(1, 2);
-        assert_ne!(layout_of(&other), LAYOUT, "a reordered table");
+        assert_ne!(layout_of(&other[..HEALTH_FROM]), LAYOUT, "a reordered table");
         let mut other = FIELDS;
         other[0].encoding = Encoding::U16 { step: 1e-3 };
-        assert_ne!(layout_of(&other), LAYOUT, "another encoding");
-        assert_ne!(layout_of(&FIELDS[..FIELDS.len() - 1]), LAYOUT, "a field less");
+        assert_ne!(layout_of(&other[..HEALTH_FROM]), LAYOUT, "another encoding");
+        assert_ne!(layout_of(&plain[..plain.len() - 1]), LAYOUT, "a field less");
+        assert_ne!(
+            layout_of(&FIELDS[..FIELDS.len() - 1]),
+            LAYOUT_MONITOR,
+            "a health field less"
+        );
     }
 
     #[test]
@@ -640,6 +829,9 @@ mod tests {
         // The layout tag (2 bytes), the fields, the flags (4 bytes).
         let mut size = 6;
         for (i, f) in FIELDS.iter().enumerate() {
+            if i == HEALTH_FROM {
+                assert_eq!(size, SIZE, "the plain layout's size");
+            }
             size += f.encoding.size();
             assert!(!f.doc.trim().is_empty(), "{}: a description", f.column);
             assert!(f.scale > 0.0 && !f.unit.is_empty(), "{}", f.column);
@@ -649,7 +841,101 @@ mod tests {
                 f.column
             );
         }
-        assert_eq!(size, SIZE);
+        assert_eq!(size, SIZE_MONITOR);
+        assert_eq!(Layout::Plain.fields().len(), HEALTH_FROM);
+        assert_eq!(Layout::Monitor.fields().len(), FIELDS.len());
+        assert_eq!((Layout::Plain.size(), Layout::Monitor.size()), (SIZE, SIZE_MONITOR));
+        // The health columns begin with these nine, each its
+        // `HealthEstimate` field: divider, spring and offset with their
+        // standard deviations, the friction, the CUSUM, the rejected
+        // readings (a parameter added later goes after them).
+        let health: [&str; 9] = core::array::from_fn(|i| FIELDS[HEALTH_FROM + i].column);
+        assert_eq!(
+            health,
+            [
+                "divider",
+                "divider_sd",
+                "spring",
+                "spring_sd",
+                "sensor_offset",
+                "sensor_offset_sd",
+                "friction_n",
+                "cusum",
+                "rejected"
+            ]
+        );
+    }
+
+    /// An estimate with a health estimate of distinct values.
+    fn monitored() -> StateEstimate {
+        let mut e = estimate();
+        // Field by field: a parameter the monitor adds keeps its NONE.
+        let h = &mut e.health;
+        h.divider = 1.25;
+        h.sd_divider = 0.012;
+        h.spring = 0.97;
+        h.sd_spring = 0.05;
+        h.offset = -123.5;
+        h.sd_offset = 288.7;
+        h.friction = 0.75;
+        h.cusum = 4.5;
+        h.rejected = 17;
+        h.probe_bias = -0.25;
+        h.sd_probe_bias = 0.18;
+        h.oil = 47.5;
+        h.flags = Flags::CAPILLARY_RESTRICTED;
+        e.flags.insert(Flags::CAPILLARY_RESTRICTED);
+        e
+    }
+
+    #[test]
+    fn a_record_with_the_monitor_carries_the_health_estimate() {
+        let e = monitored();
+        let bytes = encode_monitor(&e);
+        assert_eq!(bytes.len(), SIZE_MONITOR);
+        assert_eq!(&bytes[..2], &LAYOUT_MONITOR.to_le_bytes());
+        let r = Record::decode(&bytes).unwrap();
+        assert_eq!(bits(&r), bits(&Record::of_layout(&e, Layout::Monitor)));
+        assert_eq!(r.layout(), Layout::Monitor);
+        assert_eq!(r.divider, 1.25);
+        assert_eq!(r.divider_sd, f64::from(0.012f32));
+        assert_eq!(r.spring, f64::from(0.97f32));
+        assert_eq!(r.sensor_offset, -123.5);
+        assert_eq!(r.sensor_offset_sd, f64::from(288.7f32));
+        assert_eq!(r.friction_n, 0.75);
+        assert_eq!(r.cusum, 4.5);
+        assert_eq!(r.rejected, 17.0);
+        assert_eq!(r.probe_bias_k, -0.25);
+        assert_eq!(r.probe_bias_sd_k, f64::from(0.18f32));
+        assert_eq!(r.t_monitor_c, 47.5);
+        assert_eq!(r.flags, e.flags);
+        // The plain part is the plain record's, byte for byte.
+        let plain = encode(&e);
+        assert_eq!(&bytes[2..SIZE - 4], &plain[2..SIZE - 4]);
+        assert_eq!(&bytes[SIZE_MONITOR - 4..], &plain[SIZE - 4..]);
+    }
+
+    #[test]
+    fn a_record_without_the_monitor_has_nan_health_columns() {
+        // The same estimate, packed by an image without the monitor: the
+        // health columns are not sent, and read as NaN.
+        let e = monitored();
+        let r = Record::decode(&encode(&e)).unwrap();
+        assert_eq!(r.layout(), Layout::Plain);
+        assert_eq!(bits(&r), bits(&Record::of(&e)));
+        let values = r.values();
+        assert!(values[HEALTH_FROM..].iter().all(|v| v.is_nan()));
+        assert_eq!(r.x_m, f64::from(e.x));
+        // A monitor record cut to the plain size is refused by its tag's length.
+        let bytes = encode_monitor(&e);
+        assert_eq!(
+            Record::decode(&bytes[..SIZE]),
+            Err(DecodeError::Length {
+                expected: SIZE_MONITOR,
+                got: SIZE
+            })
+        );
+        assert_eq!(Record::decode(&[]), Err(DecodeError::Length { expected: SIZE, got: 0 }));
     }
 
     /// A table with a field of every encoding, through the same macro.
@@ -664,13 +950,19 @@ mod tests {
             v_m_s ["m/s", f32] shown ["v", "mm/s", 1e3, 3] = |e| e.v;
             /// Count.
             reseats ["-", u32] shown ["reseats", "", 1.0, 0] = |e| e.reseats;
+        @monitor:
+            /// A health parameter, 1e-4 codes.
+            divider ["-", u16 1e-4] shown ["A", "", 1.0, 4] = |e| e.health.divider;
+            /// A count.
+            rejected ["-", u32] shown ["rejected", "", 1.0, 0] = |e| e.health.rejected;
         }
     }
 
     #[test]
     fn every_encoding_packs_and_decodes_as_the_estimate_carries_it() {
-        use every_encoding::{FIELDS, Record, SIZE, encode};
+        use every_encoding::{FIELDS, Record, SIZE, SIZE_MONITOR, encode, encode_monitor};
         assert_eq!(SIZE, 2 + 2 + 2 + 4 + 4 + 4);
+        assert_eq!(SIZE_MONITOR, SIZE + 2 + 4);
         let mut e = estimate();
         for (x, p_a) in [
             (12.86e-6, 196205.72),
@@ -692,9 +984,23 @@ mod tests {
         let r = Record::of(&estimate());
         assert_eq!(r.x_m, 129.0 * 1e-7);
         assert_eq!(r.p_a_pa, 19621.0 * 10.0);
+        // The monitor's part: a 16-bit health field and a count.
+        e.health.divider = 1.23456;
+        e.health.rejected = 9;
+        let r = Record::decode(&encode_monitor(&e)).unwrap();
+        assert_eq!(r.layout(), Layout::Monitor);
+        assert_eq!(r.divider, 12346.0 * 1e-4);
+        assert_eq!(r.rejected, 9.0);
+        assert_eq!(
+            r.values().map(f64::to_bits),
+            Record::of_layout(&e, Layout::Monitor).values().map(f64::to_bits)
+        );
+        assert!(Record::decode(&encode(&e)).unwrap().divider.is_nan());
         // Two tables, two layouts: neither decodes the other's records.
         assert_ne!(every_encoding::LAYOUT, LAYOUT);
+        assert_ne!(every_encoding::LAYOUT_MONITOR, LAYOUT_MONITOR);
         assert!(super::Record::decode(&encode(&e)).is_err());
+        assert!(super::Record::decode(&encode_monitor(&e)).is_err());
         assert_eq!(FIELDS[0].encoding, Encoding::U16 { step: 1e-7 });
         assert_eq!(FIELDS[0].encoding.describe().to_string(), "u16 x 1e-7");
     }

@@ -119,18 +119,29 @@ impl<const N: usize> Lag<N> {
 
     /// One step of `decay.h` to the new inputs `u` (see the module docs).
     pub fn step(&mut self, u: &[f32; N], decay: &Decay) {
-        for (i, &u) in u.iter().enumerate() {
-            let w0 = self.well[i];
+        self.step_signals(u, decay, 0..N);
+    }
+
+    /// [`Lag::step`] of the signals `signals` alone (the others keep
+    /// their stages): a step may be taken in parts, each signal once.
+    pub fn step_signals(&mut self, u: &[f32; N], decay: &Decay, signals: core::ops::Range<usize>) {
+        let stages = u
+            .iter()
+            .zip(self.input.iter_mut())
+            .zip(self.well.iter_mut())
+            .zip(self.probe.iter_mut());
+        for (((&u, input), well), probe) in stages.take(signals.end).skip(signals.start) {
+            let w0 = *well;
             let w1 = if decay.well > 0.0 {
-                let m = 0.5 * (self.input[i] + u);
+                let m = 0.5 * (*input + u);
                 m + (w0 - m) * decay.well
             } else {
                 u
             };
             let m = 0.5 * (w0 + w1);
-            self.probe[i] = m + (self.probe[i] - m) * decay.probe;
-            self.well[i] = w1;
-            self.input[i] = u;
+            *probe = m + (*probe - m) * decay.probe;
+            *well = w1;
+            *input = u;
         }
     }
 

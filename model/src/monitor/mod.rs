@@ -472,7 +472,7 @@ pub struct Monitor {
     /// noise variance, residual after the update, and the share `c` of the
     /// reading's noise in it; its measurement noise drives the lag's noise
     /// at the next step.
-    pending: Option<(Measured, f32)>,
+    correlated: Option<(Measured, f32)>,
     /// The share of the probe lag's memory still from its start at rest
     /// (`p^k` after `k` steps).
     rest_share: f32,
@@ -513,6 +513,47 @@ pub struct Monitor {
     /// The twin's oil temperature at the last reading through the play of
     /// [`TRAVEL_PLAY`] \[C\].
     last_oil: f32,
+    /// The reading's stages not yet run ([`Monitor::begin`]).
+    pending: Pending,
+}
+
+/// What a reading begun by [`Monitor::begin`] has left to run, and what it
+/// carries to those stages.
+#[derive(Clone, Copy, Debug)]
+struct Pending {
+    /// The hypotheses' signatures, and their signals' step through the lag.
+    signatures: Option<SignatureInputs>,
+    /// The signatures' signals step through the lag (the step's other
+    /// signals have).
+    step: bool,
+    /// The probe's reading to test, and the twin's oil temperature \[C\].
+    test: Option<(ProbeSample, f32)>,
+    /// The reading's prediction, the second sensor's temperature \[C\],
+    /// its flags so far and the twin's oil temperature \[C\]; `None`:
+    /// nothing pending.
+    estimate: Option<(f32, f32, Flags, f32)>,
+}
+
+/// What [`Monitor::signatures`] takes: `-1 / (dy/dT)`, the
+/// redistribution parameter, the filter's parameters and the reading
+/// there, the reading's Jacobian, the sticking test's signature.
+#[derive(Clone, Copy, Debug)]
+struct SignatureInputs {
+    inv: f32,
+    a: f32,
+    theta: [f32; PARAMETERS],
+    value: f32,
+    jacobian: [f32; PARAMETERS],
+    sticking: f32,
+}
+
+impl Pending {
+    const NONE: Pending = Pending {
+        signatures: None,
+        step: false,
+        test: None,
+        estimate: None,
+    };
 }
 
 impl Monitor {
@@ -574,7 +615,7 @@ impl Monitor {
             lag: Lag::at_rest([0.0; SIGNALS]),
             decay: Decay::new(&settings.probe, settings.sample_period),
             last_fresh: 0.0,
-            pending: None,
+            correlated: None,
             rest_share: 1.0,
             started: false,
             friction_width: 0.0,
@@ -594,6 +635,7 @@ impl Monitor {
             reference: [0.0; PARAMETERS],
             sd_model,
             last_oil: f32::NAN,
+            pending: Pending::NONE,
         })
     }
 
@@ -646,8 +688,74 @@ impl Monitor {
 
     /// One reading `measured` (`Err`: the sensor's own checks refused it)
     /// of the second sensor, with the plant as it is now and the probe's
-    /// reading since the last (see the module docs).
+    /// reading since the last (see the module docs): [`Monitor::begin`],
+    /// then [`Monitor::advance`] until the reading is done.
     pub fn update<E>(&mut self, params: &Params<f32>, view: &PlantView, measured: Result<f32, E>) -> HealthEstimate {
+        self.begin(params, view, measured);
+        // Two stages at most after the beginning (the signatures, the test).
+        let mut done = None;
+        for _ in 0..2 {
+            done = self.advance();
+            if done.is_some() {
+                break;
+            }
+        }
+        done.unwrap_or(HealthEstimate::NONE)
+    }
+
+    /// Whether a reading begun by [`Monitor::begin`] has stages left.
+    pub fn pending(&self) -> bool {
+        self.pending.estimate.is_some()
+    }
+
+    /// The next stage of the reading begun by [`Monitor::begin`]: the
+    /// hypotheses' signatures through the lag (while a change is watched),
+    /// then the probe's test and the filter; `Some` with the reading's
+    /// health estimate once done (then and without a reading pending:
+    /// [`Monitor::update`]'s estimate). The stages split a reading's cost
+    /// over ticks (the worst about 900 instructions on the Cortex-M4F,
+    /// `cargo xtask bench`); run one after the other, they are
+    /// [`Monitor::update`], bit for bit.
+    pub fn advance(&mut self) -> Option<HealthEstimate> {
+        let (predicted, oil, mut flags, t_twin) = self.pending.estimate?;
+        let mut estimate = HealthEstimate {
+            predicted,
+            innovation: self.innovation,
+            oil,
+            ..HealthEstimate::NONE
+        };
+        if let Some(g) = self.pending.signatures.take() {
+            let mut u = [0.0f32; SIGNALS];
+            self.signatures(&mut u, g.inv, (g.a, &g.theta, g.value), &g.jacobian, g.sticking);
+            if self.pending.step {
+                self.lag.step_signals(&u, &self.decay, SIGNATURE..UNINFORMED);
+            }
+            self.pending.step = false;
+            return None;
+        }
+        if self.pending.step {
+            // No signature this reading: their signals step with zero.
+            self.lag
+                .step_signals(&[0.0; SIGNALS], &self.decay, SIGNATURE..UNINFORMED);
+            self.pending.step = false;
+        }
+        if let Some((sample, t)) = self.pending.test.take() {
+            self.test(sample, t, &mut estimate, &mut flags);
+        }
+        self.pending = Pending::NONE;
+        Some(self.publish(estimate, flags, t_twin))
+    }
+
+    /// Begins one reading (see [`Monitor::update`]): the prediction, the
+    /// second sensor's temperature and the lag's step of its signals but
+    /// the signatures'; the rest waits for [`Monitor::advance`]. A reading
+    /// still pending is finished first.
+    pub fn begin<E>(&mut self, params: &Params<f32>, view: &PlantView, measured: Result<f32, E>) {
+        for _ in 0..2 {
+            if self.advance().is_some() {
+                break;
+            }
+        }
         let mut flags = self.latched;
         let a = a_parameter(params, &view.oil.state);
         let theta = self.filter.theta();
@@ -704,6 +812,7 @@ impl Monitor {
         let sd_t = <f32 as Real>::sqrt(spread) / libm::fabsf(dy_dt);
         let mut u = [0.0f32; SIGNALS];
         u[OIL] = t_twin;
+        let mut signatures = None;
         let informed = match reading {
             Some(y)
                 if sd_t < MAX_TEMPERATURE_SD
@@ -718,7 +827,14 @@ impl Monitor {
                     u[D_THETA + k] = jacobian[k] * inv;
                 }
                 if self.running() {
-                    self.signatures(&mut u, inv, (a, &theta, now.value), &jacobian, sticking);
+                    signatures = Some(SignatureInputs {
+                        inv,
+                        a,
+                        theta,
+                        value: now.value,
+                        jacobian,
+                        sticking,
+                    });
                 }
                 true
             }
@@ -728,9 +844,17 @@ impl Monitor {
             }
         };
         estimate.oil = u[OIL];
+        let mut step = false;
         if !self.started {
             if !u[OIL].is_finite() {
-                return self.publish(estimate, flags, t_twin);
+                self.pending = Pending {
+                    estimate: Some((estimate.predicted, estimate.oil, flags, t_twin)),
+                    ..Pending::NONE
+                };
+                return;
+            }
+            if let Some(g) = signatures.take() {
+                self.signatures(&mut u, g.inv, (g.a, &g.theta, g.value), &g.jacobian, g.sticking);
             }
             // The lag at rest holds all of this reading's noise, `x_0 = n_0`:
             // its Markov part is `e_0 = (1 - c) n_0` ([`filter`]).
@@ -744,13 +868,15 @@ impl Monitor {
             if view.dt != self.decay.h {
                 self.decay = Decay::new(&self.settings.probe, view.dt);
             }
-            self.lag.step(&u, &self.decay);
+            self.lag.step_signals(&u, &self.decay, OIL..SIGNATURE);
+            self.lag.step_signals(&u, &self.decay, UNINFORMED..SIGNALS);
+            step = true;
             // The lag's noise: `e_k = p e_(k-1) + c (1 + p) n_(k-1)`.
             let p = self.decay.probe;
             let drive = 0.5 * (1.0 - p) * (1.0 + p);
             let q = drive * drive * self.last_fresh;
             self.rest_share *= p;
-            match self.pending.take() {
+            match self.correlated.take() {
                 // The last update's measurement noise held `-c n_(k-1)`.
                 Some((last, c)) => {
                     let m = -drive * c * self.last_fresh;
@@ -777,10 +903,12 @@ impl Monitor {
         if held.is_finite() {
             self.last_oil = held;
         }
-        if let Some(sample) = view.probe {
-            self.test(sample, t_twin, &mut estimate, &mut flags);
-        }
-        self.publish(estimate, flags, t_twin)
+        self.pending = Pending {
+            signatures: if step { signatures } else { None },
+            step,
+            test: view.probe.map(|sample| (sample, t_twin)),
+            estimate: Some((estimate.predicted, estimate.oil, flags, t_twin)),
+        };
     }
 
     /// The hypotheses' signatures on the second sensor's temperature
@@ -852,7 +980,7 @@ impl Monitor {
         let c = 0.5 * (1.0 - self.decay.probe);
         let r = probe.reading_sd * probe.reading_sd + c * c * self.last_fresh + spread * spread;
         let s = self.filter.innovation_variance(&h) + r;
-        self.pending = None;
+        self.correlated = None;
         let z = nu / <f32 as Real>::sqrt(s);
         if !z.is_finite() {
             return;
@@ -899,7 +1027,7 @@ impl Monitor {
             // The parameters are held; the lag's noise follows the reading.
             let residual = self.filter.update_noise(&h, nu, s);
             let c = 0.5 * (1.0 - self.decay.probe);
-            self.pending = Some((Measured { h, r, residual }, c));
+            self.correlated = Some((Measured { h, r, residual }, c));
         }
         if self.detected {
             flags.insert(Flags::DEVICE_CHANGED);
@@ -925,7 +1053,7 @@ impl Monitor {
         let change = self.filter.update(h, nu, s);
         let c = 0.5 * (1.0 - self.decay.probe);
         let residual = nu * r / s;
-        self.pending = Some((Measured { h: *h, r, residual }, c));
+        self.correlated = Some((Measured { h: *h, r, residual }, c));
         for (k, c) in change.iter().enumerate().take(OFFSET + 1) {
             self.lag.add_scaled(OIL, D_THETA + k, *c);
         }

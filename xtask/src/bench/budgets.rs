@@ -19,10 +19,22 @@ pub const BUDGET_FLASH: u64 = 64 * 1024;
 /// characteristic it prints, about 7 KiB) [bytes].
 pub const BUDGET_QEMU_TWIN_FLASH: u64 = 72 * 1024;
 
+/// Flash budget of the board image built for a second sensor (the
+/// condition monitor: its health filter, the probe's lag, change and
+/// isolation tests, the transducer's driver and checks, the record's
+/// health rows): measured at 77.7 KiB for `presets/paper-monitor.toml`,
+/// 15.3 KiB more than the board without it, so it cannot keep the 64 KiB
+/// of a part that small. The STM32F405 has 1 MiB of flash (every package:
+/// RM0090, DS8626), so the 64 KiB budget was a margin, not the part;
+/// 80 KiB keeps the monitor's image within a twelfth of it [bytes].
+pub const BUDGET_MONITOR_BOARD_FLASH: u64 = 80 * 1024;
+
 /// The flash budget of the image labelled `label` [bytes].
 pub fn flash_budget(label: &str) -> u64 {
     if label == super::QEMU_TWIN {
         BUDGET_QEMU_TWIN_FLASH
+    } else if label == super::MONITOR_BOARD {
+        BUDGET_MONITOR_BOARD_FLASH
     } else {
         BUDGET_FLASH
     }
@@ -57,6 +69,9 @@ pub const BUDGET_FIXED_RAM: u64 = 16 * 1024;
 #[derive(Debug, Clone)]
 pub struct EstimatorBudget {
     pub telemetry: bool,
+    /// With the condition monitor fitted (the images built for a second
+    /// sensor): its update in a job's place, the health rows in the record.
+    pub monitor: bool,
     /// The mean of the first workload (the step).
     pub mean: f64,
     /// The worst of every workload: what the budget bounds.
@@ -66,10 +81,11 @@ pub struct EstimatorBudget {
 impl EstimatorBudget {
     /// The row's name.
     pub fn what(&self) -> &'static str {
-        if self.telemetry {
-            "estimator tick with telemetry packing"
-        } else {
-            "estimator tick, no telemetry"
+        match (self.monitor, self.telemetry) {
+            (false, true) => "estimator tick with telemetry packing",
+            (false, false) => "estimator tick, no telemetry",
+            (true, true) => "estimator tick with the monitor, telemetry packing",
+            (true, false) => "estimator tick with the monitor, no telemetry",
         }
     }
 }
@@ -120,12 +136,23 @@ impl Budget {
     pub fn of(fw: &Firmware) -> Result<Budget, String> {
         let mut over = Vec::new();
         let mut estimator = Vec::new();
-        for telemetry in [true, false] {
-            let (mean, worst) = fw
-                .m4
-                .estimator("f32", telemetry)
-                .ok_or("the bench image reported no estimator tick cost")?;
-            let e = EstimatorBudget { telemetry, mean, worst };
+        let monitored = fw.monitor.iter().flat_map(|m| [(true, m), (false, m)]);
+        let rows = [true, false]
+            .into_iter()
+            .map(|t| (t, false, &fw.m4))
+            .chain(monitored.map(|(t, m)| (t, true, &m.costs)));
+        for (telemetry, monitor, costs) in rows {
+            let (mean, worst) = costs.estimator_with("f32", telemetry, monitor).ok_or(if monitor {
+                "the monitor's bench image reported no estimator tick cost with the monitor"
+            } else {
+                "the bench image reported no estimator tick cost"
+            })?;
+            let e = EstimatorBudget {
+                telemetry,
+                monitor,
+                mean,
+                worst,
+            };
             if e.worst > BUDGET_INSTRUCTIONS {
                 over.push(format!(
                     "{}: worst {:.0} instructions > {BUDGET_INSTRUCTIONS:.0}",
@@ -255,6 +282,7 @@ mod tests {
                     ram: 300,
                 },
             ],
+            monitor: None,
             cpi: None,
         }
     }
@@ -279,6 +307,44 @@ mod tests {
              | static RAM and peak stack, Cortex-M0 twin image | 300 + 5000 bytes | <= 16 KiB |\n\
              | peak stack, QEMU twin run (stack painting) | 4580 bytes | <= 6 KiB |\n"
         );
+    }
+
+    #[test]
+    fn the_monitors_rows_have_their_own_budgets() {
+        let mut fw = firmware(&[], 49766, 4580);
+        fw.monitor = Some(crate::bench::Monitored {
+            params: "paper-monitor.toml".into(),
+            costs: Costs::parse(&lines(&[
+                "[measure] estimator workload=step scheme=sdirk3 substeps=1 monitor=true telemetry=true ticks=1000 total=400000 worst=450 worst_tick=3",
+                "[measure] estimator workload=ramps scheme=sdirk3 substeps=1 monitor=true telemetry=true ticks=1000 total=400000 worst=510 worst_tick=3",
+                "[measure] estimator workload=step scheme=sdirk3 substeps=1 monitor=true telemetry=false ticks=1000 total=400000 worst=400 worst_tick=3",
+                "[measure] piece name=monitor-update-mean calls=400 total=68000",
+                "[measure] piece name=monitor-update-worst total=260",
+            ]))
+            .unwrap(),
+        });
+        fw.footprints.push(Footprint {
+            label: crate::bench::MONITOR_BOARD,
+            flash: 75_000,
+            ram: 1104,
+        });
+        let b = Budget::of(&fw).unwrap();
+        // The worst of both workloads with telemetry: 510 counts, 3060
+        // instructions; the board with the monitor within its 80 KiB.
+        assert_eq!(
+            b.over,
+            ["estimator tick with the monitor, telemetry packing: worst 3060 instructions > 3000"]
+        );
+        let table = budget_table(&fw, &b);
+        assert!(table.contains(
+            "| estimator tick with the monitor, telemetry packing, as built for paper-monitor.toml, Cortex-M4F f32 (step and ramps) | mean 2400, worst 3060 instructions | <= 3000 |"
+        ));
+        assert!(table.contains(
+            "| the monitor's update alone (one reading: filter, tests, isolation), Cortex-M4F f32 | mean 1020, worst 1560 instructions | measured (in a job's place) |"
+        ));
+        assert!(table.contains("| flash, board image with the monitor | 73.2 KiB | <= 80 KiB |"));
+        fw.footprints.last_mut().unwrap().flash = 90_000;
+        assert_eq!(Budget::of(&fw).unwrap().over.len(), 2);
     }
 
     #[test]

@@ -119,6 +119,8 @@ pub struct EstimatorCost {
     pub scalar: String,
     /// With telemetry packing.
     pub telemetry: bool,
+    /// With the condition monitor fitted and its sensor read.
+    pub monitor: bool,
     pub mean: f64,
     pub worst: f64,
 }
@@ -224,6 +226,7 @@ impl Costs {
                         // The Cortex-M4F's f32 twin unless the line says.
                         scalar: m.fields.get("scalar").map_or("f32", String::as_str).to_string(),
                         telemetry: m.str("telemetry") == "true",
+                        monitor: m.str("monitor") == "true",
                         mean: m.num("total")? * k / ticks,
                         worst: m.num("worst")? * k,
                     });
@@ -237,14 +240,26 @@ impl Costs {
     /// The estimator's mean over the first workload (the step) and worst
     /// over every workload, with its twin in `scalar`, with or without
     /// telemetry, if measured.
+    #[cfg_attr(not(feature = "host"), allow(dead_code, reason = "the host-only report's"))]
     pub fn estimator(&self, scalar: &str, telemetry: bool) -> Option<(f64, f64)> {
+        self.estimator_with(scalar, telemetry, false)
+    }
+
+    /// As [`Costs::estimator`], with the condition monitor fitted
+    /// (`monitor`) or without.
+    pub fn estimator_with(&self, scalar: &str, telemetry: bool, monitor: bool) -> Option<(f64, f64)> {
         let rows: Vec<_> = self
             .estimator
             .iter()
-            .filter(|e| e.scalar == scalar && e.telemetry == telemetry)
+            .filter(|e| e.scalar == scalar && e.telemetry == telemetry && e.monitor == monitor)
             .collect();
         let first = rows.first()?;
         Some((first.mean, rows.iter().map(|e| e.worst).fold(0.0, f64::max)))
+    }
+
+    /// One piece's cost (`[measure] piece name=...`), if measured.
+    pub fn piece(&self, name: &str) -> Option<f64> {
+        self.pieces.iter().find(|p| p.name == name).map(|p| p.instructions)
     }
 
     /// One operation's cost (`[measure] fixed name=...`), if measured.
@@ -331,6 +346,16 @@ pub(super) mod tests {
             e,
             [(true, 1800.0, 2400.0), (false, 1500.0, 1800.0), (false, 0.006, 2700.0)]
         );
+        // With the monitor: its own rows, not the plain estimator's.
+        let c = Costs::parse(&lines(&[
+            "INFO  [measure] estimator workload=step scheme=sdirk3 substeps=1 monitor=true telemetry=true ticks=1000 total=400000 worst=450 worst_tick=3",
+            "INFO  [measure] piece name=monitor-update-mean calls=400 total=40000",
+        ]))
+        .unwrap();
+        assert_eq!(c.estimator("f32", true), Some((1800.0, 2400.0)));
+        assert_eq!(c.estimator_with("f32", true, true), Some((2400.0, 2700.0)));
+        assert_eq!(c.estimator_with("f32", false, true), None);
+        assert_eq!(c.piece("monitor-update-mean"), Some(600.0));
     }
 
     #[test]

@@ -57,11 +57,65 @@ pub struct Firmware {
     /// The board image's, the QEMU twin image's, then the Cortex-M3 and
     /// Cortex-M0 twin images'.
     footprints: Vec<Footprint>,
+    /// The images built with the condition monitor: their bench on the
+    /// Cortex-M4F and their board image (`None`: not measured).
+    pub monitor: Option<Monitored>,
     /// Cycles per instruction of the estimator's tick on the Cortex-M4F,
     /// M3 and M0, lower and upper (`profile::cycles_per_instruction`;
     /// `None` where not measured).
     #[cfg_attr(not(feature = "host"), allow(dead_code, reason = "read by the host-only report"))]
     cpi: Option<[(f64, f64); 3]>,
+}
+
+/// What the images built with the condition monitor measured.
+pub struct Monitored {
+    /// The device file they were built for (file name).
+    pub params: String,
+    /// The Cortex-M4F bench image's costs (its `monitor=true` rows and
+    /// `monitor-update-*` pieces).
+    pub costs: Costs,
+}
+
+/// The device file the monitor's costs are measured with, unless the one
+/// given names a second sensor itself.
+pub const MONITOR_PRESET: &str = "presets/paper-monitor.toml";
+
+/// The footprint label of the board image with the monitor.
+pub const MONITOR_BOARD: &str = "board image with the monitor";
+
+/// The images the monitor's costs need, built for `params` when it names
+/// a second sensor, else for [`MONITOR_PRESET`]: the Cortex-M4F bench and
+/// the board, copied under `target/xtask/monitor/` (a build for another
+/// file writes the same paths). Build them after the other images have
+/// been measured or copied, or before they are built.
+pub fn monitor_images(
+    tc: &crate::toolchain::Toolchain,
+    root: &Path,
+    params: Option<&Path>,
+) -> Result<(PathBuf, Vec<(Image, PathBuf)>), String> {
+    let file = match params {
+        Some(p) if crate::firmware::names_second_sensor(Some(p)) => p.to_path_buf(),
+        _ => root.join(MONITOR_PRESET),
+    };
+    let mut elfs = Vec::new();
+    for img in [Image::BENCH_M4, Image::BOARD] {
+        eprintln!(
+            "xtask: building {} ({}, features {}) for {}",
+            img.bin,
+            img.target,
+            crate::firmware::features(&img, Some(&file)),
+            file.display()
+        );
+        let built = crate::firmware::build(tc, root, &img, Some(&file))?;
+        // Kept apart: the next build of the image for another file writes
+        // the same path (the plain images' footprints and benches must not
+        // read these).
+        let kept = root.join(format!("target/xtask/monitor/{}/{}", img.target, img.bin));
+        std::fs::create_dir_all(kept.parent().expect("has a parent")).map_err(|e| e.to_string())?;
+        std::fs::copy(&built, &kept).map_err(|e| format!("{}: {e}", kept.display()))?;
+        elfs.push((img, kept));
+    }
+    Ok((file, elfs))
 }
 
 /// The footprint label of the Cortex-M3 twin image.
@@ -74,7 +128,11 @@ pub const M0_TWIN: &str = "Cortex-M0 twin image";
 /// Runs the bench images on QEMU and reads the footprints. `twin_runs`:
 /// the output of twin runs already made (the snapshot check, the fixed-point
 /// cores' replays), else each twin is run here for its stack peak.
-pub fn measure_firmware(elfs: &[(Image, PathBuf)], twin_runs: &[(Image, Vec<String>)]) -> Result<Firmware, String> {
+pub fn measure_firmware(
+    elfs: &[(Image, PathBuf)],
+    twin_runs: &[(Image, Vec<String>)],
+    monitor: Option<&(PathBuf, Vec<(Image, PathBuf)>)>,
+) -> Result<Firmware, String> {
     let find = |img: Image| {
         elfs.iter()
             .find(|(i, _)| *i == img)
@@ -105,6 +163,26 @@ pub fn measure_firmware(elfs: &[(Image, PathBuf)], twin_runs: &[(Image, Vec<Stri
     ] {
         footprints.push(footprint(label, &find(img)?)?);
     }
+    let monitor = match monitor {
+        Some((file, elfs)) => {
+            let elf = |img: Image| {
+                elfs.iter()
+                    .find(|(i, _)| *i == img)
+                    .map(|(_, p)| p.clone())
+                    .ok_or_else(|| format!("missing the monitor's image {} ({})", img.bin, img.target))
+            };
+            let costs = Costs::parse(&run_image(&elf(Image::BENCH_M4)?, Image::BENCH_M4.machine())?)?;
+            footprints.push(footprint(MONITOR_BOARD, &elf(Image::BOARD)?)?);
+            Some(Monitored {
+                params: file
+                    .file_name()
+                    .map(|f| f.to_string_lossy().into_owned())
+                    .unwrap_or_default(),
+                costs,
+            })
+        }
+        None => None,
+    };
     Ok(Firmware {
         m4,
         m3,
@@ -112,6 +190,7 @@ pub fn measure_firmware(elfs: &[(Image, PathBuf)], twin_runs: &[(Image, Vec<Stri
         stack,
         fixed_stacks,
         footprints,
+        monitor,
         cpi: None,
     })
 }
@@ -126,8 +205,11 @@ pub fn cmd(root: &Path, params: Option<&Path>, write: bool) -> Result<i32, Strin
     let tc = crate::toolchain::get(root, &crate::firmware::TARGETS)?;
     eprintln!("xtask: toolchain: {}", tc.description);
     qemu::ensure()?;
+    // The monitor's images first: they are copied away, and the builds
+    // after them write the plain images' paths again.
+    let monitor = monitor_images(&tc, root, params)?;
     let elfs = crate::firmware::build_all_params(&tc, root, params)?;
-    let mut fw = measure_firmware(&elfs, &[])?;
+    let mut fw = measure_firmware(&elfs, &[], Some(&monitor))?;
     let mut cpi = [(f64::NAN, f64::NAN); 3];
     for (c, target) in cpi
         .iter_mut()
@@ -154,9 +236,14 @@ pub fn cmd(root: &Path, params: Option<&Path>, write: bool) -> Result<i32, Strin
 /// The budget check of `cargo xtask test` (firmware measurements only; the
 /// accuracy tables are `cargo xtask bench`'s). `twin_runs`: the output of
 /// the twin runs made (the snapshot run, the fixed-point cores' replays),
-/// for the stack peaks.
-pub fn check(elfs: &[(Image, PathBuf)], twin_runs: &[(Image, Vec<String>)]) -> Result<(), String> {
-    let fw = measure_firmware(elfs, twin_runs)?;
+/// for the stack peaks; `monitor`: the images built with the monitor
+/// ([`monitor_images`]).
+pub fn check(
+    elfs: &[(Image, PathBuf)],
+    twin_runs: &[(Image, Vec<String>)],
+    monitor: &(PathBuf, Vec<(Image, PathBuf)>),
+) -> Result<(), String> {
+    let fw = measure_firmware(elfs, twin_runs, Some(monitor))?;
     let budget = Budget::of(&fw)?;
     eprint!("{}", report::budget_table(&fw, &budget));
     if budget.over.is_empty() {

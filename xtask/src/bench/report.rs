@@ -20,12 +20,25 @@ pub fn budget_table(fw: &Firmware, budget: &Budget) -> String {
     let mut t = String::new();
     let _ = writeln!(t, "| what | measured | goal |\n| --- | --- | --- |");
     for e in &budget.estimator {
+        let built = match (&fw.monitor, e.monitor) {
+            (Some(m), true) => format!(", as built for {}", m.params),
+            _ => String::new(),
+        };
         let _ = writeln!(
             t,
-            "| {}, Cortex-M4F f32 (step and ramps) | mean {:.0}, worst {:.0} instructions | <= {BUDGET_INSTRUCTIONS:.0} |",
+            "| {}{built}, Cortex-M4F f32 (step and ramps) | mean {:.0}, worst {:.0} instructions | <= {BUDGET_INSTRUCTIONS:.0} |",
             e.what(),
             e.mean,
             e.worst
+        );
+    }
+    if let Some(m) = &fw.monitor {
+        let piece = |name: &str| m.costs.piece(name).unwrap_or(f64::NAN);
+        let _ = writeln!(
+            t,
+            "| the monitor's update alone (one reading: filter, tests, isolation), Cortex-M4F f32 | mean {:.0}, worst {:.0} instructions | measured (in a job's place) |",
+            piece("monitor-update-mean"),
+            piece("monitor-update-worst")
         );
     }
     let twin = &budget.twin;
@@ -245,14 +258,15 @@ pub fn operations_section(fw: &Firmware) -> String {
 /// sending the record), from the bench image's pieces.
 #[cfg(feature = "host")]
 fn telemetry_section(m4: &Costs) -> String {
-    use compensator::estimator::telemetry::{Encoding, FIELDS, SIZE};
+    use compensator::estimator::telemetry::{Encoding, FIELDS, HEALTH_FROM, SIZE, SIZE_MONITOR};
     let piece = |name: &str| m4.pieces.iter().find(|p| p.name == name).map(|p| p.instructions);
     let mut t = String::new();
     let _ = writeln!(t, "\n## Telemetry record (Cortex-M4F)\n");
     let _ = writeln!(
         t,
-        "The record (`model/src/estimator/telemetry.rs`) is {SIZE} bytes: a 2-byte layout tag, {} fields, \
-         the 2-byte flags. Sending it whole (`telemetry`: packing and the defmt frame through the QEMU \
+        "The record (`model/src/estimator/telemetry.rs`) is {SIZE} bytes: a 2-byte layout tag, {HEALTH_FROM} fields, \
+         the 4-byte flags ({SIZE_MONITOR} bytes and {} fields in an image with the condition monitor, whose \
+         health parameters it adds). Sending it whole (`telemetry`: packing and the defmt frame through the QEMU \
          logger) costs {:.0} instructions, packing alone (`telemetry-pack`) {:.0}. A field costs its \
          encoding plus its bytes at `telemetry-byte` each (the QEMU logger's copy into its frame buffer; on the board, defmt-rtt's copy into its ring buffer):\n",
         FIELDS.len(),
