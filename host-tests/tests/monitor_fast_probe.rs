@@ -123,7 +123,11 @@ fn innovations_are_white_for_every_probe() {
             assert!(t.alarm.is_none(), "{what}: {:?}", t.alarm);
             assert!(mean.abs() < 0.05, "{what}");
             assert!((0.85..1.15).contains(&var), "{what}");
-            assert!(lag1.abs() < 0.08, "{what}");
+            // A positive correlation lengthens the CUSUM's runs (the
+            // variance of a sum of n innovations is about n (1 + 2 lag-1));
+            // a negative one shortens them, and only a large one would
+            // say the innovation's variance is modelled wrong.
+            assert!((-0.15..0.08).contains(&lag1), "{what}");
         }
     }
 }

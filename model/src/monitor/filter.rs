@@ -249,6 +249,43 @@ impl HealthFilter {
         self.p[NOISE][NOISE] = v;
     }
 
+    /// Projects the estimate onto `lo <= theta_i <= hi` when it has left
+    /// it: every state moves by its regression on `theta_i`,
+    /// `-P[:, i] / P[i][i] (theta_i - bound)` (the estimate projection of
+    /// D. Simon and T. L. Chia, "Kalman filtering with state equality
+    /// constraints", IEEE Trans. AES 38(1), 2002, with `W = P^-1`), so that
+    /// the parameters correlated with it go back with it; the covariance
+    /// stands. Returns the change of the health parameters (zero inside
+    /// the bounds).
+    pub fn project(&mut self, i: usize, lo: f32, hi: f32) -> [f32; PARAMETERS] {
+        let mut change = [0.0; PARAMETERS];
+        let v = self.theta[i];
+        let excess = if v > hi {
+            v - hi
+        } else if v < lo {
+            v - lo
+        } else {
+            return change;
+        };
+        let pii = self.p[i][i];
+        for j in 0..STATES {
+            let c = if j == i {
+                -excess
+            } else if pii > 0.0 {
+                -self.p[j][i] / pii * excess
+            } else {
+                0.0
+            };
+            if c.is_finite() {
+                self.theta[j] += c;
+                if j < PARAMETERS {
+                    change[j] = c;
+                }
+            }
+        }
+        change
+    }
+
     /// Moves parameter `i` by `by` (a change isolated and sized by the
     /// tests).
     pub fn shift(&mut self, i: usize, by: f32) {
@@ -292,6 +329,36 @@ mod tests {
 
     /// A Gauss-Markov parameter forgets: its estimate decays, its variance
     /// tends to the stationary one, its correlations fade.
+    #[test]
+    fn a_projection_takes_the_correlated_parameters_back_along() {
+        let mut f = HealthFilter::new([0.1, 0.05, 1.0, 0.5, 1.0], [0.0; PARAMETERS]);
+        // One reading that cannot tell parameter 0 from parameter 3: their
+        // estimates become correlated (negatively, for equal signs).
+        let mut h = [0.0; STATES];
+        h[0] = 1.0;
+        h[3] = 1.0;
+        let s = f.innovation_variance(&h) + 1e-4;
+        f.update(&h, 5.0, s);
+        let before = f.theta();
+        assert!(before[3] > 1.0, "{before:?}");
+        let change = f.project(3, -1.0, 1.0);
+        let after = f.theta();
+        assert!((after[3] - 1.0).abs() < 1e-6, "{after:?}");
+        // The regression of parameter 0 on parameter 3, P[0][3] / P[3][3],
+        // is negative after such a reading: it moves the other way.
+        let p = f.covariance();
+        let expected = -p[0][3] / p[3][3] * (before[3] - 1.0);
+        assert!(expected > 0.0);
+        assert!(
+            (change[0] - expected).abs() < 1e-5 * expected.abs().max(1.0),
+            "{change:?} {expected}"
+        );
+        assert!((after[0] - before[0] - expected).abs() < 1e-5, "{after:?}");
+        // Inside the bounds nothing moves.
+        assert_eq!(f.project(3, -1.0, 1.0), [0.0; PARAMETERS]);
+        assert_eq!(f.theta(), after);
+    }
+
     #[test]
     fn decay_forgets_towards_the_stationary_variance() {
         let mut f = HealthFilter::new([1.0, 0.5, 1.0, 1.0, 0.1], [0.0; PARAMETERS]);
