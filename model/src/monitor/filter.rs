@@ -260,27 +260,24 @@ impl HealthFilter {
     pub fn project(&mut self, i: usize, lo: f32, hi: f32) -> [f32; PARAMETERS] {
         let mut change = [0.0; PARAMETERS];
         let v = self.theta[i];
-        let excess = if v > hi {
-            v - hi
+        let excess = v - if v > hi {
+            hi
         } else if v < lo {
-            v - lo
+            lo
         } else {
-            return change;
+            v
         };
         let pii = self.p[i][i];
+        // Inside the bounds, NaN, or a parameter the readings fixed exactly.
+        if !(excess != 0.0 && pii > 0.0) {
+            return change;
+        }
+        let k = excess / pii;
         for j in 0..STATES {
-            let c = if j == i {
-                -excess
-            } else if pii > 0.0 {
-                -self.p[j][i] / pii * excess
-            } else {
-                0.0
-            };
-            if c.is_finite() {
-                self.theta[j] += c;
-                if j < PARAMETERS {
-                    change[j] = c;
-                }
+            let c = if j == i { -excess } else { -self.p[j][i] * k };
+            self.theta[j] += c;
+            if j < PARAMETERS {
+                change[j] = c;
             }
         }
         change
