@@ -273,6 +273,9 @@ impl HealthFilter {
             return change;
         }
         let k = excess / pii;
+        // `j` indexes the estimate, the covariance's column and the
+        // parameters' change alike (the change only below PARAMETERS).
+        #[allow(clippy::needless_range_loop)]
         for j in 0..STATES {
             let c = if j == i { -excess } else { -self.p[j][i] * k };
             self.theta[j] += c;
