@@ -528,6 +528,11 @@ struct Pending {
     step: bool,
     /// The probe's reading to test, and the twin's oil temperature \[C\].
     test: Option<(ProbeSample, f32)>,
+    /// The hypotheses' signatures of this reading at the filter's
+    /// parameters (their derivatives, `inv dy/dtheta`), zero for a reading
+    /// that does not inform: what a change's test seeds the signatures'
+    /// lag with when it starts at this reading.
+    onset: [f32; HYPOTHESES],
     /// The reading's prediction, the second sensor's temperature \[C\],
     /// its flags so far and the twin's oil temperature \[C\]; `None`:
     /// nothing pending.
@@ -552,6 +557,7 @@ impl Pending {
         signatures: None,
         step: false,
         test: None,
+        onset: [0.0; HYPOTHESES],
         estimate: None,
     };
 }
@@ -740,7 +746,8 @@ impl Monitor {
             self.pending.step = false;
         }
         if let Some((sample, t)) = self.pending.test.take() {
-            self.test(sample, t, &mut estimate, &mut flags);
+            let onset = self.pending.onset;
+            self.test(sample, t, &onset, &mut estimate, &mut flags);
         }
         self.pending = Pending::NONE;
         Some(self.publish(estimate, flags, t_twin))
@@ -813,6 +820,7 @@ impl Monitor {
         let mut u = [0.0f32; SIGNALS];
         u[OIL] = t_twin;
         let mut signatures = None;
+        let mut onset = [0.0f32; HYPOTHESES];
         let informed = match reading {
             Some(y)
                 if sd_t < MAX_TEMPERATURE_SD
@@ -825,6 +833,15 @@ impl Monitor {
                 u[OIL] = t_twin + d;
                 for k in 0..=OFFSET {
                     u[D_THETA + k] = jacobian[k] * inv;
+                }
+                for (o, h) in onset.iter_mut().zip(Hypothesis::ALL) {
+                    let k = h.parameter();
+                    let g = if k == PARAMETERS {
+                        sticking
+                    } else {
+                        jacobian[k] * h.sign()
+                    };
+                    *o = g * inv;
                 }
                 if self.running() {
                     signatures = Some(SignatureInputs {
@@ -905,6 +922,7 @@ impl Monitor {
             signatures: if step { signatures } else { None },
             step,
             test: view.probe.map(|sample| (sample, t_twin)),
+            onset,
             estimate: Some((estimate.predicted, estimate.oil, flags, t_twin)),
         };
     }
@@ -947,7 +965,14 @@ impl Monitor {
     /// The probe's reading `sample` against the lagged temperature: the
     /// tests, then the filter (see the module docs, steps 3-5). `t_oil` is
     /// the twin's oil temperature \[C\].
-    fn test(&mut self, sample: ProbeSample, t_oil: f32, estimate: &mut HealthEstimate, flags: &mut Flags) {
+    fn test(
+        &mut self,
+        sample: ProbeSample,
+        t_oil: f32,
+        onset: &[f32; HYPOTHESES],
+        estimate: &mut HealthEstimate,
+        flags: &mut Flags,
+    ) {
         let probe = self.settings.probe;
         let uninformed = self.lag.probe(UNINFORMED);
         if !(uninformed <= MAX_UNINFORMED) || !sample.value.is_finite() {
@@ -998,9 +1023,18 @@ impl Monitor {
             self.energy = 0.0;
             self.test_held = f32::NAN;
             self.window = (t_oil, t_oil);
+            // The change's onset is taken between the last reading and this
+            // one (where the CUSUM last stood at zero, Page's estimate):
+            // the innovation holds one step of the lag's response to it, and
+            // so must the signatures, or the first readings' fit, far above
+            // the noise for a large change, favours whichever hypothesis'
+            // shape the missing step happens to resemble.
+            let mut u = [0.0f32; SIGNALS];
             for i in 0..HYPOTHESES {
                 self.lag.clear(SIGNATURE + i);
+                u[SIGNATURE + i] = onset[i];
             }
+            self.lag.step_signals(&u, &self.decay, SIGNATURE..UNINFORMED);
         }
         let zc = clamp(z, -CUSUM_CLIP, CUSUM_CLIP);
         self.cusum[0] = clamp(self.cusum[0] + zc - CUSUM_DRIFT, 0.0, f32::MAX);
