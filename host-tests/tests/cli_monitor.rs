@@ -38,7 +38,12 @@ type Row = (f64, Option<f64>, Option<f64>);
 
 /// The scenario's records as log rows: every tick with a reading.
 fn scenario_rows(raw: &RawParams) -> Vec<Row> {
-    let sensor = SecondSensor::default_for(Quantity::PA, &raw.core);
+    // The transducer as the file describes it (`monitor.noise`): with a
+    // fast probe the monitor's test is only as good as that noise.
+    let sensor = SecondSensor {
+        noise_sd: raw.monitor.noise,
+        ..SecondSensor::default_for(Quantity::PA, &raw.core)
+    };
     let injection = Injection {
         fault: Fault::CapillaryRestricted(0.8),
         onset: 60.0,

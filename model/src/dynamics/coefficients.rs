@@ -203,6 +203,15 @@ impl<F: Float> Model<F> {
         })
     }
 
+    /// The chamber rates `omega_a0`, `omega_b0` in the flow unit `2^shift
+    /// Q*`, in `F`: what [`Coefficients::omega_a0`] and
+    /// [`Coefficients::omega_b0`] are before a fixed-point twin saturates
+    /// them (a product each, no `f64`).
+    pub fn chamber_rates(&self, shift: u8) -> [F; 2] {
+        let s = F::from_f64((1u32 << shift) as f64);
+        [self.omega[0] * s, self.omega[1] * s]
+    }
+
     /// The parameters.
     pub fn params(&self) -> &Params<F> {
         &self.params

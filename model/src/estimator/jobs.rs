@@ -2,7 +2,7 @@
 //! that is neither a telemetry tick nor an eventful one, in turn (the
 //! rotation is the estimator's, in the parent module).
 
-use super::stability::{quartic_hurwitz, slowest_decay_rate};
+use super::stability::{DecaySearch, quartic_hurwitz, slowest_decay_rate};
 use super::{MAX_STOP_SETTLE, MIN_SETTLE_TICKS, SETTLE_TIME_CONSTANTS, STOP_SETTLE_TIME_CONSTANTS, TWIN_SLEW};
 use crate::asymptotic;
 use crate::compensation;
@@ -184,6 +184,14 @@ fn move_oil<T: Real>(
     target: f32,
     slew: f32,
 ) -> Result<(), ModelError> {
+    let point = slewed_point(p, statics, target, slew)?;
+    apply(p, twin, design, statics, point)
+}
+
+/// The oil the twin moves to towards `target` \[C\] ([`move_oil`]'s first
+/// half: the oil's properties there, `statics.slewing` set).
+#[inline(always)]
+fn slewed_point(p: &Params<f32>, statics: &mut Statics, target: f32, slew: f32) -> Result<FluidPoint<f32>, ModelError> {
     let prev = &statics.point;
     let now = prev.state.temperature;
     let dln_mu = libm::fabsf(prev.viscosity.d1 / prev.viscosity.value + prev.density.d1 / prev.density.value);
@@ -191,7 +199,7 @@ fn move_oil<T: Real>(
     let step = super::clamp(target - now, -max_step, max_step);
     let point = p.oil.point(now + step)?;
     statics.slewing = step != target - now;
-    apply(p, twin, design, statics, point)
+    Ok(point)
 }
 
 /// The twin's oil and the flow laws at `t` \[C\] at once (the Fluid job's
@@ -228,6 +236,170 @@ fn apply<T: Real>(
     Ok(())
 }
 
+/// Routh-Hurwitz tests per slice of the Stability job's decay-rate search
+/// on a core without an FPU ([`Pending::Search`]): the usual case, the
+/// hint confirmed, is one slice; a whole search (at most ten tests) four.
+pub(super) const SEARCH_STEPS: u32 = 3;
+
+/// The characteristic polynomial of the linearisation at the equilibrium
+/// (in the twin's model units), in `f32` whatever the twin's scalar. A
+/// fixed-point twin's chamber rates are stored saturated
+/// (`Coefficients::omega_a0`), so the model's are put in their place: a
+/// product each, where forming every coefficient again from the model took
+/// `f64` arithmetic (about 8,000 software-float instructions on a
+/// Cortex-M0); the others are the twin's own.
+#[inline(always)]
+fn stability_polynomial<T: Real>(twin: &Twin<f32, T>, statics: &Statics) -> [f32; 4] {
+    characteristic_polynomial(&stability_jacobian(twin, statics))
+}
+
+/// The Jacobian whose characteristic polynomial [`stability_polynomial`] is.
+#[inline(always)]
+fn stability_jacobian<T: Real>(twin: &Twin<f32, T>, statics: &Statics) -> [[f32; 4]; 4] {
+    let mut coefficients = twin.coefficients().to_f32();
+    if T::SATURATES {
+        [coefficients.omega_a0, coefficients.omega_b0] = twin.model().chamber_rates(coefficients.flow_shift);
+    }
+    let sys = Fsi {
+        coefficients: &coefficients,
+        contact: Contact::Free,
+    };
+    sys.jacobian(&statics.y_equilibrium)
+}
+
+/// The Stability job's results from the slowest decay rate `sigma` (in the
+/// twin's time unit; 0: none, not stable): its time constant and the
+/// consistency check's settling window.
+#[inline(always)]
+fn set_decay_rate<T: Real>(twin: &Twin<f32, T>, statics: &mut Statics, sigma: f32) {
+    statics.slowest_rate = sigma;
+    if sigma > 0.0 {
+        statics.slowest_time_constant = twin.model().scales.time / sigma;
+        let tau = statics.slowest_time_constant;
+        let mut window = SETTLE_TIME_CONSTANTS * tau;
+        if statics.on_closed_stop {
+            window = window.max((STOP_SETTLE_TIME_CONSTANTS * tau).min(MAX_STOP_SETTLE));
+        }
+        let ticks = window * statics.ticks_per_second;
+        // Saturating conversion; NaN is impossible here (sigma > 0).
+        statics.settle_ticks = if ticks < u32::MAX as f32 {
+            (ticks as u32).saturating_add(1).max(MIN_SETTLE_TICKS)
+        } else {
+            u32::MAX
+        };
+    } else {
+        statics.slowest_time_constant = f32::INFINITY;
+        statics.settle_ticks = u32::MAX;
+    }
+}
+
+/// What the next job tick runs in place of the rotation's next job, on a
+/// core without an FPU: the rest of a job whose whole would cost a tick
+/// several times the twin's (in software `f32` on a Cortex-M0: the
+/// Fluid job about 19,000 instructions, the Equilibrium job 18,000, the Stability job's
+/// linearisation 20,000 and its decay-rate search up to 27,000).
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Pending {
+    /// The Fluid job's new oil, for the twin and the flow laws ([`apply`]).
+    Apply(FluidPoint<f32>),
+    /// The Equilibrium job's `dx/dt` ([`asymptotic::sensitivity_at`]).
+    Sensitivity,
+    /// The Stability job's Jacobian at the equilibrium, whose
+    /// characteristic polynomial and Routh-Hurwitz verdict are next.
+    Jacobian([[f32; 4]; 4]),
+    /// The Stability job's decay-rate search.
+    Search(DecaySearch),
+}
+
+/// The first slice of `job` on a core without an FPU: the Fluid job's
+/// oil properties at the slewed temperature (the twin's and the flow laws'
+/// next), the Equilibrium job's closed form (its results published at once; `dx/dt` next), the
+/// Stability job's Jacobian; another job whole ([`run`]). `Ok(Some)`: the
+/// continuation the next job tick runs ([`resume`]).
+#[allow(clippy::too_many_arguments, reason = "the tick's state, borrowed apart")]
+pub(super) fn start<T: Real>(
+    job: Job,
+    p: &Params<f32>,
+    table: &UncertaintyTable,
+    twin: &mut Twin<f32, T>,
+    design: Design,
+    t: f32,
+    variance: impl FnOnce() -> f32,
+    statics: &mut Statics,
+) -> Result<Option<Pending>, ModelError> {
+    match job {
+        Job::Fluid => Ok(Some(Pending::Apply(slewed_point(p, statics, t, TWIN_SLEW)?))),
+        Job::Equilibrium => {
+            equilibrium(p, twin, statics)?;
+            Ok(Some(Pending::Sensitivity))
+        }
+        Job::Stability => Ok(Some(Pending::Jacobian(stability_jacobian(twin, statics)))),
+        _ => run(job, p, table, twin, design, t, variance, statics).map(|()| None),
+    }
+}
+
+/// The next slice of a job begun by [`start`]: the job it belongs to, and
+/// what follows it (`Ok(None)`: the job is done).
+pub(super) fn resume<T: Real>(
+    pending: Pending,
+    p: &Params<f32>,
+    twin: &mut Twin<f32, T>,
+    design: Design,
+    statics: &mut Statics,
+) -> (Job, Result<Option<Pending>, ModelError>) {
+    match pending {
+        Pending::Apply(point) => (Job::Fluid, apply(p, twin, design, statics, point).map(|()| None)),
+        Pending::Sensitivity => (
+            Job::Equilibrium,
+            asymptotic::sensitivity_at(p, &statics.point).map(|s| {
+                statics.dx_dt = s.dx_dt;
+                None
+            }),
+        ),
+        Pending::Jacobian(m) => {
+            let poly = characteristic_polynomial(&m);
+            statics.stable = quartic_hurwitz(&poly);
+            let next = if statics.stable {
+                Some(Pending::Search(DecaySearch::new(&poly, statics.slowest_rate)))
+            } else {
+                set_decay_rate(twin, statics, 0.0);
+                None
+            };
+            (Job::Stability, Ok(next))
+        }
+        Pending::Search(mut search) => {
+            let mut done = None;
+            for _ in 0..SEARCH_STEPS {
+                done = search.step();
+                if done.is_some() {
+                    break;
+                }
+            }
+            let next = match done {
+                Some(sigma) => {
+                    set_decay_rate(twin, statics, sigma);
+                    None
+                }
+                None => Some(Pending::Search(search)),
+            };
+            (Job::Stability, Ok(next))
+        }
+    }
+}
+
+/// The Equilibrium job's closed form at the twin's oil: the equilibrium,
+/// in SI and in the twin's model units, and whether it holds the plunger
+/// on the closed stop.
+#[inline(always)]
+fn equilibrium<T: Real>(p: &Params<f32>, twin: &Twin<f32, T>, statics: &mut Statics) -> Result<(), ModelError> {
+    let point = &statics.point;
+    let eq = equilibrium_for(p, point.state, a_parameter(p, &point.state))?;
+    statics.x_equilibrium = eq.x;
+    statics.y_equilibrium = twin.model().equilibrium_state(&eq);
+    statics.on_closed_stop = eq.stop == Stop::Closed;
+    Ok(())
+}
+
 /// Runs `job` at the estimated oil temperature `t` \[C\], updating
 /// `statics`; `variance` gives the oil temperature's variance \[C^2\] for
 /// the Uncertainty job (the table's input). On an error the job's previous
@@ -261,45 +433,14 @@ pub(super) fn run<T: Real>(
             statics.on_closed_stop = eq.stop == Stop::Closed;
         }
         Job::Stability => {
-            // In f32 whatever the twin's scalar: the linearisation reads
-            // the chamber rates, which fixed point stores saturated
-            // (`Coefficients::omega_a0`), so a fixed-point twin's are
-            // formed again from the model.
-            let coefficients = if T::SATURATES {
-                twin.model().coefficients::<f32>(&statics.point.state)?
-            } else {
-                twin.coefficients().to_f32()
-            };
-            let sys = Fsi {
-                coefficients: &coefficients,
-                contact: Contact::Free,
-            };
-            let poly = characteristic_polynomial(&sys.jacobian(&statics.y_equilibrium));
+            let poly = stability_polynomial(twin, statics);
             statics.stable = quartic_hurwitz(&poly);
             let sigma = if statics.stable {
                 slowest_decay_rate(&poly, statics.slowest_rate)
             } else {
                 0.0
             };
-            statics.slowest_rate = sigma;
-            if sigma > 0.0 {
-                statics.slowest_time_constant = twin.model().scales.time / sigma;
-                let tau = statics.slowest_time_constant;
-                let mut window = SETTLE_TIME_CONSTANTS * tau;
-                if statics.on_closed_stop {
-                    window = window.max((STOP_SETTLE_TIME_CONSTANTS * tau).min(MAX_STOP_SETTLE));
-                }
-                let ticks = window * statics.ticks_per_second;
-                // Saturating conversion; NaN is impossible here (sigma > 0).
-                statics.settle_ticks = if ticks < u32::MAX as f32 {
-                    (ticks as u32).saturating_add(1).max(MIN_SETTLE_TICKS)
-                } else {
-                    u32::MAX
-                };
-            } else {
-                statics.slowest_time_constant = f32::INFINITY;
-                statics.settle_ticks = u32::MAX;
-            }
+            set_decay_rate(twin, statics, sigma);
         }
         Job::Losses => {
             statics.losses = match &p.machine {

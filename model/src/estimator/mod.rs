@@ -30,7 +30,11 @@
 //!    Each result is thus refreshed every five job ticks (5 ms at the
 //!    default 1 kHz and 2 Hz telemetry), while the oil's temperature
 //!    changes over seconds. A job the model refuses keeps its previous
-//!    results and flags the estimate `DEGRADED` until it succeeds again;
+//!    results and flags the estimate `DEGRADED` until it succeeds again.
+//!    Where the twin is fixed point (the cores without an FPU, whose `f32`
+//!    is software) the Fluid, Equilibrium and Stability jobs run in slices
+//!    on consecutive job ticks ([`Plant::run_job`]), so that no tick
+//!    carries a whole job;
 //! 5. flows and the compensation error follow from the twin's state.
 //!
 //! The pieces, one concept per file: [`EstimatorConfig`] and its

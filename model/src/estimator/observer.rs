@@ -527,30 +527,27 @@ impl ObserverDesign {
         if p < last { p / last } else { 1.0 }
     }
 
-    /// The gains `ticks` after a change: the schedule's entries around
-    /// `sqrt(ticks schedule_rate)`, each constant interpolated linearly.
-    fn at(&self, ticks: u32) -> ModeGains {
+    /// The constants `pick` takes of the schedule's entries `ticks` after
+    /// a change: the entries around `sqrt(ticks schedule_rate)`, each
+    /// constant interpolated linearly. Only what the caller uses is
+    /// interpolated (a reading's update needs five of the nine constants,
+    /// the variance the other four: on a core without an FPU each is a
+    /// software subtraction, product and sum).
+    #[inline]
+    fn at<const N: usize>(&self, ticks: u32, pick: impl Fn(&ModeGains) -> [f32; N]) -> [f32; N] {
         let last = SCHEDULE - 1;
         let p = (ticks as f32 * self.schedule_rate).sqrt();
         if !(p < last as f32) {
-            return self.schedule[last];
+            return pick(&self.schedule[last]);
         }
         let j = (p as usize).min(last - 1);
         let m = p - j as f32;
-        let (h, f) = (&self.schedule[j], &self.schedule[j + 1]);
-        let lerp = |a: f32, b: f32| a + m * (b - a);
-        let mut gain = [0.0; 4];
-        for (i, g) in gain.iter_mut().enumerate() {
-            *g = lerp(h.gain[i], f.gain[i]);
+        let (h, f) = (pick(&self.schedule[j]), pick(&self.schedule[j + 1]));
+        let mut out = h;
+        for (o, (a, b)) in out.iter_mut().zip(h.iter().zip(f.iter())) {
+            *o = a + m * (b - a);
         }
-        ModeGains {
-            gain,
-            inv_innovation_sd: lerp(h.inv_innovation_sd, f.inv_innovation_sd),
-            var_oil: lerp(h.var_oil, f.var_oil),
-            cov_oil_rate: lerp(h.cov_oil_rate, f.cov_oil_rate),
-            var_rate: lerp(h.var_rate, f.var_rate),
-            q: lerp(h.q, f.q),
-        }
+        out
     }
 }
 
@@ -652,9 +649,10 @@ impl OilObserver {
     /// expects, as after a jump of the oil it does not describe, say that
     /// the estimate is worse than the steady state's variance).
     pub fn variance(&self, design: &ObserverDesign) -> f32 {
-        let g = design.at(self.since_alarm);
+        let [var_oil, cov_oil_rate, var_rate, q] =
+            design.at(self.since_alarm, |g| [g.var_oil, g.cov_oil_rate, g.var_rate, g.q]);
         let t = self.since_reading as f32 * design.tick;
-        let steady = g.var_oil + t * (2.0 * g.cov_oil_rate + t * (g.var_rate + t * g.q * (1.0 / 3.0)));
+        let steady = var_oil + t * (2.0 * cov_oil_rate + t * (var_rate + t * q * (1.0 / 3.0)));
         steady * self.innovations.max(1.0)
     }
 
@@ -700,24 +698,27 @@ impl OilObserver {
             }
             Verdict::Accepted => {}
         }
-        let g = design.at(self.since_alarm);
+        let [g0, g1, g2, g3, inv_innovation_sd] = design.at(self.since_alarm, |g| {
+            let [g0, g1, g2, g3] = g.gain;
+            [g0, g1, g2, g3, g.inv_innovation_sd]
+        });
         let nu = y - self.probe;
-        self.oil = self.oil.mul_add_compensated(g.gain[0], nu, &mut self.oil_carry);
-        self.rate = self.rate.mul_add_compensated(g.gain[1], nu, &mut self.rate_carry);
+        self.oil = self.oil.mul_add_compensated(g0, nu, &mut self.oil_carry);
+        self.rate = self.rate.mul_add_compensated(g1, nu, &mut self.rate_carry);
         let limit = design.rate_limit;
         if !(libm::fabsf(self.rate) <= limit) {
             self.rate = if self.rate > 0.0 { limit } else { -limit };
             self.rate_carry = 0.0;
         }
         if design.well {
-            self.well = self.well.mul_add_compensated(g.gain[2], nu, &mut self.well_carry);
+            self.well = self.well.mul_add_compensated(g2, nu, &mut self.well_carry);
         } else {
             self.well = self.oil;
         }
-        self.probe = self.probe.mul_add_compensated(g.gain[3], nu, &mut self.probe_carry);
+        self.probe = self.probe.mul_add_compensated(g3, nu, &mut self.probe_carry);
         // The innovations' CUSUM: a shift in their mean is a change the
         // current mode does not follow.
-        let u = nu * g.inv_innovation_sd;
+        let u = nu * inv_innovation_sd;
         self.innovations += (u * u - self.innovations) * design.innovation_weight;
         self.cusum_up = (self.cusum_up + u - CUSUM_DRIFT).max(0.0);
         self.cusum_down = (self.cusum_down - u - CUSUM_DRIFT).max(0.0);

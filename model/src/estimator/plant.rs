@@ -10,10 +10,12 @@
 //!
 //! Cost: [`Plant::advance`] is one twin tick ([`Twin::tick`]),
 //! [`Plant::run_job`] one job (the largest, Stability, about 500
-//! Cortex-M4F instructions: `docs/profile.md`), [`Plant::estimate`] three
+//! Cortex-M4F instructions: `docs/profile.md`; with a fixed-point twin, on
+//! the cores without an FPU, one slice of a job: `jobs::Pending`),
+//! [`Plant::estimate`] three
 //! flow laws and a few products. Nothing allocates or panics.
 
-use super::jobs::{self, Design, Job, Statics};
+use super::jobs::{self, Design, Job, Pending, Statics};
 use super::{EstimatorConfig, Flags, ObserverDesign, P_TOLERANCE, STEADY_BAND, StateEstimate, X_TOLERANCE};
 use crate::asymptotic;
 use crate::dynamics::{DynamicState, Twin, TwinMemory};
@@ -57,6 +59,9 @@ pub struct Plant<T = f32> {
     failed_jobs: u8,
     /// The job of the next [`Plant::run_job`].
     next_job: Job,
+    /// The rest of a job under way, on a core without an FPU: the next job
+    /// tick runs it (`jobs::resume`) in place of the rotation's next job.
+    pending: Option<Pending>,
     /// The twin's temperature at the start of the current steady stretch \[C\].
     steady_anchor: f32,
     /// Job ticks the twin's temperature stayed within [`STEADY_BAND`] of
@@ -124,6 +129,7 @@ impl<T: Real> Plant<T> {
             statics,
             failed_jobs: 0,
             next_job: Job::Fluid,
+            pending: None,
             steady_anchor: initial,
             steady_ticks: 0,
             reseats: 0,
@@ -250,6 +256,7 @@ impl<T: Real> Plant<T> {
             Ok(()) => {
                 self.statics = statics;
                 self.failed_jobs = 0;
+                self.pending = None;
             }
             Err(_) => self.failed_jobs |= Job::Fluid.bit(),
         }
@@ -290,7 +297,10 @@ impl<T: Real> Plant<T> {
     /// variance from `variance` \[C^2\] for the Uncertainty job; then, after
     /// an Equilibrium job, the consistency check. A job the model refuses
     /// leaves its previous results in force, and the estimates `DEGRADED`
-    /// until it succeeds again.
+    /// until it succeeds again. With a fixed-point twin (the cores without
+    /// an FPU) the Fluid, Equilibrium and Stability jobs run in slices, one
+    /// a call: a job's rest runs before the rotation's next job, and each
+    /// result is published when its slice ends.
     pub fn run_job(&mut self, table: &UncertaintyTable, t: f32, variance: impl FnOnce() -> f32) {
         // The steady stretch, counted in ticks that run a job: the twin's
         // temperature (it follows `t` at most at its slew rate), steady once
@@ -302,6 +312,23 @@ impl<T: Real> Plant<T> {
             self.steady_anchor = tw;
             self.steady_ticks = 0;
         }
+        // Without an FPU a job's rest, begun on an earlier job tick, runs
+        // first.
+        if T::SATURATES
+            && let Some(pending) = self.pending.take()
+        {
+            let (job, outcome) = jobs::resume(pending, &self.params, &mut self.twin, self.design, &mut self.statics);
+            match outcome {
+                Ok(next) => {
+                    self.pending = next;
+                    if next.is_none() {
+                        self.failed_jobs &= !job.bit();
+                    }
+                }
+                Err(_) => self.failed_jobs |= job.bit(),
+            }
+            return;
+        }
         // While the twin's oil is on its way to a new temperature, every
         // job tick moves it on (the other jobs' results wait: the
         // temperature they belong to is moving).
@@ -312,16 +339,34 @@ impl<T: Real> Plant<T> {
             self.next_job = job.next();
             job
         };
-        match jobs::run(
-            job,
-            &self.params,
-            table,
-            &mut self.twin,
-            self.design,
-            t,
-            variance,
-            &mut self.statics,
-        ) {
+        // Without an FPU the Fluid, Equilibrium and Stability jobs run in
+        // slices (their first here, the rest on the next job ticks); with
+        // one, whole.
+        let outcome = if T::SATURATES {
+            jobs::start(
+                job,
+                &self.params,
+                table,
+                &mut self.twin,
+                self.design,
+                t,
+                variance,
+                &mut self.statics,
+            )
+            .map(|next| self.pending = next)
+        } else {
+            jobs::run(
+                job,
+                &self.params,
+                table,
+                &mut self.twin,
+                self.design,
+                t,
+                variance,
+                &mut self.statics,
+            )
+        };
+        match outcome {
             Ok(()) => {
                 self.failed_jobs &= !job.bit();
                 if job == Job::Equilibrium {

@@ -88,9 +88,152 @@ pub fn slowest_decay_rate(a: &[f32; 4], hint: f32) -> f32 {
     below
 }
 
+/// Where a [`DecaySearch`] is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Phase {
+    /// Testing the hint (`hint` below the rate?).
+    Hint(f32),
+    /// The hint is below the rate: is `1.25 hint` not?
+    HintAbove(f32),
+    /// Testing the search's floor, `a3 / 4 * 2^-32`.
+    Floor,
+    /// Bracketing by powers of two: `sigma(lo)` not below the rate (or
+    /// `lo = 0`), `sigma(hi)` below it.
+    Bracket { lo: u32, hi: u32 },
+    /// Bisecting the bracket `[below, above]`, `left` bisections to go.
+    Refine { below: f32, above: f32, left: u8 },
+    /// The result.
+    Done(f32),
+}
+
+/// [`slowest_decay_rate`] in steps of one Routh-Hurwitz test each, so that
+/// a core without an FPU (each test costs about 3,500 software-float
+/// instructions on a Cortex-M0) can spread the search over several ticks:
+/// run to its end it returns what [`slowest_decay_rate`] returns for the
+/// same polynomial and hint, test for test.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DecaySearch {
+    a: [f32; 4],
+    phase: Phase,
+}
+
+impl DecaySearch {
+    /// A search of the monic quartic `[a3, a2, a1, a0]` with `hint` (a
+    /// previous result, or 0), as [`slowest_decay_rate`].
+    pub fn new(a: &[f32; 4], hint: f32) -> Self {
+        DecaySearch {
+            a: *a,
+            phase: if hint > 0.0 { Phase::Hint(hint) } else { Phase::Floor },
+        }
+    }
+
+    /// The result once the search has ended.
+    pub fn result(&self) -> Option<f32> {
+        match self.phase {
+            Phase::Done(sigma) => Some(sigma),
+            _ => None,
+        }
+    }
+
+    /// The next step: at most one Routh-Hurwitz test. `Some` with the
+    /// result when the search has ended (then every later call too).
+    pub fn step(&mut self) -> Option<f32> {
+        let a = &self.a;
+        let stable = |sigma: f32| quartic_hurwitz(&shifted(a, sigma));
+        let top = 0.25 * a[0];
+        let scaled = |k: u32| top * f32::from_bits((127 - k) << 23);
+        self.phase = match self.phase {
+            Phase::Hint(h) => {
+                if stable(h) {
+                    Phase::HintAbove(h)
+                } else {
+                    Phase::Floor
+                }
+            }
+            Phase::HintAbove(h) => {
+                if stable(1.25 * h) {
+                    Phase::Floor
+                } else {
+                    Phase::Done(h)
+                }
+            }
+            Phase::Floor => {
+                if !(top > 0.0) || !stable(scaled(32)) {
+                    Phase::Done(0.0)
+                } else {
+                    Phase::Bracket { lo: 0, hi: 32 }
+                }
+            }
+            Phase::Bracket { lo, hi } => {
+                let mid = (lo + hi) / 2;
+                let (lo, hi) = if stable(scaled(mid)) { (lo, mid) } else { (mid, hi) };
+                if hi - lo > 1 {
+                    Phase::Bracket { lo, hi }
+                } else {
+                    Phase::Refine {
+                        below: scaled(hi),
+                        above: scaled(lo),
+                        left: 2,
+                    }
+                }
+            }
+            Phase::Refine { below, above, left } => {
+                let mid = 0.5 * (below + above);
+                let (below, above) = if stable(mid) { (mid, above) } else { (below, mid) };
+                if left > 1 {
+                    Phase::Refine {
+                        below,
+                        above,
+                        left: left - 1,
+                    }
+                } else {
+                    Phase::Done(below)
+                }
+            }
+            done @ Phase::Done(_) => done,
+        };
+        self.result()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A [`DecaySearch`] run to its end, and its steps.
+    fn stepped(a: &[f32; 4], hint: f32) -> (f32, u32) {
+        let mut search = DecaySearch::new(a, hint);
+        for n in 1..=16 {
+            if let Some(sigma) = search.step() {
+                return (sigma, n);
+            }
+        }
+        panic!("no result after 16 steps");
+    }
+
+    #[test]
+    fn the_stepped_search_is_the_search() {
+        for roots in [
+            [0.5, 1.0, 2.0, 4.0],
+            [0.01, 1.0, 3.0, 10.0],
+            [0.3, 0.5, 2.0, 2.5],
+            [-0.5, 1.0, 2.0, 3.0],
+            [1e-3, 50.0, 400.0, 9e3],
+            [2.0, 2.0, 2.0, 2.0],
+        ] {
+            let a = with_roots(roots);
+            for hint in [0.0, 0.2, 0.4, 0.75 * roots[0], roots[0], 3.0] {
+                let (sigma, steps) = stepped(&a, hint);
+                assert_eq!(
+                    sigma.to_bits(),
+                    slowest_decay_rate(&a, hint).to_bits(),
+                    "{roots:?} {hint}"
+                );
+                assert!(steps <= 10, "{roots:?} {hint}: {steps}");
+            }
+        }
+        assert_eq!(stepped(&[f32::NAN; 4], 1.0).0, slowest_decay_rate(&[f32::NAN; 4], 1.0));
+    }
 
     /// The monic quartic with the roots `-r` (coefficients `[a3, a2, a1, a0]`).
     fn with_roots(r: [f32; 4]) -> [f32; 4] {

@@ -22,12 +22,14 @@ pub const BUDGET_QEMU_TWIN_FLASH: u64 = 72 * 1024;
 /// Flash budget of the board image built for a second sensor (the
 /// condition monitor: its health filter, the probe's lag, change and
 /// isolation tests, the transducer's driver and checks, the record's
-/// health rows): measured at 77.7 KiB for `presets/paper-monitor.toml`,
-/// 15.3 KiB more than the board without it, so it cannot keep the 64 KiB
-/// of a part that small. The STM32F405 has 1 MiB of flash (every package:
-/// RM0090, DS8626), so the 64 KiB budget was a margin, not the part;
-/// 80 KiB keeps the monitor's image within a twelfth of it [bytes].
-pub const BUDGET_MONITOR_BOARD_FLASH: u64 = 80 * 1024;
+/// health rows): measured at 79.8 KiB for `presets/paper-monitor.toml`,
+/// 17.4 KiB more than the board without it, so it cannot keep the 64 KiB
+/// of a part that small; 80.2 KiB with the isolation's onset (its
+/// signatures seeded at a run's start). The STM32F405 has 1 MiB of flash
+/// (every package: RM0090, DS8626), so the 64 KiB budget was a margin,
+/// not the part; 85 KiB keeps the monitor's image within a twelfth of it
+/// (85.3 KiB) [bytes].
+pub const BUDGET_MONITOR_BOARD_FLASH: u64 = 85 * 1024;
 
 /// The flash budget of the image labelled `label` [bytes].
 pub fn flash_budget(label: &str) -> u64 {
@@ -330,7 +332,7 @@ mod tests {
         });
         let b = Budget::of(&fw).unwrap();
         // The worst of both workloads with telemetry: 510 counts, 3060
-        // instructions; the board with the monitor within its 80 KiB.
+        // instructions; the board with the monitor within its 85 KiB.
         assert_eq!(
             b.over,
             ["estimator tick with the monitor, telemetry packing: worst 3060 instructions > 3000"]
@@ -342,7 +344,7 @@ mod tests {
         assert!(table.contains(
             "| the monitor's update alone (one reading: filter, tests, isolation), Cortex-M4F f32 | mean 1020, worst 1560 instructions | measured (in a job's place) |"
         ));
-        assert!(table.contains("| flash, board image with the monitor | 73.2 KiB | <= 80 KiB |"));
+        assert!(table.contains("| flash, board image with the monitor | 73.2 KiB | <= 85 KiB |"));
         fw.footprints.last_mut().unwrap().flash = 90_000;
         assert_eq!(Budget::of(&fw).unwrap().over.len(), 2);
     }
