@@ -337,6 +337,15 @@ impl Hypothesis {
         }
     }
 
+    /// Its signature's derivative in the reading: `sign * dy/dtheta` from
+    /// the reading's Jacobian, or the sticking test's signature.
+    fn derivative(self, jacobian: &[f32; PARAMETERS], sticking: f32) -> f32 {
+        match self.parameter() {
+            PARAMETERS => sticking,
+            k => jacobian[k] * self.sign(),
+        }
+    }
+
     /// The health parameter it moves ([`PARAMETERS`] for the play band).
     fn parameter(self) -> usize {
         match self {
@@ -835,13 +844,7 @@ impl Monitor {
                     u[D_THETA + k] = jacobian[k] * inv;
                 }
                 for (o, h) in onset.iter_mut().zip(Hypothesis::ALL) {
-                    let k = h.parameter();
-                    let g = if k == PARAMETERS {
-                        sticking
-                    } else {
-                        jacobian[k] * h.sign()
-                    };
-                    *o = g * inv;
+                    *o = h.derivative(&jacobian, sticking) * inv;
                 }
                 if self.running() {
                     signatures = Some(SignatureInputs {
@@ -946,10 +949,8 @@ impl Monitor {
         let (a, theta, value) = at;
         for (i, h) in Hypothesis::ALL.iter().enumerate() {
             let k = h.parameter();
-            let g = if k == PARAMETERS {
-                sticking
-            } else if k == OFFSET || jacobian[k] == 0.0 || !(self.fit_c[i] > 0.0) {
-                jacobian[k] * h.sign()
+            let g = if k == PARAMETERS || k == OFFSET || jacobian[k] == 0.0 || !(self.fit_c[i] > 0.0) {
+                h.derivative(jacobian, sticking)
             } else {
                 // The size fitted so far, by the fault's sign (at least a
                 // hundredth, where the secant is the derivative).
