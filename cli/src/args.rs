@@ -48,6 +48,78 @@ impl ParamsArg {
     }
 }
 
+/// `--params FILE --sensor-data LOG.csv`: a device file and a log replayed
+/// through its estimator (`estimate`, `monitor`), read together because
+/// the log's second sensor's column is checked against the file's.
+#[derive(clap::Args, Debug, Clone)]
+pub struct ReplayInputs {
+    #[command(flatten)]
+    pub params: ParamsArg,
+    /// Log: time_s, one of the probe's columns (t_c, t_probe_c, rtd_ohm, code) and, with the file's [monitor], the second sensor's (p_a_pa, p_b_pa, dp_ab_pa or x_m; CSV); - reads standard input.
+    #[arg(long, value_name = "LOG.csv")]
+    pub sensor_data: PathBuf,
+}
+
+/// A [`ReplayInputs`] read: the device file, the log, and the log's name
+/// as its errors give it.
+#[derive(Debug, Clone)]
+pub struct Replay {
+    /// The device file, validated.
+    pub raw: RawParams,
+    /// The log, its second sensor's column checked against the file's.
+    pub log: crate::estimate::Log,
+    /// The log's path, or `standard input`.
+    pub shown: String,
+}
+
+impl Replay {
+    /// An error of the replay: one about the log (not `--params`')
+    /// prefixed with `--sensor-data` and the log's name.
+    pub fn in_log(&self, e: CliError) -> CliError {
+        match e {
+            CliError::Input(m) if !m.starts_with("--params") => {
+                CliError::Input(format!("--sensor-data: {}: {m}", self.shown))
+            }
+            e => e,
+        }
+    }
+}
+
+impl ReplayInputs {
+    /// Reads the device file and the log (bounded: [`crate::input::MAX_LOG_BYTES`]).
+    ///
+    /// # Errors
+    ///
+    /// Both on standard input; the file as [`ParamsArg::raw`] and its
+    /// `[monitor]` section as [`crate::estimate::SecondSensor::of`]; the
+    /// log as [`crate::estimate::read_log`], naming `--sensor-data`, the
+    /// log and its row, line and column.
+    pub fn read(&self) -> Result<Replay, CliError> {
+        let log_path = &self.sensor_data;
+        if log_path.as_os_str() == "-" && self.params.params.as_os_str() == "-" {
+            return Err(CliError::Input(
+                "--sensor-data: standard input is --params' already; give one of them as a file".into(),
+            ));
+        }
+        let raw = self.params.raw()?;
+        let text = crate::input::bounded_text(
+            log_path,
+            "--sensor-data",
+            crate::input::MAX_LOG_BYTES,
+            &format!(": {}", crate::estimate::SPLIT),
+        )?;
+        let shown = if log_path.as_os_str() == "-" {
+            "standard input".to_string()
+        } else {
+            log_path.display().to_string()
+        };
+        let sensor = crate::estimate::SecondSensor::of(&raw)?;
+        let log = crate::estimate::read_log(&text, sensor.as_ref())
+            .map_err(|e| CliError::Input(format!("--sensor-data: {shown}: {e}")))?;
+        Ok(Replay { raw, log, shown })
+    }
+}
+
 /// The default of a command's `--temps` (the commands differ in it).
 pub trait TempsDefault: Clone + Debug + Send + Sync + 'static {
     /// `start:end:step` or a comma list [C].

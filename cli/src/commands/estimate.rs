@@ -1,9 +1,8 @@
 //! `estimate`: the firmware's estimator replayed over a recorded probe log.
 
-use crate::args::{Output, ParamsArg, PlottedTable};
+use crate::args::{Output, PlottedTable, ReplayInputs};
 use crate::error::CliError;
 use crate::estimate::{self, Options};
-use std::path::PathBuf;
 
 const HELP: &str = "\
 Runs the firmware's estimator (the same code, f32, the same tick
@@ -61,10 +60,7 @@ Example:
 #[command(after_long_help = HELP)]
 pub struct Args {
     #[command(flatten)]
-    params: ParamsArg,
-    /// Probe log: time_s and one of t_c, t_probe_c, rtd_ohm, code, with the file's second sensor's column (CSV); - reads standard input.
-    #[arg(long, value_name = "LOG.csv")]
-    sensor_data: PathBuf,
+    inputs: ReplayInputs,
     /// One row per row of the log instead of one per telemetry period.
     #[arg(long)]
     every_sample: bool,
@@ -80,38 +76,16 @@ impl Args {
     /// Bad input (the file, the log: naming row, line and column) as
     /// [`estimate::read_log`] and [`estimate::run`].
     pub fn run(self) -> Result<Output, CliError> {
-        let log_path = &self.sensor_data;
-        if log_path.as_os_str() == "-" && self.params.params.as_os_str() == "-" {
-            return Err(CliError::Input(
-                "--sensor-data: standard input is --params' already; give one of them as a file".into(),
-            ));
-        }
-        let raw = self.params.raw()?;
-        let text = crate::input::bounded_text(
-            log_path,
-            "--sensor-data",
-            crate::input::MAX_LOG_BYTES,
-            &format!(": {}", estimate::SPLIT),
-        )?;
-        let shown = if log_path.as_os_str() == "-" {
-            "standard input".to_string()
-        } else {
-            log_path.display().to_string()
-        };
-        let prefix = |e: String| CliError::Input(format!("--sensor-data: {shown}: {e}"));
-        let sensor = estimate::SecondSensor::of(&raw)?;
-        let log = estimate::read_log(&text, sensor.as_ref()).map_err(prefix)?;
+        let input = self.inputs.read()?;
+        let (raw, shown) = (&input.raw, &input.shown);
         let replay = estimate::run(
-            &raw,
-            &log,
+            raw,
+            &input.log,
             Options {
                 every_sample: self.every_sample,
             },
         )
-        .map_err(|e| match e {
-            CliError::Input(m) if !m.starts_with("--params") => prefix(m),
-            e => e,
-        })?;
+        .map_err(|e| input.in_log(e))?;
         eprintln!("{}", replay.note);
         self.output.output(replay.table, |csv, units| {
             crate::plot::estimate(csv, raw.core.stroke, &format!("Estimate over {shown}"), units)

@@ -1,10 +1,8 @@
 //! `monitor`: what the condition monitor made of a log with the second
 //! sensor's readings.
 
-use crate::args::{FormatArg, Output, ParamsArg, PlotArg};
+use crate::args::{FormatArg, Output, PlotArg, ReplayInputs};
 use crate::error::CliError;
-use crate::estimate;
-use std::path::PathBuf;
 
 const HELP: &str = "\
 Replays a log through the firmware's estimator with the condition monitor
@@ -44,10 +42,7 @@ Example:
 #[command(after_long_help = HELP)]
 pub struct Args {
     #[command(flatten)]
-    params: ParamsArg,
-    /// Log: time_s, the probe's column and the second sensor's (p_a_pa, p_b_pa, dp_ab_pa or x_m; CSV); - reads standard input.
-    #[arg(long, value_name = "LOG.csv")]
-    sensor_data: PathBuf,
+    inputs: ReplayInputs,
     #[command(flatten)]
     plot: PlotArg,
     #[command(flatten)]
@@ -62,31 +57,9 @@ impl Args {
     /// Bad input (the file, the log: naming row, line and column) as
     /// [`estimate::read_log`] and [`crate::monitor::summarise`].
     pub fn run(self) -> Result<Output, CliError> {
-        let log_path = &self.sensor_data;
-        if log_path.as_os_str() == "-" && self.params.params.as_os_str() == "-" {
-            return Err(CliError::Input(
-                "--sensor-data: standard input is --params' already; give one of them as a file".into(),
-            ));
-        }
-        let raw = self.params.raw()?;
-        let sensor = estimate::SecondSensor::of(&raw)?;
-        let text = crate::input::bounded_text(
-            log_path,
-            "--sensor-data",
-            crate::input::MAX_LOG_BYTES,
-            &format!(": {}", estimate::SPLIT),
-        )?;
-        let shown = if log_path.as_os_str() == "-" {
-            "standard input".to_string()
-        } else {
-            log_path.display().to_string()
-        };
-        let prefix = |e: String| CliError::Input(format!("--sensor-data: {shown}: {e}"));
-        let log = estimate::read_log(&text, sensor.as_ref()).map_err(prefix)?;
-        let summary = crate::monitor::summarise(&raw, &log).map_err(|e| match e {
-            CliError::Input(m) if !m.starts_with("--params") => prefix(m),
-            e => e,
-        })?;
+        let input = self.inputs.read()?;
+        let (log, shown) = (&input.log, &input.shown);
+        let summary = crate::monitor::summarise(&input.raw, log).map_err(|e| input.in_log(e))?;
         if let Some(path) = &self.plot.plot {
             let figure = crate::plot::monitor(
                 &summary.trace,
@@ -95,7 +68,7 @@ impl Args {
             );
             crate::plot::write(path, &figure)?;
         }
-        for line in summary.notes(&log) {
+        for line in summary.notes(log) {
             eprintln!("{line}");
         }
         Ok(Output::si_table(summary.table, &self.format))
