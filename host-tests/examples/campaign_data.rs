@@ -26,27 +26,68 @@
 //! fault is present. At the end, the residual's statistics before and
 //! after the onset.
 
+use clap::Parser;
 use host_tests::campaign::{Fault, Injection, Quantity, Scenario, design, onset_after_warm_up};
 use std::time::Instant;
 
+/// A faulted history of one seeded device, as the condition monitor's
+/// fault-injection campaign receives it.
+#[derive(Parser)]
+struct Args {
+    /// `paper` (the paper preset) or the seed of a random design, its
+    /// as-built device, history and sensor.
+    #[arg(value_name = "design", default_value = "1", value_parser = parse_design)]
+    design: Design,
+    /// `name:severity` (capillary, orifice-worn, orifice-clogged, spring,
+    /// preload, sticking, sensor-offset) or `none`.
+    #[arg(value_name = "fault", default_value = "capillary:0.8", value_parser = Fault::parse)]
+    fault: Fault,
+    /// The second sensor's quantity.
+    #[arg(value_name = "sensor", default_value = "x", value_parser = sensor_parser())]
+    sensor: Quantity,
+    /// The history's length [hours].
+    #[arg(value_name = "hours", default_value_t = 2.0)]
+    hours: f64,
+    /// One printed row every so many seconds [s] (and the rows around the
+    /// onset).
+    #[arg(value_name = "every_s", default_value_t = 300.0)]
+    every_s: f64,
+}
+
+/// The paper preset, or a random design by its seed.
+#[derive(Clone, Copy)]
+enum Design {
+    Paper,
+    Seed(u64),
+}
+
+fn parse_design(s: &str) -> Result<Design, String> {
+    if s == "paper" {
+        return Ok(Design::Paper);
+    }
+    s.parse()
+        .map(Design::Seed)
+        .map_err(|_| format!("`{s}`: a design is `paper` or a seed"))
+}
+
+/// The second sensor's quantities, by name (`p_a`, `p_b`, `dp_ab`, `x`).
+fn sensor_parser() -> impl clap::builder::TypedValueParser<Value = Quantity> {
+    use clap::builder::{PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new(Quantity::ALL.map(Quantity::name))
+        .try_map(|name| Quantity::parse(&name).ok_or("unknown sensor"))
+}
+
 fn main() -> Result<(), String> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let arg = |i: usize, d: &str| args.get(i).cloned().unwrap_or_else(|| d.to_string());
-    let which = arg(0, "1");
-    let (raw, seed, name) = if which == "paper" {
-        let raw =
-            compensator_cli::load(&host_tests::repo_root().join("presets/paper.toml")).map_err(|e| e.to_string())?;
-        (raw, 1, "the paper preset".to_string())
-    } else {
-        let seed: u64 = which
-            .parse()
-            .map_err(|_| format!("`{which}`: a design is `paper` or a seed"))?;
-        (design(seed), seed, format!("random design {seed}"))
+    let args = Args::parse();
+    let (raw, seed, name) = match args.design {
+        Design::Paper => {
+            let raw = compensator_cli::load(&host_tests::repo_root().join("presets/paper.toml"))
+                .map_err(|e| e.to_string())?;
+            (raw, 1, "the paper preset".to_string())
+        }
+        Design::Seed(seed) => (design(seed), seed, format!("random design {seed}")),
     };
-    let fault = Fault::parse(&arg(1, "capillary:0.8"))?;
-    let quantity = Quantity::parse(&arg(2, "x")).ok_or("a sensor is p_a, p_b, dp_ab or x")?;
-    let hours: f64 = arg(3, "2").parse().map_err(|_| "hours: a number")?;
-    let every: f64 = arg(4, "300").parse().map_err(|_| "every_s: a number")?;
+    let (fault, quantity, hours, every) = (args.fault, args.sensor, args.hours, args.every_s);
     let duration = hours * 3600.0;
 
     // The history first, for the onset after its warm-up.

@@ -1,11 +1,21 @@
 //! One case of `random_cases` in detail: coefficients and trajectories.
 //! `cargo run --release -p host-tests --example case_dump -- INDEX`
+//! (default 0, the first case).
+use clap::Parser;
 use compensator::dynamics::TwinConfig;
 use compensator_cli::dynamics::Precision;
 use host_tests::accuracy::random_cases;
 
+/// One case of `random_cases` in detail: coefficients and trajectories.
+#[derive(Parser)]
+struct Args {
+    /// The case's index among `random_cases` (from 0).
+    #[arg(value_name = "INDEX", default_value_t = 0)]
+    index: usize,
+}
+
 fn main() {
-    let want: usize = std::env::args().nth(1).and_then(|a| a.parse().ok()).unwrap_or(0);
+    let want = Args::parse().index;
     let c = random_cases(want + 1).pop().unwrap();
     let p = compensator::Params::<f64>::new(&c.raw).unwrap();
     let m = compensator::dynamics::Model::new(&p).unwrap();

@@ -8,14 +8,32 @@
 //! Defaults: 1,000 devices of the paper preset and of each of 4 random
 //! designs, 2 temperatures each, seed 1. Prints the coverage table.
 
+use clap::Parser;
 use host_tests::coverage::{drawing_tolerances, study, table};
 use host_tests::random::{Rng, physical_params};
 use std::time::Instant;
 
+/// The uncertainty's coverage: devices drawn from the declared
+/// uncertainties, the reference's truth against the `f32` estimator's band.
+#[derive(Parser)]
+struct Args {
+    /// Devices drawn per design (count).
+    #[arg(value_name = "DEVICES", default_value_t = 1000)]
+    devices: u64,
+    /// Random designs beside the paper preset (count).
+    #[arg(value_name = "DESIGNS", default_value_t = 4)]
+    designs: u64,
+    /// Temperatures drawn per device (count).
+    #[arg(value_name = "TEMPERATURES", default_value_t = 2)]
+    temperatures: u64,
+    /// Seed of the designs, devices and temperatures.
+    #[arg(value_name = "SEED", default_value_t = 1)]
+    seed: u64,
+}
+
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let arg = |i: usize, d: u64| args.get(i).and_then(|a| a.parse().ok()).unwrap_or(d);
-    let (devices, count, temps, seed) = (arg(0, 1000), arg(1, 4), arg(2, 2), arg(3, 1));
+    let args = Args::parse();
+    let (devices, count, temps, seed) = (args.devices, args.designs, args.temperatures, args.seed);
     let mut paper = compensator_cli::load(&host_tests::repo_root().join("presets/paper.toml")).expect("paper preset");
     paper.tolerances = drawing_tolerances(&paper);
     let mut designs = vec![paper];

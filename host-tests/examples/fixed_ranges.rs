@@ -12,33 +12,49 @@
 //! path with the range of its results in `f64` and in Q12.20, and how far
 //! the Q12.20 twin strays from the `f64` one. `--scheme ros3` (any name of
 //! the CLI's `--scheme`) audits another scheme than the shipped SDIRK3.
+use clap::Parser;
 use compensator::dynamics::{Scheme, TwinConfig};
 use host_tests::fixed_audit::{COEFFICIENTS, Measured, Q12_20_LSB, coefficient_table, extremes, probe_design};
 use host_tests::probe::{Site, source_line};
 use host_tests::survey::{chosen as chosen_config, designs};
+use rayon::prelude::*;
+
+/// The fixed-point audit's tables: every arithmetic site's range in `f64`
+/// and in Q12.20.
+#[derive(Parser)]
+struct Args {
+    /// Survey designs drawn (count).
+    #[arg(long, value_name = "N", default_value_t = 1000)]
+    designs: usize,
+    /// Seed of the survey designs (decimal; the default is 0x5EED2026).
+    #[arg(long, value_name = "S", default_value_t = 0x5EED_2026)]
+    seed: u64,
+    /// Each scenario's length [twin ticks].
+    #[arg(long, value_name = "T", default_value_t = 1000)]
+    ticks: usize,
+    /// Audit every one of the N designs, not only the presets and the
+    /// extremes.
+    #[arg(long)]
+    all: bool,
+    /// Audit another scheme than the shipped SDIRK3 (the CLI's --scheme
+    /// names), same substeps.
+    #[arg(long, value_name = "NAME", value_parser = scheme_parser())]
+    scheme: Option<Scheme>,
+}
+
+/// The core's one-step schemes, by name (as the CLI's `--scheme`).
+fn scheme_parser() -> impl clap::builder::TypedValueParser<Value = Scheme> {
+    use clap::builder::{PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new(Scheme::ALL.map(Scheme::name))
+        .try_map(|name| Scheme::from_name(&name).ok_or("unknown scheme"))
+}
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let value = |name: &str, default: u64| -> u64 {
-        args.iter()
-            .position(|a| a == name)
-            .and_then(|i| args.get(i + 1))
-            .map(|v| v.parse().unwrap_or_else(|_| panic!("{name}: not a number: {v}")))
-            .unwrap_or(default)
-    };
-    let (count, seed, ticks) = (
-        value("--designs", 1000) as usize,
-        value("--seed", 0x5EED_2026),
-        value("--ticks", 1000) as usize,
-    );
-    let all = args.iter().any(|a| a == "--all");
+    let args = Args::parse();
+    let (count, seed, ticks, all) = (args.designs, args.seed, args.ticks, args.all);
     // Another scheme than the shipped SDIRK3 (the generic Rosenbrock and
     // Runge-Kutta schemes of `--scheme` in the CLI), same substeps.
-    let scheme = args
-        .iter()
-        .position(|a| a == "--scheme")
-        .and_then(|i| args.get(i + 1))
-        .map(|n| Scheme::from_name(n).unwrap_or_else(|| panic!("--scheme: unknown {n}")));
+    let scheme = args.scheme;
     let t = std::time::Instant::now();
     let chosen = if all {
         designs(count, seed)
@@ -57,33 +73,21 @@ fn main() {
     for ((name, (vl, vh)), (ol, oh)) in COEFFICIENTS.iter().zip(valid).zip(oil) {
         println!("| {name} | {vl:.3e} | {vh:.3e} | {ol:.3e} | {oh:.3e} |");
     }
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let mut total = Measured::default();
-    std::thread::scope(|s| {
-        let hs: Vec<_> = (0..threads)
-            .map(|_| {
-                s.spawn(|| {
-                    let mut m = Measured::default();
-                    loop {
-                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        let Some(raw) = chosen.get(i) else { break };
-                        let config = scheme
-                            .and_then(|scheme| chosen_config(raw).ok().map(|c| TwinConfig { scheme, ..c.config }));
-                        let mut d = probe_design(raw, config, ticks);
-                        for f in &mut d.failures {
-                            *f = format!("design {i}: {f}");
-                        }
-                        m.merge(&d);
-                    }
-                    m
-                })
-            })
-            .collect();
-        for h in hs {
-            total.merge(&h.join().expect("audit thread"));
-        }
-    });
+    let total = chosen
+        .par_iter()
+        .enumerate()
+        .map(|(i, raw)| {
+            let config = scheme.and_then(|scheme| chosen_config(raw).ok().map(|c| TwinConfig { scheme, ..c.config }));
+            let mut d = probe_design(raw, config, ticks);
+            for f in &mut d.failures {
+                *f = format!("design {i}: {f}");
+            }
+            d
+        })
+        .reduce(Measured::default, |mut a, b| {
+            a.merge(&b);
+            a
+        });
     let mut sites: Vec<&Site> = total.exact.keys().chain(total.fixed.keys()).collect();
     sites.sort();
     sites.dedup();

@@ -18,74 +18,115 @@
 //! identified mass and damping's error against the design's damping ratio.
 //! `identify_campaign show under|over INDEX [SEED [NOISE [NOISE_SEED]]]` prints one
 //! design, its base file and the command's notes (NOISE scales the noise).
-//! Runs on all cores (`std::thread::available_parallelism`, or THREADS in
-//! the environment).
+//! Runs on all cores (rayon; `RAYON_NUM_THREADS=N` limits them).
 
+use clap::{Parser, Subcommand, ValueEnum};
 use compensator_cli::plot::{Figure, Panel, Series, write};
 use host_tests::identify_study::{self, Class, Outcome, Summary};
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use rayon::prelude::*;
+use std::path::PathBuf;
+
+/// The identification campaign: `compensator identify`'s default fit on
+/// seeded random underdamped and overdamped designs.
+#[derive(Parser)]
+#[command(args_conflicts_with_subcommands = true, disable_help_subcommand = true)]
+struct Args {
+    #[command(subcommand)]
+    show: Option<Show>,
+    /// Underdamped designs (count).
+    #[arg(value_name = "UNDERDAMPED", default_value_t = 200)]
+    under: u64,
+    /// Overdamped designs (count).
+    #[arg(value_name = "OVERDAMPED", default_value_t = 100)]
+    over: u64,
+    /// Seed of the designs and their records.
+    #[arg(value_name = "SEED", default_value_t = 1)]
+    seed: u64,
+    /// Write the figure (SVG) of the mass and damping errors against the
+    /// damping ratio to this file (default: none).
+    #[arg(value_name = "FIGURE.svg")]
+    figure: Option<PathBuf>,
+}
+
+#[derive(Subcommand)]
+enum Show {
+    /// One design: its truth, base file and the command's notes.
+    ///
+    /// With BULK_TRUTH set, the base file's bulk modulus is the truth's;
+    /// with PROFILE_TRUTH set, the misfit with the bulk modulus held at the
+    /// truth follows.
+    Show {
+        /// The design's class.
+        #[arg(value_name = "CLASS", value_enum, default_value_t = Damping::Under)]
+        class: Damping,
+        /// The design's index in its class (from 0).
+        #[arg(value_name = "INDEX", default_value_t = 0)]
+        index: u64,
+        /// Seed of the designs (the campaign's SEED).
+        #[arg(value_name = "SEED", default_value_t = 1)]
+        seed: u64,
+        /// The record's noise, in multiples of the design's own.
+        #[arg(value_name = "NOISE", default_value_t = 1.0)]
+        noise: f64,
+        /// Mixed into the record's noise seed.
+        #[arg(value_name = "NOISE_SEED", default_value_t = 0)]
+        noise_seed: u64,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Damping {
+    /// An underdamped design.
+    Under,
+    /// An overdamped design.
+    Over,
+}
 
 fn main() {
-    let mut args = std::env::args().skip(1).peekable();
-    if args.peek().map(String::as_str) == Some("show") {
-        // `show under|over INDEX [SEED]`: one design's truth, base file and
-        // the command's notes.
-        let _ = args.next();
-        let class = if args.next().as_deref() == Some("over") {
-            Class::Overdamped
-        } else {
-            Class::Underdamped
+    let args = Args::parse();
+    if let Some(Show::Show {
+        class,
+        index,
+        seed,
+        noise,
+        noise_seed,
+    }) = args.show
+    {
+        // `show under|over INDEX [SEED [NOISE [NOISE_SEED]]]`: one design's
+        // truth, base file and the command's notes.
+        let class = match class {
+            Damping::Under => Class::Underdamped,
+            Damping::Over => Class::Overdamped,
         };
-        let index: u64 = args.next().and_then(|s| s.parse().ok()).unwrap_or(0);
-        let seed: u64 = args.next().and_then(|s| s.parse().ok()).unwrap_or(1);
-        let noise: f64 = args.next().and_then(|s| s.parse().ok()).unwrap_or(1.0);
-        let noise_seed: u64 = args.next().and_then(|s| s.parse().ok()).unwrap_or(0);
         show(class, seed, index, noise, noise_seed);
         return;
     }
-    let under: u64 = args.next().and_then(|s| s.parse().ok()).unwrap_or(200);
-    let over: u64 = args.next().and_then(|s| s.parse().ok()).unwrap_or(100);
-    let seed: u64 = args.next().and_then(|s| s.parse().ok()).unwrap_or(1);
-    let figure = args.next();
-    let threads = std::env::var("THREADS")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let (under, over, seed, figure) = (args.under, args.over, args.seed, args.figure);
+    let threads = rayon::current_num_threads();
     let jobs: Vec<(Class, u64)> = (0..under)
         .map(|i| (Class::Underdamped, i))
         .chain((0..over).map(|i| (Class::Overdamped, i)))
         .collect();
-    let next = AtomicUsize::new(0);
-    let done = Mutex::new(Vec::new());
-    let skipped = AtomicUsize::new(0);
     let start = std::time::Instant::now();
-    std::thread::scope(|s| {
-        for _ in 0..threads {
-            s.spawn(|| {
-                loop {
-                    let k = next.fetch_add(1, Ordering::Relaxed);
-                    let Some(&(class, i)) = jobs.get(k) else { break };
-                    match identify_study::run(class, seed, i) {
-                        Some(o) => {
-                            println!("{}", line(&o));
-                            done.lock().unwrap().push(o);
-                        }
-                        None => {
-                            skipped.fetch_add(1, Ordering::Relaxed);
-                        }
-                    }
-                }
-            });
-        }
-    });
-    let mut outcomes = done.into_inner().unwrap();
+    // Each outcome printed as it comes (the campaign takes minutes).
+    let ran: Vec<Option<Outcome>> = jobs
+        .par_iter()
+        .map(|&(class, i)| {
+            let o = identify_study::run(class, seed, i);
+            if let Some(o) = &o {
+                println!("{}", line(o));
+            }
+            o
+        })
+        .collect();
+    let skipped = ran.iter().filter(|o| o.is_none()).count();
+    let mut outcomes: Vec<Outcome> = ran.into_iter().flatten().collect();
     outcomes.sort_by_key(|o| (o.class == Class::Overdamped, o.index));
     println!(
         "{} designs in {:.0} s on {threads} threads ({} skipped: the reference solver could not record them)",
         outcomes.len(),
         start.elapsed().as_secs_f64(),
-        skipped.load(Ordering::Relaxed)
+        skipped
     );
     for (class, name) in [(Class::Underdamped, "underdamped"), (Class::Overdamped, "overdamped")] {
         let of: Vec<Outcome> = outcomes.iter().filter(|o| o.class == class).cloned().collect();
@@ -114,8 +155,8 @@ fn main() {
         }
     }
     if let Some(path) = figure {
-        write(std::path::Path::new(&path), &plot(&outcomes)).expect("the figure is written");
-        println!("figure: {path}");
+        write(&path, &plot(&outcomes)).expect("the figure is written");
+        println!("figure: {}", path.display());
     }
 }
 

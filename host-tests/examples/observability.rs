@@ -29,14 +29,26 @@
 //! (`host_tests::random::physical_params`) whose plunger travels over the
 //! range, seed 1.
 
+use clap::Parser;
 use host_tests::observability::{FAULTS, Finding, SENSORS, analyse};
 use host_tests::random::{Rng, physical_params};
 use host_tests::reference::equilibrium;
 
+/// Which device faults a second sensor can see at steady state, and which
+/// it cannot tell apart.
+#[derive(Parser)]
+struct Args {
+    /// Random designs beside the two presets (count).
+    #[arg(value_name = "designs", default_value_t = 20)]
+    designs: usize,
+    /// Seed of the random designs.
+    #[arg(value_name = "seed", default_value_t = 1)]
+    seed: u64,
+}
+
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let arg = |i: usize, d: u64| args.get(i).and_then(|a| a.parse().ok()).unwrap_or(d);
-    let (count, seed) = (arg(0, 20) as usize, arg(1, 1));
+    let args = Args::parse();
+    let (count, seed) = (args.designs, args.seed);
     let root = host_tests::repo_root();
     let paper = compensator_cli::load(&root.join("presets/paper.toml")).expect("paper preset");
     let example = compensator_cli::load(&root.join("presets/model-example.toml")).expect("model example");

@@ -1,13 +1,29 @@
 //! Study: the oil-temperature observer's error beyond the probe's fixed tolerance over the
 //! campaign's healthy histories, binned by the observer's own standard deviation and rate.
+//!
+//!     cargo run --release -p host-tests --example observer_error -- [DESIGNS] [HOURS]
+//!
+//! Defaults: the paper preset and 4 random designs (`host_tests::campaign::design`,
+//! seeds from 1000), 1.5 h histories.
+use clap::Parser;
 use compensator::Params;
 use compensator::estimator::{Estimator, EstimatorConfig};
 use host_tests::campaign::{Quantity, catalogue, design};
 
+/// The oil-temperature observer's error beyond the probe's fixed tolerance
+/// over the campaign's healthy histories.
+#[derive(Parser)]
+struct Args {
+    /// Random designs beside the paper preset (count).
+    #[arg(value_name = "DESIGNS", default_value_t = 4)]
+    designs: u64,
+    /// Each history's length [hours].
+    #[arg(value_name = "HOURS", default_value_t = 1.5)]
+    hours: f64,
+}
+
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let designs: u64 = args.first().and_then(|a| a.parse().ok()).unwrap_or(4);
-    let hours: f64 = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(1.5);
+    let Args { designs, hours } = Args::parse();
     let root = host_tests::repo_root();
     let mut bins = vec![(0usize, 0.0f64, 0.0f64); 12];
     let mut ratio_hist = vec![0usize; 12];

@@ -29,6 +29,7 @@
 //! should never do to a correct twin (the estimator slews its twin's oil
 //! rather than stepping it, docs/firmware.md).
 
+use clap::Parser;
 use compensator::dynamics::linear::linearise;
 use compensator::dynamics::{Twin, TwinConfig};
 use compensator::equilibrium::{Stop, equilibrium};
@@ -81,10 +82,20 @@ fn settle(raw: &RawParams, from: f64, to: f64) -> Option<([f64; 2], Stop, f64)> 
     Some((last_out.map(|k| k as f64 * tick / tau), eq.stop, tau))
 }
 
+/// How many of the linearisation's slowest time constants the twin needs
+/// to come to rest on the closed form after an abrupt temperature step.
+#[derive(Parser)]
+struct Args {
+    /// Designs (count): half random, half the paper preset scaled.
+    #[arg(value_name = "DESIGNS", default_value_t = 300)]
+    designs: usize,
+    /// Seed of the designs.
+    #[arg(value_name = "SEED", default_value_t = 1)]
+    seed: u64,
+}
+
 fn main() {
-    let mut args = std::env::args().skip(1);
-    let count: usize = args.next().map_or(300, |s| s.parse().expect("DESIGNS"));
-    let seed: u64 = args.next().map_or(1, |s| s.parse().expect("SEED"));
+    let Args { designs: count, seed } = Args::parse();
     let paper = compensator_cli::load(&host_tests::repo_root().join("presets/paper.toml")).expect("paper preset");
     // Per (stop at the end, tolerance): every settling time, and the worst.
     let mut by_stop: Vec<ByStop> = Vec::new();

@@ -10,23 +10,38 @@
 //!   designs for `--drift-ticks` ticks each (default: `--ticks`).
 //!
 //! Runs on all cores; prints the figures of `docs/soak.md`; exits 1 when
-//! any check failed.
+//! any check failed. Defaults: 1e7 ticks, `host_tests::soak::SEED`, 4
+//! designs.
+use clap::Parser;
 use host_tests::soak::{SEED, drift, moving_designs, paper, run};
 
+/// The long soak: the estimator with faults, and the `f32` twin against the
+/// `f64` one.
+#[derive(Parser)]
+struct Args {
+    /// The paper preset's estimator soak [estimator ticks, 1 ms each].
+    #[arg(long, value_name = "T", default_value_t = 10_000_000)]
+    ticks: u32,
+    /// Seed of the walks, the faults and the random designs.
+    #[arg(long, value_name = "S", default_value_t = SEED)]
+    seed: u64,
+    /// Random designs whose plunger travels (count).
+    #[arg(long, value_name = "N", default_value_t = 4)]
+    designs: usize,
+    /// Each random design's estimator soak [estimator ticks] (default: a
+    /// tenth of --ticks).
+    #[arg(long, value_name = "T")]
+    design_ticks: Option<u32>,
+    /// Each design's twin drift run [twin ticks] (default: --ticks).
+    #[arg(long, value_name = "T")]
+    drift_ticks: Option<u32>,
+}
+
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let value = |name: &str, default: u64| -> u64 {
-        args.iter()
-            .position(|a| a == name)
-            .and_then(|i| args.get(i + 1))
-            .map(|v| v.parse().unwrap_or_else(|_| panic!("{name}: not a number: {v}")))
-            .unwrap_or(default)
-    };
-    let ticks = value("--ticks", 10_000_000) as u32;
-    let seed = value("--seed", SEED);
-    let count = value("--designs", 4) as usize;
-    let design_ticks = value("--design-ticks", u64::from(ticks / 10)) as u32;
-    let drift_ticks = value("--drift-ticks", u64::from(ticks)) as u32;
+    let args = Args::parse();
+    let (ticks, seed, count) = (args.ticks, args.seed, args.designs);
+    let design_ticks = args.design_ticks.unwrap_or(ticks / 10);
+    let drift_ticks = args.drift_ticks.unwrap_or(ticks);
     let mut runs = vec![("paper preset".to_string(), paper())];
     for (i, d) in moving_designs(count, seed).into_iter().enumerate() {
         runs.push((format!("random design {i} (moving_designs seed {seed})"), d));

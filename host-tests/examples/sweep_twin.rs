@@ -13,13 +13,24 @@
 //! largest and the 99th-percentile error, the settling times equal, within
 //! their allowance, or not.
 
+use clap::Parser;
 use compensator_cli::params_file;
 use host_tests::sweep_twin::{Compared, compare_first, variant};
 
+/// The sweep's settling time from the `f64` twin against the reference
+/// solver over many variants.
+#[derive(Parser)]
+struct Args {
+    /// Variants of the paper preset (count).
+    #[arg(value_name = "VARIANTS", default_value_t = 400)]
+    variants: u64,
+    /// Seed of the variants.
+    #[arg(value_name = "SEED", default_value_t = 1)]
+    seed: u64,
+}
+
 fn main() {
-    let mut args = std::env::args().skip(1);
-    let n: u64 = args.next().and_then(|s| s.parse().ok()).unwrap_or(400);
-    let seed: u64 = args.next().and_then(|s| s.parse().ok()).unwrap_or(1);
+    let Args { variants: n, seed } = Args::parse();
     let paper = params_file::parse(compensator_cli::input::PAPER_PRESET).expect("the built-in preset");
     let mut done: Vec<Compared> = Vec::new();
     let mut skipped = 0;

@@ -8,25 +8,33 @@
 //! arithmetic of the tick path, by kind) and the ten busiest sites. With
 //! the per-operation costs `cargo xtask bench` measures on each core
 //! (`docs/bench.md`, "Fixed-point operations"), this is the tick's profile.
+use clap::Parser;
 use compensator::Params;
 use compensator::dynamics::{Scheme, Twin, TwinConfig};
 use compensator::scalar::Fixed;
 use host_tests::probe::{Op, Probe, Recording, source_line};
 use std::collections::BTreeMap;
 
+/// What a Q12.20 twin tick is made of: operations per tick, by kind and by
+/// site.
+#[derive(Parser)]
+struct Args {
+    /// The parameter file (default: presets/paper.toml).
+    #[arg(long, value_name = "F")]
+    params: Option<String>,
+    /// SDIRK3 steps per 1 ms tick (count).
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    substeps: u8,
+}
+
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let arg = |name: &str| {
-        args.iter()
-            .position(|a| a == name)
-            .and_then(|i| args.get(i + 1))
-            .cloned()
-    };
-    let file =
-        arg("--params").unwrap_or_else(|| host_tests::repo_root().join("presets/paper.toml").display().to_string());
+    let args = Args::parse();
+    let file = args
+        .params
+        .unwrap_or_else(|| host_tests::repo_root().join("presets/paper.toml").display().to_string());
     let raw = compensator_cli::load(std::path::Path::new(&file)).expect("parameter file");
     let params = Params::<f32>::new(&raw).expect("valid parameters");
-    let substeps = arg("--substeps").map_or(1, |s| s.parse().expect("--substeps N"));
+    let substeps = args.substeps;
     let config = TwinConfig {
         scheme: Scheme::Sdirk3,
         tick: 1e-3,

@@ -13,22 +13,39 @@
 //! passed, |x - x_ref| <= 0.5 % of the stroke at 0.5 C/s and 0.15 % at
 //! 0.05 C/s.
 
+use clap::{Parser, ValueEnum};
 use host_tests::random::{Rng, physical_params};
 use host_tests::tracking::{Run, run};
 use std::time::Instant;
 
+/// How closely the estimate follows a warm-up through a lagging probe.
+#[derive(Parser)]
+struct Args {
+    /// Random designs beside the paper preset (count).
+    #[arg(value_name = "DESIGNS", default_value_t = 40)]
+    designs: usize,
+    /// Seed of the designs, their probes and the probes' noise.
+    #[arg(value_name = "SEED", default_value_t = 1)]
+    seed: u64,
+    /// The random designs' probes.
+    #[arg(value_name = "PROBES", value_enum, default_value_t = Probes::Random)]
+    probes: Probes,
+}
+
+#[derive(Clone, Copy, PartialEq, ValueEnum)]
+enum Probes {
+    /// Random probes: time constant log-uniform over 2-30 s, one in four
+    /// with a well lag of 0.5-2 times it.
+    Random,
+    /// The goals' probe: an 8 s time constant, no well lag.
+    #[value(name = "8s")]
+    EightSeconds,
+}
+
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let arg = |i: usize, d: u64| args.get(i).and_then(|a| a.parse().ok()).unwrap_or(d);
-    let (count, seed) = (arg(0, 40) as usize, arg(1, 1));
-    let fixed_probe = match args.get(2).map(String::as_str) {
-        None | Some("random") => false,
-        Some("8s") => true,
-        Some(other) => {
-            eprintln!("PROBES: expected random or 8s, found {other}");
-            std::process::exit(2);
-        }
-    };
+    let args = Args::parse();
+    let (count, seed) = (args.designs, args.seed);
+    let fixed_probe = args.probes == Probes::EightSeconds;
     let mut paper = compensator_cli::load(&host_tests::repo_root().join("presets/paper.toml")).expect("paper preset");
     paper.probe.time_constant = 8.0;
     paper.probe.well_time_constant = 0.0;

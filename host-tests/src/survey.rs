@@ -17,6 +17,7 @@ use compensator::params::RawCore;
 use compensator::{Params, RawParams};
 use compensator_cli::dynamics::{Precision, simulate};
 use compensator_reference::dynamics::{self as reference, Method, Profile};
+use rayon::prelude::*;
 
 /// Spread of every scattered value: up to this many decades either way.
 pub const DECADES: f64 = 0.3;
@@ -459,32 +460,18 @@ pub fn survey_design(index: usize, raw: &RawParams, seed: u64) -> Report {
     r
 }
 
-/// `count` designs from `seed` (see [`designs`]), surveyed on all cores.
+/// `count` designs from `seed` (see [`designs`]), surveyed on all cores
+/// (rayon; `RAYON_NUM_THREADS=N` limits them).
 pub fn survey(count: usize, seed: u64) -> Report {
     let all = designs(count, seed);
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(count.max(1));
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let mut report = Report::default();
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..threads)
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut r = Report::default();
-                    loop {
-                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        let Some(raw) = all.get(i) else { break };
-                        r.merge(survey_design(i, raw, seed));
-                    }
-                    r
-                })
-            })
-            .collect();
-        for h in handles {
-            report.merge(h.join().expect("a survey thread panicked"));
-        }
-    });
+    let mut report = all
+        .par_iter()
+        .enumerate()
+        .map(|(i, raw)| survey_design(i, raw, seed))
+        .reduce(Report::default, |mut a, b| {
+            a.merge(b);
+            a
+        });
     report.failures.sort();
     report
 }
