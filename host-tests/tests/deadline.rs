@@ -115,3 +115,25 @@ fn a_record_due_inside_the_gap_goes_out_with_the_late_tick() {
     est.tick_after(Ok(None), 3);
     assert!(est.telemetry_due());
 }
+
+/// A probe read on every tick: without an FPU a tick that took a reading's
+/// update gives up its job, but never two in a row, so the jobs still run
+/// and the fixed-point twin's oil follows a step as the `f32` one's does.
+#[test]
+fn readings_on_every_tick_do_not_starve_the_jobs() {
+    let (_, mut float) = setup::<f32>(40.0);
+    let (_, mut fixed) = setup::<Fixed>(40.0);
+    for _ in 0..20_000 {
+        float.tick(Ok(Some(50.0)));
+        fixed.tick(Ok(Some(50.0)));
+    }
+    let (a, b) = (
+        float.plant().oil().state.temperature,
+        fixed.plant().oil().state.temperature,
+    );
+    assert!(a > 49.0, "the f32 twin's oil stayed at {a} C");
+    assert!(
+        (a - b).abs() < 0.5,
+        "the Q12.20 twin's oil at {b} C, the f32 one's at {a} C"
+    );
+}

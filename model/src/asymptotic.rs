@@ -271,12 +271,8 @@ pub fn sensitivity<T: Float>(params: &Params<T>, t: T) -> Result<Sensitivity<T>,
 /// As [`a_derivatives_at`], and `NonFinite` naming `dx/dt` or
 /// `dQ_throt/dt` when one of them is not finite.
 pub fn sensitivity_at<T: Float>(params: &Params<T>, point: &FluidPoint<T>) -> Result<Sensitivity<T>, ModelError> {
-    let a = a_derivatives_at(params, point)?;
+    let (dx_branch, dx, x, stop) = dx_dt_parts(params, point)?;
     let rho = &point.density;
-    let ph = phi_derivatives(params, a.value);
-    let dx_branch = ph.d1 * a.d1;
-    let (x, stop) = clamp_to_stops(ph.value - params.plunger.preload, params.plunger.stroke);
-    let dx = if stop == Stop::Free { dx_branch } else { T::ZERO };
     let w = params.slot.window_factor(params.pressure_drop);
     let inv_sqrt_rho = T::ONE / rho.value.sqrt();
     // Eq. (30): eta pi d sqrt(2 dp / rho) dx/dt - eta pi d x sqrt(2 dp) rho^(-3/2) rho' / 2
@@ -288,6 +284,31 @@ pub fn sensitivity_at<T: Float>(params: &Params<T>, point: &FluidPoint<T>) -> Re
         dq_throt_dt: finite(dq, "dQ_throt/dt")?,
         stop,
     })
+}
+
+/// [`sensitivity_at`]'s `dx/dt` alone [m/K] (0 on a stop), without the
+/// throttle flow's sensitivity (a square root and two divisions, in
+/// software on a core without an FPU): the same operations, the same
+/// value.
+///
+/// # Errors
+///
+/// As [`sensitivity_at`], but for `dQ_throt/dt`, which is not formed.
+pub fn dx_dt_at<T: Float>(params: &Params<T>, point: &FluidPoint<T>) -> Result<T, ModelError> {
+    let (dx_branch, dx, _, _) = dx_dt_parts(params, point)?;
+    finite(dx_branch, "dx/dt")?;
+    Ok(dx)
+}
+
+/// Eq. (31) at `point`: `dx/dt` on the branch and clamped to the stops (0
+/// on one), with the clamped opening `x` \[m\] and its stop, what
+/// [`sensitivity_at`] and [`dx_dt_at`] both form.
+fn dx_dt_parts<T: Float>(params: &Params<T>, point: &FluidPoint<T>) -> Result<(T, T, T, Stop), ModelError> {
+    let a = a_derivatives_at(params, point)?;
+    let ph = phi_derivatives(params, a.value);
+    let dx_branch = ph.d1 * a.d1;
+    let (x, stop) = clamp_to_stops(ph.value - params.plunger.preload, params.plunger.stroke);
+    Ok((dx_branch, if stop == Stop::Free { dx_branch } else { T::ZERO }, x, stop))
 }
 
 /// Verdict of the monotonicity test of Eq. (32) over a temperature range.

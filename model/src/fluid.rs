@@ -76,6 +76,19 @@ pub struct FluidPoint<T> {
     pub density: Derivatives<T>,
 }
 
+/// The first half of a Walther evaluation ([`Oil::walther_log`]): the
+/// temperature and `w = log10(nu_cSt + 0.7)`, what [`Oil::point_from_log`]
+/// ends it from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WaltherLog<T> {
+    /// Temperature \[C\].
+    pub temperature: T,
+    /// Temperature \[K\].
+    kelvin: T,
+    /// `w = log10(nu_cSt + 0.7)` [-].
+    pub w: T,
+}
+
 /// A quantity with its first two temperature derivatives.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Derivatives<T> {
@@ -104,6 +117,22 @@ impl<T: Float> Oil<T> {
 
     /// Walther's inner variables at `t` [C]: `(Z = nu_cSt + 0.7, w = log10 Z, T_K)`.
     fn walther(&self, t: T) -> Result<(T, T, T), ModelError> {
+        let log = self.walther_log(t)?;
+        Ok((Self::walther_z(log.w)?, log.w, log.kelvin))
+    }
+
+    /// The first half of a Walther evaluation at `t` \[C\]: `w = log10(nu_cSt
+    /// + 0.7)` (one `ln_1p`, one `exp10`). [`Oil::point_from_log`] ends it
+    /// (one `exp10`, the derivatives and the density), so that a core
+    /// without an FPU can spread one evaluation over two ticks; the two
+    /// halves give [`Oil::point`]'s result bit for bit.
+    ///
+    /// # Errors
+    ///
+    /// [`ModelError::NonFinite`] for a temperature that is not finite;
+    /// [`ModelError::OutOfRange`] at or below absolute zero (the viscosity's
+    /// range is [`Oil::point_from_log`]'s to check).
+    pub fn walther_log(&self, t: T) -> Result<WaltherLog<T>, ModelError> {
         let t = finite(t, "temperature")?;
         let tk = t + T::from_f64(KELVIN_OFFSET);
         if !(tk > T::ZERO) {
@@ -112,7 +141,15 @@ impl<T: Float> Oil<T> {
         let t_ref = T::from_f64(WALTHER_REFERENCE_C + KELVIN_OFFSET);
         let delta = (t - T::from_f64(WALTHER_REFERENCE_C)) / t_ref;
         let u = self.walther_u_ref - self.walther_b * delta.ln_1p() * T::from_f64(core::f64::consts::LOG10_E);
-        let w = u.exp10();
+        Ok(WaltherLog {
+            temperature: t,
+            kelvin: tk,
+            w: u.exp10(),
+        })
+    }
+
+    /// `Z = 10^w = nu_cSt + 0.7`, inside Walther's range.
+    fn walther_z(w: T) -> Result<T, ModelError> {
         let z = w.exp10();
         if !z.is_finite() || z > T::from_f64(WALTHER_MAX_CST + 0.7) {
             return Err(ModelError::OutOfRange(
@@ -122,7 +159,7 @@ impl<T: Float> Oil<T> {
         if !(z >= T::from_f64(WALTHER_MIN_CST + 0.7)) {
             return Err(ModelError::OutOfRange("temperature (viscosity below 2 cSt)"));
         }
-        Ok((z, w, tk))
+        Ok(z)
     }
 
     /// Kinematic viscosity `nu(t)` [m^2/s].
@@ -147,16 +184,21 @@ impl<T: Float> Oil<T> {
     /// As [`Oil::kinematic_viscosity`].
     pub fn kinematic_viscosity_derivatives(&self, t: T) -> Result<Derivatives<T>, ModelError> {
         let (z, w, tk) = self.walther(t)?;
+        Ok(self.viscosity_derivatives(z, w, tk))
+    }
+
+    /// `nu`, `nu'`, `nu''` from Walther's inner variables `Z`, `w`, `T_K`.
+    fn viscosity_derivatives(&self, z: T, w: T, tk: T) -> Derivatives<T> {
         let ln10 = T::from_f64(core::f64::consts::LN_10);
         let b = self.walther_b;
         let d1 = -b * ln10 * z * w / tk;
         let d2 = -b * ln10 * w * (d1 / tk - z * (b + T::ONE) / (tk * tk));
         let cst = T::from_f64(1e-6);
-        Ok(Derivatives {
+        Derivatives {
             value: (z - T::from_f64(0.7)) * cst,
             d1: d1 * cst,
             d2: d2 * cst,
-        })
+        }
     }
 
     /// The factor `1 + e (t - 15)`; positive for every validated parameter
@@ -207,11 +249,23 @@ impl<T: Float> Oil<T> {
     /// As [`Oil::kinematic_viscosity`] and [`Oil::density`], and
     /// `NonFinite("dynamic viscosity")` if `nu rho` overflows.
     pub fn point(&self, t: T) -> Result<FluidPoint<T>, ModelError> {
-        let nu = self.kinematic_viscosity_derivatives(t)?;
-        let rho = self.density_derivatives(t)?;
+        self.point_from_log(self.walther_log(t)?)
+    }
+
+    /// [`Oil::point`] from the first half of its Walther evaluation
+    /// ([`Oil::walther_log`]).
+    ///
+    /// # Errors
+    ///
+    /// As [`Oil::point`] (the viscosity's range, the density law,
+    /// `NonFinite("dynamic viscosity")`).
+    pub fn point_from_log(&self, log: WaltherLog<T>) -> Result<FluidPoint<T>, ModelError> {
+        let z = Self::walther_z(log.w)?;
+        let nu = self.viscosity_derivatives(z, log.w, log.kelvin);
+        let rho = self.density_derivatives(log.temperature)?;
         Ok(FluidPoint {
             state: FluidState {
-                temperature: t,
+                temperature: log.temperature,
                 kinematic_viscosity: nu.value,
                 density: rho.value,
                 dynamic_viscosity: finite(nu.value * rho.value, "dynamic viscosity")?,

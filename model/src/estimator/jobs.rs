@@ -12,7 +12,7 @@ use crate::dynamics::linear::characteristic_polynomial;
 use crate::dynamics::schemes::OdeSystem;
 use crate::equilibrium::{Stop, a_parameter, equilibrium_for};
 use crate::error::ModelError;
-use crate::fluid::FluidPoint;
+use crate::fluid::{FluidPoint, WaltherLog};
 use crate::params::Params;
 use crate::scalar::Real;
 use crate::throttle::FlowLaws;
@@ -192,14 +192,22 @@ fn move_oil<T: Real>(
 /// half: the oil's properties there, `statics.slewing` set).
 #[inline(always)]
 fn slewed_point(p: &Params<f32>, statics: &mut Statics, target: f32, slew: f32) -> Result<FluidPoint<f32>, ModelError> {
+    let (t, slewing) = slewed_temperature(statics, target, slew);
+    let point = p.oil.point(t)?;
+    statics.slewing = slewing;
+    Ok(point)
+}
+
+/// The temperature the twin's oil moves to towards `target` \[C\], and
+/// whether the slew limit held it short of `target`.
+#[inline(always)]
+fn slewed_temperature(statics: &Statics, target: f32, slew: f32) -> (f32, bool) {
     let prev = &statics.point;
     let now = prev.state.temperature;
     let dln_mu = libm::fabsf(prev.viscosity.d1 / prev.viscosity.value + prev.density.d1 / prev.density.value);
     let max_step = if dln_mu > 0.0 { slew / dln_mu } else { f32::INFINITY };
     let step = super::clamp(target - now, -max_step, max_step);
-    let point = p.oil.point(now + step)?;
-    statics.slewing = step != target - now;
-    Ok(point)
+    (now + step, step != target - now)
 }
 
 /// The twin's oil and the flow laws at `t` \[C\] at once (the Fluid job's
@@ -300,6 +308,10 @@ fn set_decay_rate<T: Real>(twin: &Twin<f32, T>, statics: &mut Statics, sigma: f3
 /// linearisation 20,000 and its decay-rate search up to 27,000).
 #[derive(Clone, Copy, Debug)]
 pub(super) enum Pending {
+    /// The first half of the Fluid job's Walther evaluation at the slewed
+    /// temperature, which [`Oil::point_from_log`](crate::fluid::Oil::point_from_log)
+    /// ends, and whether the slew limit held that temperature short.
+    Walther(WaltherLog<f32>, bool),
     /// The Fluid job's new oil, for the twin and the flow laws ([`apply`]).
     Apply(FluidPoint<f32>),
     /// The Equilibrium job's `dx/dt` ([`asymptotic::sensitivity_at`]).
@@ -307,13 +319,18 @@ pub(super) enum Pending {
     /// The Stability job's Jacobian at the equilibrium, whose
     /// characteristic polynomial and Routh-Hurwitz verdict are next.
     Jacobian([[f32; 4]; 4]),
+    /// The Uncertainty job's oil temperature \[C\] and its variance
+    /// \[C^2\] (the observer's, taken on the job's first tick), the
+    /// table's input.
+    Uncertainty(f32, f32),
     /// The Stability job's decay-rate search.
     Search(DecaySearch),
 }
 
-/// The first slice of `job` on a core without an FPU: the Fluid job's
-/// oil properties at the slewed temperature (the twin's and the flow laws'
-/// next), the Equilibrium job's closed form (its results published at once; `dx/dt` next), the
+/// The first slice of `job` on a core without an FPU: the first half of
+/// the Fluid job's Walther evaluation at the slewed temperature (the oil's
+/// properties for the twin and the flow laws next, then their hand-over),
+/// the Equilibrium job's closed form (its results published at once; `dx/dt` next), the
 /// Stability job's Jacobian; another job whole ([`run`]). `Ok(Some)`: the
 /// continuation the next job tick runs ([`resume`]).
 #[allow(clippy::too_many_arguments, reason = "the tick's state, borrowed apart")]
@@ -328,12 +345,16 @@ pub(super) fn start<T: Real>(
     statics: &mut Statics,
 ) -> Result<Option<Pending>, ModelError> {
     match job {
-        Job::Fluid => Ok(Some(Pending::Apply(slewed_point(p, statics, t, TWIN_SLEW)?))),
+        Job::Fluid => {
+            let (t, slewing) = slewed_temperature(statics, t, TWIN_SLEW);
+            Ok(Some(Pending::Walther(p.oil.walther_log(t)?, slewing)))
+        }
         Job::Equilibrium => {
             equilibrium(p, twin, statics)?;
             Ok(Some(Pending::Sensitivity))
         }
         Job::Stability => Ok(Some(Pending::Jacobian(stability_jacobian(twin, statics)))),
+        Job::Uncertainty => Ok(Some(Pending::Uncertainty(t, variance()))),
         _ => run(job, p, table, twin, design, t, variance, statics).map(|()| None),
     }
 }
@@ -343,19 +364,31 @@ pub(super) fn start<T: Real>(
 pub(super) fn resume<T: Real>(
     pending: Pending,
     p: &Params<f32>,
+    table: &UncertaintyTable,
     twin: &mut Twin<f32, T>,
     design: Design,
     statics: &mut Statics,
 ) -> (Job, Result<Option<Pending>, ModelError>) {
     match pending {
+        Pending::Walther(log, slewing) => (
+            Job::Fluid,
+            p.oil.point_from_log(log).map(|point| {
+                statics.slewing = slewing;
+                Some(Pending::Apply(point))
+            }),
+        ),
         Pending::Apply(point) => (Job::Fluid, apply(p, twin, design, statics, point).map(|()| None)),
         Pending::Sensitivity => (
             Job::Equilibrium,
-            asymptotic::sensitivity_at(p, &statics.point).map(|s| {
-                statics.dx_dt = s.dx_dt;
+            asymptotic::dx_dt_at(p, &statics.point).map(|dx_dt| {
+                statics.dx_dt = dx_dt;
                 None
             }),
         ),
+        Pending::Uncertainty(t, variance) => {
+            statics.uncertainty = table.at(t, variance);
+            (Job::Uncertainty, Ok(None))
+        }
         Pending::Jacobian(m) => {
             let poly = characteristic_polynomial(&m);
             statics.stable = quartic_hurwitz(&poly);
@@ -427,7 +460,7 @@ pub(super) fn run<T: Real>(
         Job::Equilibrium => {
             let point = &statics.point;
             let eq = equilibrium_for(p, point.state, a_parameter(p, &point.state))?;
-            statics.dx_dt = asymptotic::sensitivity_at(p, point)?.dx_dt;
+            statics.dx_dt = asymptotic::dx_dt_at(p, point)?;
             statics.x_equilibrium = eq.x;
             statics.y_equilibrium = twin.model().equilibrium_state(&eq);
             statics.on_closed_stop = eq.stop == Stop::Closed;

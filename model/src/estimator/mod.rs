@@ -32,9 +32,10 @@
 //!    changes over seconds. A job the model refuses keeps its previous
 //!    results and flags the estimate `DEGRADED` until it succeeds again.
 //!    Where the twin is fixed point (the cores without an FPU, whose `f32`
-//!    is software) the Fluid, Equilibrium and Stability jobs run in slices
-//!    on consecutive job ticks ([`Plant::run_job`]), so that no tick
-//!    carries a whole job;
+//!    is software) the Fluid, Equilibrium, Stability and Uncertainty jobs
+//!    run in slices on consecutive job ticks ([`Plant::run_job`]), so that
+//!    no tick carries a whole job, and a tick that took a reading's update
+//!    runs no job;
 //! 5. flows and the compensation error follow from the twin's state.
 //!
 //! The pieces, one concept per file: [`EstimatorConfig`] and its
@@ -207,6 +208,10 @@ pub struct Estimator<T = f32, U = UncertaintyTable, O = ObserverDesign> {
     late: bool,
     /// Consecutive ticks the twin had an event on (saturating).
     deferred: u32,
+    /// The last tick gave up its job to a reading's update (FPU-less
+    /// cores): the next one runs its job whatever it takes, so that a probe
+    /// read every tick cannot starve the jobs.
+    yielded: bool,
     /// The condition monitor, with a second sensor ([`Estimator::with_monitor`]).
     monitor: Option<Monitor>,
     /// The second sensor's reading not yet given to the monitor (it runs
@@ -269,6 +274,7 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
             lost_ticks: 0,
             late: false,
             deferred: 0,
+            yielded: false,
             monitor: None,
             #[cfg(feature = "monitor")]
             second: None,
@@ -434,9 +440,14 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
         self.since_sample = self.since_sample.saturating_add(1);
         let design = self.config.observer_design();
         self.observer.predict(design);
+        // A reading's update took this tick (without an FPU it costs about
+        // a job slice: the tick then runs no job).
+        let mut updated = false;
         match sample {
             Ok(Some(t)) if t.is_finite() && self.config.oil.contains(t) => {
-                match self.observer.offer(design, &self.config.spikes, t) {
+                let verdict = self.observer.offer(design, &self.config.spikes, t);
+                updated = verdict == Verdict::Accepted;
+                match verdict {
                     Verdict::Accepted | Verdict::Step => {
                         self.since_sample = 0;
                         #[cfg(feature = "monitor")]
@@ -484,7 +495,13 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
             || (self.config.telemetry_every > 0 && self.tick.is_multiple_of(self.config.telemetry_every));
         self.publish = due && !eventful;
         self.telemetry_pending = due && eventful;
-        if !due && !eventful {
+        // Without an FPU (a fixed-point twin: the estimator's own `f32` is
+        // software) a tick that took a reading's update runs no job either:
+        // the update costs about what a job's slice does, and the two on
+        // one tick made the worst tick.
+        let busy = T::SATURATES && updated && !self.yielded;
+        self.yielded = busy;
+        if !due && !eventful && !busy {
             // A job tick (a telemetry tick only publishes: the costliest
             // tick is spared); a waiting reading of the second sensor takes
             // the job's place.

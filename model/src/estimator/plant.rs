@@ -298,7 +298,7 @@ impl<T: Real> Plant<T> {
     /// an Equilibrium job, the consistency check. A job the model refuses
     /// leaves its previous results in force, and the estimates `DEGRADED`
     /// until it succeeds again. With a fixed-point twin (the cores without
-    /// an FPU) the Fluid, Equilibrium and Stability jobs run in slices, one
+    /// an FPU) the Fluid, Equilibrium, Stability and Uncertainty jobs run in slices, one
     /// a call: a job's rest runs before the rotation's next job, and each
     /// result is published when its slice ends.
     pub fn run_job(&mut self, table: &UncertaintyTable, t: f32, variance: impl FnOnce() -> f32) {
@@ -317,7 +317,14 @@ impl<T: Real> Plant<T> {
         if T::SATURATES
             && let Some(pending) = self.pending.take()
         {
-            let (job, outcome) = jobs::resume(pending, &self.params, &mut self.twin, self.design, &mut self.statics);
+            let (job, outcome) = jobs::resume(
+                pending,
+                &self.params,
+                table,
+                &mut self.twin,
+                self.design,
+                &mut self.statics,
+            );
             match outcome {
                 Ok(next) => {
                     self.pending = next;
@@ -339,7 +346,7 @@ impl<T: Real> Plant<T> {
             self.next_job = job.next();
             job
         };
-        // Without an FPU the Fluid, Equilibrium and Stability jobs run in
+        // Without an FPU the Fluid, Equilibrium, Stability and Uncertainty jobs run in
         // slices (their first here, the rest on the next job ticks); with
         // one, whole.
         let outcome = if T::SATURATES {
