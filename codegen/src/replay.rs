@@ -41,7 +41,7 @@ pub const LEVELS: [f64; 10] = [
 /// [`LEVELS`] (at the transition rate, each held): the capillary is
 /// restricted half-way through the first hold, and the move to the second
 /// spans the temperature the monitor's isolation needs
-/// (`compensator::monitor::ISOLATION_SPAN`, 1 K).
+/// (`compensator::monitor::ISOLATION_SPAN`, 3 K).
 pub const MONITOR_TAIL: [f64; 2] = [40.0, 50.0];
 
 /// The capillary's conductance after its restriction, a fraction of the
