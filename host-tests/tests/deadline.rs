@@ -137,3 +137,45 @@ fn readings_on_every_tick_do_not_starve_the_jobs() {
         "the Q12.20 twin's oil at {b} C, the f32 one's at {a} C"
     );
 }
+
+/// The bench's ramps across the opening (4 C/s), a reading every other
+/// tick, on the even ticks and then on the odd ones (so that every event
+/// tick has a reading in one of the runs): without an FPU a reading that
+/// arrives on a tick the twin spends on an event (an impact, a release) is
+/// held back and offered on the next tick, which then reads it; with one,
+/// every reading is taken on its own tick.
+#[test]
+fn a_reading_on_an_event_tick_waits_one_tick_without_an_fpu() {
+    fn run<T: Real>(phase: u32) -> (u32, u32) {
+        let (_, mut est) = setup::<T>(26.0);
+        let (mut readings, mut held) = (0u32, 0u32);
+        let mut waiting: Option<f32> = None;
+        for k in 0..10_000u32 {
+            let s = k as f32 * 1e-3;
+            let t = 26.0 + 4.0 * if s < 5.0 { s } else { 10.0 - s };
+            let sample = (k % 2 == phase).then_some(t);
+            let e = est.tick(Ok(sample));
+            if let Some(w) = waiting.take() {
+                assert_eq!(e.t_probe, w, "tick {k}: the reading held back was not offered");
+            }
+            if let Some(t) = sample {
+                readings += 1;
+                if e.t_probe != t {
+                    held += 1;
+                    waiting = Some(t);
+                }
+            }
+        }
+        (readings, held)
+    }
+    for phase in 0..2 {
+        assert_eq!(run::<f32>(phase), (5000, 0), "f32 held readings back");
+    }
+    let (even, odd) = (run::<Fixed>(0), run::<Fixed>(1));
+    assert_eq!((even.0, odd.0), (5000, 5000));
+    let held = even.1 + odd.1;
+    assert!(
+        (1..=8).contains(&held),
+        "Q12.20: {held} readings held back (the ramps have a few event ticks)"
+    );
+}

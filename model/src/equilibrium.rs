@@ -144,13 +144,35 @@ pub fn clamp_to_stops<T: Float>(x_free: T, stroke: T) -> (T, Stop) {
     }
 }
 
-/// The equilibrium for a given `A` [sqrt(Pa)] and fluid state.
+/// The force balance of the equilibrium for a given `A` [sqrt(Pa)]: its
+/// chamber pressures and displacement, without the flows
+/// ([`equilibrium_for`] adds them; the estimator's Equilibrium job needs
+/// only these).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Balance<T> {
+    /// Pressure in chamber (a) \[Pa\].
+    pub p_a: T,
+    /// Pressure in chamber (b) \[Pa\].
+    pub p_b: T,
+    /// `p_b - p_a` \[Pa\].
+    pub dp_ab: T,
+    /// Plunger displacement, clamped to the stops \[m\].
+    pub x: T,
+    /// Displacement of the force balance without stops \[m\].
+    pub x_free: T,
+    /// Which stop, if any, holds the plunger.
+    pub stop: Stop,
+    /// Each branch's flow fraction `q / sqrt(dp)` ([`branch_fraction`]).
+    pub q: T,
+}
+
+/// The force balance for a given `A` [sqrt(Pa)] (Eqs. 2-5).
 ///
 /// # Errors
 ///
-/// [`ModelError::NonFinite`] when `a`, the free displacement or the total
-/// flow is not finite.
-pub fn equilibrium_for<T: Float>(params: &Params<T>, fluid: FluidState<T>, a: T) -> Result<Equilibrium<T>, ModelError> {
+/// [`ModelError::NonFinite`] when `a` or the free displacement is not
+/// finite.
+pub fn balance_for<T: Float>(params: &Params<T>, a: T) -> Result<Balance<T>, ModelError> {
     let dp = params.pressure_drop;
     let sqrt_dp = dp.sqrt();
     let (q, _) = branch_fraction(finite(a, "A(t)")? / sqrt_dp);
@@ -160,19 +182,40 @@ pub fn equilibrium_for<T: Float>(params: &Params<T>, fluid: FluidState<T>, a: T)
     let dp_ab = (T::from_f64(2.0) * q * q - T::ONE) * dp;
     let x_free = dp_ab * params.plunger.compliance() - params.plunger.preload;
     let (x, stop) = clamp_to_stops(x_free, params.plunger.stroke);
-    // Orifice flow at the full drop; each branch carries the fraction q.
-    let q_full = params.orifice.flow(dp, fluid.density);
-    let q_branch = q * q_full;
-    let q_throt = params.slot.flow(x, dp, fluid.density);
-    Ok(Equilibrium {
-        fluid,
-        a,
+    Ok(Balance {
         p_a,
         p_b,
         dp_ab,
         x,
         x_free: finite(x_free, "displacement")?,
         stop,
+        q,
+    })
+}
+
+/// The equilibrium for a given `A` [sqrt(Pa)] and fluid state: the force
+/// balance ([`balance_for`]) and the flows (Eqs. 6-7).
+///
+/// # Errors
+///
+/// [`ModelError::NonFinite`] when `a`, the free displacement or the total
+/// flow is not finite.
+pub fn equilibrium_for<T: Float>(params: &Params<T>, fluid: FluidState<T>, a: T) -> Result<Equilibrium<T>, ModelError> {
+    let b = balance_for(params, a)?;
+    // Orifice flow at the full drop; each branch carries the fraction q.
+    let dp = params.pressure_drop;
+    let q_full = params.orifice.flow(dp, fluid.density);
+    let q_branch = b.q * q_full;
+    let q_throt = params.slot.flow(b.x, dp, fluid.density);
+    Ok(Equilibrium {
+        fluid,
+        a,
+        p_a: b.p_a,
+        p_b: b.p_b,
+        dp_ab: b.dp_ab,
+        x: b.x,
+        x_free: b.x_free,
+        stop: b.stop,
         q_branch,
         q_throt,
         q_total: finite(q_branch + q_branch + q_throt, "total flow")?,

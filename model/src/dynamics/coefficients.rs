@@ -277,11 +277,18 @@ impl<F: Float> Model<F> {
 
     /// The model state of a quasi-static equilibrium (at rest).
     pub fn equilibrium_state<T: Real>(&self, eq: &Equilibrium<F>) -> [T; 4] {
+        self.rest_state(eq.x, eq.p_a, eq.p_b)
+    }
+
+    /// The state at rest at displacement `x` \[m\] with chamber pressures
+    /// `p_a`, `p_b` \[Pa\], in model units (an equilibrium's force
+    /// balance, [`crate::equilibrium::Balance`]).
+    pub fn rest_state<T: Real>(&self, x: F, p_a: F, p_b: F) -> [T; 4] {
         self.scales.from_si(&DynamicState {
-            x: eq.x,
+            x,
             v: F::ZERO,
-            p_a: eq.p_a,
-            p_b: eq.p_b,
+            p_a,
+            p_b,
         })
     }
 }

@@ -76,11 +76,35 @@ impl<T: Real> Fsi<'_, T> {
 
     #[inline]
     fn local(&self, y: &[T; 4]) -> Local<T> {
+        self.local_with(y, self.orifice_a(y), self.orifice_b(y))
+    }
+
+    /// Chamber (a)'s orifice law at `y`: `(r, r')` of its drop `D - pi_a`
+    /// ([`regularised_root`]).
+    #[inline]
+    pub fn orifice_a(&self, y: &[T; 4]) -> (T, T) {
+        regularised_root(self.coefficients.supply() - y[2], self.coefficients.u_tr)
+    }
+
+    /// Chamber (b)'s orifice law at `y`: `(r, r')` of its drop `pi_b`.
+    #[inline]
+    pub fn orifice_b(&self, y: &[T; 4]) -> (T, T) {
+        regularised_root(y[3], self.coefficients.u_tr)
+    }
+
+    /// [`OdeSystem::jacobian`] with the orifice laws given
+    /// ([`Fsi::orifice_a`], [`Fsi::orifice_b`] at `y`): a caller that
+    /// spreads the Jacobian's cost over several calls (the estimator's
+    /// Stability job on the cores without an FPU) evaluates them apart.
+    pub fn jacobian_with(&self, y: &[T; 4], a: (T, T), b: (T, T)) -> [[T; 4]; 4] {
+        self.jacobian_of(&self.local_with(y, a, b))
+    }
+
+    #[inline]
+    fn local_with(&self, y: &[T; 4], (ra, sa): (T, T), (rb, sb): (T, T)) -> Local<T> {
         let c = self.coefficients;
         let (da, db) = c.relative_volumes(y[0]);
         let (oa, ob) = (c.omega_a0 / da, c.omega_b0 / db);
-        let (ra, sa) = regularised_root(c.supply() - y[2], c.u_tr);
-        let (rb, sb) = regularised_root(y[3], c.u_tr);
         let (fa, fb) = c.inflows(y, ra, rb);
         Local {
             oa,
@@ -93,6 +117,31 @@ impl<T: Real> Fsi<'_, T> {
             fa,
             fb,
         }
+    }
+
+    /// The Jacobian from the local quantities at a state.
+    #[inline]
+    fn jacobian_of(&self, l: &Local<T>) -> [[T; 4]; 4] {
+        let c = self.coefficients;
+        let mech = if self.moving() {
+            [
+                [T::ZERO, c.a_x, T::ZERO, T::ZERO],
+                [-c.inv_a_x, -c.two_zeta, -c.phi_over_a_x, c.phi_over_a_x],
+            ]
+        } else {
+            [[T::ZERO; 4]; 2]
+        };
+        [
+            mech[0],
+            mech[1],
+            [l.doa * l.fa, l.oa * c.sigma, -(l.oa * (c.q_t * l.sa + c.g_l)), T::ZERO],
+            [
+                l.dob * l.fb,
+                -(l.ob * c.sigma),
+                T::ZERO,
+                -(l.ob * (c.g_l + c.q_t * l.sb)),
+            ],
+        ]
     }
 
     /// The net chamber inflows ([`Coefficients::inflows`]) without the
@@ -207,27 +256,7 @@ impl<T: Real> OdeSystem<T, 4> for Fsi<'_, T> {
     }
 
     fn jacobian(&self, y: &[T; 4]) -> [[T; 4]; 4] {
-        let c = self.coefficients;
-        let l = self.local(y);
-        let mech = if self.moving() {
-            [
-                [T::ZERO, c.a_x, T::ZERO, T::ZERO],
-                [-c.inv_a_x, -c.two_zeta, -c.phi_over_a_x, c.phi_over_a_x],
-            ]
-        } else {
-            [[T::ZERO; 4]; 2]
-        };
-        [
-            mech[0],
-            mech[1],
-            [l.doa * l.fa, l.oa * c.sigma, -(l.oa * (c.q_t * l.sa + c.g_l)), T::ZERO],
-            [
-                l.dob * l.fb,
-                -(l.ob * c.sigma),
-                T::ZERO,
-                -(l.ob * (c.g_l + c.q_t * l.sb)),
-            ],
-        ]
+        self.jacobian_of(&self.local(y))
     }
 
     fn linearise(&self, y: &[T; 4], shift: T) -> Option<([T; 4], FsiFactor<T>)> {

@@ -7,10 +7,10 @@ use super::{MAX_STOP_SETTLE, MIN_SETTLE_TICKS, SETTLE_TIME_CONSTANTS, STOP_SETTL
 use crate::asymptotic;
 use crate::compensation;
 use crate::dynamics::Twin;
+use crate::dynamics::coefficients::Coefficients;
 use crate::dynamics::fsi::{Contact, Fsi};
 use crate::dynamics::linear::characteristic_polynomial;
-use crate::dynamics::schemes::OdeSystem;
-use crate::equilibrium::{Stop, a_parameter, equilibrium_for};
+use crate::equilibrium::{Stop, a_parameter, balance_for};
 use crate::error::ModelError;
 use crate::fluid::{FluidPoint, WaltherLog};
 use crate::params::Params;
@@ -264,15 +264,31 @@ fn stability_polynomial<T: Real>(twin: &Twin<f32, T>, statics: &Statics) -> [f32
 /// The Jacobian whose characteristic polynomial [`stability_polynomial`] is.
 #[inline(always)]
 fn stability_jacobian<T: Real>(twin: &Twin<f32, T>, statics: &Statics) -> [[f32; 4]; 4] {
+    let coefficients = stability_coefficients(twin);
+    let sys = linearised(&coefficients);
+    let y = &statics.y_equilibrium;
+    sys.jacobian_with(y, sys.orifice_a(y), sys.orifice_b(y))
+}
+
+/// The twin's coefficients in `f32` for the Stability job's linearisation
+/// (the chamber rates the model's, see [`stability_polynomial`]).
+#[inline(always)]
+fn stability_coefficients<T: Real>(twin: &Twin<f32, T>) -> Coefficients<f32> {
     let mut coefficients = twin.coefficients().to_f32();
     if T::SATURATES {
         [coefficients.omega_a0, coefficients.omega_b0] = twin.model().chamber_rates(coefficients.flow_shift);
     }
-    let sys = Fsi {
-        coefficients: &coefficients,
+    coefficients
+}
+
+/// The free plunger's model with `coefficients`, what the Stability job
+/// linearises.
+#[inline(always)]
+fn linearised(coefficients: &Coefficients<f32>) -> Fsi<'_, f32> {
+    Fsi {
+        coefficients,
         contact: Contact::Free,
-    };
-    sys.jacobian(&statics.y_equilibrium)
+    }
 }
 
 /// The Stability job's results from the slowest decay rate `sigma` (in the
@@ -316,6 +332,11 @@ pub(super) enum Pending {
     Apply(FluidPoint<f32>),
     /// The Equilibrium job's `dx/dt` ([`asymptotic::sensitivity_at`]).
     Sensitivity,
+    /// The Stability job's coefficients in `f32` and chamber (a)'s
+    /// orifice law at the equilibrium ([`Fsi::orifice_a`]), whose Jacobian
+    /// is next (the conversion and the whole Jacobian on one tick made the
+    /// Cortex-M0's costliest job slice, about 13,000 instructions).
+    Linearise(Coefficients<f32>, (f32, f32)),
     /// The Stability job's Jacobian at the equilibrium, whose
     /// characteristic polynomial and Routh-Hurwitz verdict are next.
     Jacobian([[f32; 4]; 4]),
@@ -353,7 +374,11 @@ pub(super) fn start<T: Real>(
             equilibrium(p, twin, statics)?;
             Ok(Some(Pending::Sensitivity))
         }
-        Job::Stability => Ok(Some(Pending::Jacobian(stability_jacobian(twin, statics)))),
+        Job::Stability => {
+            let coefficients = stability_coefficients(twin);
+            let a = linearised(&coefficients).orifice_a(&statics.y_equilibrium);
+            Ok(Some(Pending::Linearise(coefficients, a)))
+        }
         Job::Uncertainty => Ok(Some(Pending::Uncertainty(t, variance()))),
         _ => run(job, p, table, twin, design, t, variance, statics).map(|()| None),
     }
@@ -388,6 +413,14 @@ pub(super) fn resume<T: Real>(
         Pending::Uncertainty(t, variance) => {
             statics.uncertainty = table.at(t, variance);
             (Job::Uncertainty, Ok(None))
+        }
+        Pending::Linearise(coefficients, a) => {
+            let sys = linearised(&coefficients);
+            let y = &statics.y_equilibrium;
+            (
+                Job::Stability,
+                Ok(Some(Pending::Jacobian(sys.jacobian_with(y, a, sys.orifice_b(y))))),
+            )
         }
         Pending::Jacobian(m) => {
             let poly = characteristic_polynomial(&m);
@@ -426,9 +459,9 @@ pub(super) fn resume<T: Real>(
 #[inline(always)]
 fn equilibrium<T: Real>(p: &Params<f32>, twin: &Twin<f32, T>, statics: &mut Statics) -> Result<(), ModelError> {
     let point = &statics.point;
-    let eq = equilibrium_for(p, point.state, a_parameter(p, &point.state))?;
+    let eq = balance_for(p, a_parameter(p, &point.state))?;
     statics.x_equilibrium = eq.x;
-    statics.y_equilibrium = twin.model().equilibrium_state(&eq);
+    statics.y_equilibrium = twin.model().rest_state(eq.x, eq.p_a, eq.p_b);
     statics.on_closed_stop = eq.stop == Stop::Closed;
     Ok(())
 }
@@ -458,12 +491,10 @@ pub(super) fn run<T: Real>(
             move_oil(p, twin, design, statics, t, TWIN_SLEW)?;
         }
         Job::Equilibrium => {
-            let point = &statics.point;
-            let eq = equilibrium_for(p, point.state, a_parameter(p, &point.state))?;
-            statics.dx_dt = asymptotic::dx_dt_at(p, point)?;
-            statics.x_equilibrium = eq.x;
-            statics.y_equilibrium = twin.model().equilibrium_state(&eq);
-            statics.on_closed_stop = eq.stop == Stop::Closed;
+            // Both or neither: an error leaves the previous results.
+            let dx_dt = asymptotic::dx_dt_at(p, &statics.point)?;
+            equilibrium(p, twin, statics)?;
+            statics.dx_dt = dx_dt;
         }
         Job::Stability => {
             let poly = stability_polynomial(twin, statics);

@@ -212,6 +212,9 @@ pub struct Estimator<T = f32, U = UncertaintyTable, O = ObserverDesign> {
     /// cores): the next one runs its job whatever it takes, so that a probe
     /// read every tick cannot starve the jobs.
     yielded: bool,
+    /// A reading held back from an event tick (FPU-less cores) and the
+    /// tick it was taken on: the next tick offers it.
+    held_reading: Option<(f32, u32)>,
     /// The condition monitor, with a second sensor ([`Estimator::with_monitor`]).
     monitor: Option<Monitor>,
     /// The second sensor's reading not yet given to the monitor (it runs
@@ -275,6 +278,7 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
             late: false,
             deferred: 0,
             yielded: false,
+            held_reading: None,
             monitor: None,
             #[cfg(feature = "monitor")]
             second: None,
@@ -440,38 +444,11 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
         self.since_sample = self.since_sample.saturating_add(1);
         let design = self.config.observer_design();
         self.observer.predict(design);
-        // A reading's update took this tick (without an FPU it costs about
-        // a job slice: the tick then runs no job).
-        let mut updated = false;
-        match sample {
-            Ok(Some(t)) if t.is_finite() && self.config.oil.contains(t) => {
-                let verdict = self.observer.offer(design, &self.config.spikes, t);
-                updated = verdict == Verdict::Accepted;
-                match verdict {
-                    Verdict::Accepted | Verdict::Step => {
-                        self.since_sample = 0;
-                        #[cfg(feature = "monitor")]
-                        if self.monitor.is_some() {
-                            self.probe_sample = Some((t, self.tick));
-                        }
-                    }
-                    Verdict::Spike => flags.insert(Flags::SPIKE),
-                }
-            }
-            Ok(Some(_)) | Err(_) => flags.insert(Flags::SENSOR_FAULT),
-            Ok(None) => {}
-        }
-        if self.since_sample > self.config.stale_after {
-            flags.insert(Flags::DEGRADED);
-        }
-        // The estimated oil temperature, inside the range the oil model is
-        // used in (the observer may overshoot it for a moment).
-        let t = clamp(self.observer.oil(), self.config.oil.min, self.config.oil.max);
-        flags.insert(self.plant.flags_at(&self.config, t));
-        // The twin first: its events (an impact, a release) cost it a few
-        // steps more, and the tick then runs neither a job nor telemetry
-        // (both wait for the next tick), so that the worst tick stays the
-        // twin's plain tick plus the larger of one job or the telemetry.
+        // The twin first (it does not depend on the observer): its events
+        // (an impact, a release) cost it a step or two more, and the tick
+        // then runs neither a job nor telemetry (both wait for the next
+        // tick), so that the worst tick stays the twin's plain tick plus
+        // the larger of one job or the telemetry.
         let event = match self.plant.advance(&mut flags) {
             Ok(event) => event,
             Err(_) => {
@@ -491,6 +468,52 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
         // anyway: the worst tick is then an event tick plus one job.
         self.deferred = if event { self.deferred.saturating_add(1) } else { 0 };
         let eventful = event && self.deferred <= MAX_DEFERRED;
+        let tick = self.tick;
+        let mut reading = match sample {
+            Ok(Some(t)) if t.is_finite() && self.config.oil.contains(t) => Some((t, tick)),
+            Ok(Some(_)) | Err(_) => {
+                flags.insert(Flags::SENSOR_FAULT);
+                None
+            }
+            Ok(None) => None,
+        };
+        // Without an FPU a reading's update costs about a job's slice, and
+        // on a tick the twin spent on an event it is held back to the next
+        // tick (one tick late: the probe's lag is seconds), which offers it
+        // whatever that tick holds. A reading of the next tick supersedes
+        // one held back.
+        let held = self.held_reading.take();
+        if T::SATURATES && eventful && held.is_none() && reading.is_some() {
+            self.held_reading = reading.take();
+        } else if reading.is_none() {
+            reading = held;
+        }
+        // A reading's update took this tick (without an FPU it costs about
+        // a job slice: the tick then runs no job).
+        let mut updated = false;
+        if let Some((t, at)) = reading {
+            let verdict = self.observer.offer(design, &self.config.spikes, t);
+            updated = verdict == Verdict::Accepted;
+            match verdict {
+                Verdict::Accepted | Verdict::Step => {
+                    self.since_sample = 0;
+                    #[cfg(feature = "monitor")]
+                    if self.monitor.is_some() {
+                        self.probe_sample = Some((t, at));
+                    }
+                    #[cfg(not(feature = "monitor"))]
+                    let _ = at;
+                }
+                Verdict::Spike => flags.insert(Flags::SPIKE),
+            }
+        }
+        if self.since_sample > self.config.stale_after {
+            flags.insert(Flags::DEGRADED);
+        }
+        // The estimated oil temperature, inside the range the oil model is
+        // used in (the observer may overshoot it for a moment).
+        let t = clamp(self.observer.oil(), self.config.oil.min, self.config.oil.max);
+        flags.insert(self.plant.flags_at(&self.config, t));
         let due = self.telemetry_pending
             || (self.config.telemetry_every > 0 && self.tick.is_multiple_of(self.config.telemetry_every));
         self.publish = due && !eventful;
