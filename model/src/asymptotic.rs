@@ -29,7 +29,9 @@
 //! The expansion describes the branch between the stops; the series value
 //! is reported unclamped and clamped to the stops.
 
-use crate::equilibrium::{Stop, a_derivatives, a_derivatives_at, a_parameter, branch_fraction, clamp_to_stops};
+use crate::equilibrium::{
+    Stop, a_derivatives, a_derivatives_at, a_parameter, a_slope_at, branch_fraction, clamp_to_stops,
+};
 use crate::error::{ModelError, finite};
 use crate::fluid::{Derivatives, FluidPoint};
 use crate::params::Params;
@@ -47,6 +49,27 @@ pub enum Reading {
 
 /// `Phi(A)`, `Phi'(A)`, `Phi''(A)` [m, m/sqrt(Pa), m/Pa].
 pub fn phi_derivatives<T: Float>(params: &Params<T>, a: T) -> Derivatives<T> {
+    let (value, d1, k, q2, s, ah) = phi_parts(params, a);
+    let (two, four) = (T::from_f64(2.0), T::from_f64(4.0));
+    Derivatives {
+        value,
+        d1,
+        d2: four * k * q2 * (two * s + ah) / (s * s * s),
+    }
+}
+
+/// `Phi(A)` and `Phi'(A)` alone: [`phi_derivatives`]' first two, the same
+/// operations and values.
+#[inline]
+pub fn phi_slope<T: Float>(params: &Params<T>, a: T) -> (T, T) {
+    let (value, d1, ..) = phi_parts(params, a);
+    (value, d1)
+}
+
+/// `Phi`, `Phi'`, the compliance `k`, `q^2`, `s` ([`branch_fraction`])
+/// and `A / sqrt(dp)`.
+#[inline(always)]
+fn phi_parts<T: Float>(params: &Params<T>, a: T) -> (T, T, T, T, T, T) {
     let dp = params.pressure_drop;
     let k = params.plunger.compliance();
     let sqrt_dp = dp.sqrt();
@@ -55,11 +78,7 @@ pub fn phi_derivatives<T: Float>(params: &Params<T>, a: T) -> Derivatives<T> {
     let q2 = q * q;
     let two = T::from_f64(2.0);
     let four = T::from_f64(4.0);
-    Derivatives {
-        value: k * dp * (two * q2 - T::ONE),
-        d1: -four * k * sqrt_dp * q2 / s,
-        d2: four * k * q2 * (two * s + ah) / (s * s * s),
-    }
+    (k * dp * (two * q2 - T::ONE), -four * k * sqrt_dp * q2 / s, k, q2, s, ah)
 }
 
 /// `Phi(A)` of Eq. (16) \[m\].
@@ -295,14 +314,19 @@ pub fn sensitivity_at<T: Float>(params: &Params<T>, point: &FluidPoint<T>) -> Re
 ///
 /// As [`sensitivity_at`], but for `dQ_throt/dt`, which is not formed.
 pub fn dx_dt_at<T: Float>(params: &Params<T>, point: &FluidPoint<T>) -> Result<T, ModelError> {
-    let (dx_branch, dx, _, _) = dx_dt_parts(params, point)?;
-    finite(dx_branch, "dx/dt")?;
-    Ok(dx)
+    // As dx_dt_parts with the first derivatives alone: the second ones
+    // (three divisions in software on a core without an FPU) go nowhere.
+    let (a, da) = a_slope_at(params, point)?;
+    let (phi, dphi) = phi_slope(params, a);
+    let dx_branch = finite(dphi * da, "dx/dt")?;
+    let (_, stop) = clamp_to_stops(phi - params.plunger.preload, params.plunger.stroke);
+    Ok(if stop == Stop::Free { dx_branch } else { T::ZERO })
 }
 
 /// Eq. (31) at `point`: `dx/dt` on the branch and clamped to the stops (0
 /// on one), with the clamped opening `x` \[m\] and its stop, what
-/// [`sensitivity_at`] and [`dx_dt_at`] both form.
+/// [`sensitivity_at`] forms ([`dx_dt_at`] the same from the first
+/// derivatives alone).
 fn dx_dt_parts<T: Float>(params: &Params<T>, point: &FluidPoint<T>) -> Result<(T, T, T, Stop), ModelError> {
     let a = a_derivatives_at(params, point)?;
     let ph = phi_derivatives(params, a.value);

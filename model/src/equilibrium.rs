@@ -119,17 +119,38 @@ pub fn a_derivatives<T: Float>(params: &Params<T>, t: T) -> Result<Derivatives<T
 /// of them is not finite.
 pub fn a_derivatives_at<T: Float>(params: &Params<T>, point: &FluidPoint<T>) -> Result<Derivatives<T>, ModelError> {
     let (nu, rho) = (&point.viscosity, &point.density);
-    let a = geometry_factor(params) * nu.value * rho.value.sqrt();
-    let n1 = nu.d1 / nu.value;
-    let r1 = rho.d1 / rho.value;
+    let (a, n1, r1, l1) = a_logarithmic(params, point);
     let half = T::from_f64(0.5);
-    let l1 = n1 + half * r1;
     let l2 = nu.d2 / nu.value - n1 * n1 + half * rho.d2 / rho.value - half * r1 * r1;
     Ok(Derivatives {
         value: finite(a, "A(t)")?,
         d1: finite(a * l1, "dA/dt")?,
         d2: finite(a * (l1 * l1 + l2), "d2A/dt2")?,
     })
+}
+
+/// `A(t)` and `dA/dt` alone: [`a_derivatives_at`]'s first two, the same
+/// operations and values, without `d2A/dt2` (two divisions and its check,
+/// in software on a core without an FPU).
+///
+/// # Errors
+///
+/// [`ModelError::NonFinite`] naming `A(t)` or `dA/dt` when one of them is
+/// not finite.
+pub fn a_slope_at<T: Float>(params: &Params<T>, point: &FluidPoint<T>) -> Result<(T, T), ModelError> {
+    let (a, _, _, l1) = a_logarithmic(params, point);
+    Ok((finite(a, "A(t)")?, finite(a * l1, "dA/dt")?))
+}
+
+/// `A`, the viscosity's and the density's logarithmic slopes `nu'/nu`,
+/// `rho'/rho`, and `L1 = nu'/nu + rho'/(2 rho)` (`A' = A L1`).
+#[inline(always)]
+fn a_logarithmic<T: Float>(params: &Params<T>, point: &FluidPoint<T>) -> (T, T, T, T) {
+    let (nu, rho) = (&point.viscosity, &point.density);
+    let a = geometry_factor(params) * nu.value * rho.value.sqrt();
+    let n1 = nu.d1 / nu.value;
+    let r1 = rho.d1 / rho.value;
+    (a, n1, r1, n1 + T::from_f64(0.5) * r1)
 }
 
 /// Clamps a free displacement to the stops.

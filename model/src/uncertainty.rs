@@ -344,8 +344,23 @@ impl UncertaintyTable {
     /// The standard uncertainties at the estimated oil temperature `t` \[C\]
     /// whose observer variance is `var_observer` [C^2]: the grid
     /// interpolated linearly (clamped to its ends), infinite where a
-    /// neighbouring grid point is one the model refuses.
+    /// neighbouring grid point is one the model refuses. The same as
+    /// [`UncertaintyTable::lookup`], each [`UncertaintyTable::output`] and
+    /// [`UncertaintyTable::assemble`] (what a caller that spreads the cost
+    /// over several calls runs).
     pub fn at(&self, t: f32, var_observer: f32) -> Uncertainty {
+        let lookup = self.lookup(t, var_observer);
+        let mut sd = [0.0f32; OUTPUTS];
+        for (o, s) in sd.iter_mut().enumerate() {
+            *s = self.output(&lookup, o);
+        }
+        self.assemble(&lookup, sd)
+    }
+
+    /// Where `t` \[C\] falls on the grid and the oil temperature's
+    /// variance there [C^2] (the observer's `var_observer` and the probe's
+    /// tolerance): what [`UncertaintyTable::at`]'s outputs share.
+    pub fn lookup(&self, t: f32, var_observer: f32) -> Lookup {
         let pos = (t - self.t0) / self.step;
         // NaN and beyond the ends: the end rows.
         let pos = if pos > 0.0 { pos } else { 0.0 };
@@ -353,21 +368,39 @@ impl UncertaintyTable {
         let pos = if pos < last { pos } else { last };
         let k = (pos as usize).min(GRID - 2);
         let w = pos - k as f32;
-        let lerp = |a: f32, b: f32| a + w * (b - a);
-        let sd_probe = lerp(self.sd_probe[k], self.sd_probe[k + 1]);
-        let var_t = var_observer + sd_probe * sd_probe;
-        let mut sd = [0.0f32; OUTPUTS];
-        for (o, s) in sd.iter_mut().enumerate() {
-            let slope = lerp(self.slope[k][o], self.slope[k + 1][o]);
-            let sd_params = lerp(self.sd_params[k][o], self.sd_params[k + 1][o]);
-            let var = slope * slope * var_t + sd_params * sd_params;
-            *s = if var.is_nan() {
-                f32::INFINITY
-            } else {
-                crate::scalar::Real::sqrt(var)
-            };
+        let sd_probe = lerp(w, self.sd_probe[k], self.sd_probe[k + 1]);
+        Lookup {
+            k,
+            w,
+            var_t: var_observer + sd_probe * sd_probe,
         }
-        let t_oil = crate::scalar::Real::sqrt(var_t);
+    }
+
+    /// The standard uncertainty of output `o` ([`OUTPUT_NAMES`]) at
+    /// `lookup`; infinite where the model refuses a neighbouring grid
+    /// point, and for an `o` beyond [`OUTPUTS`].
+    pub fn output(&self, lookup: &Lookup, o: usize) -> f32 {
+        let k = lookup.k.min(GRID - 2);
+        let (Some(slope), Some(sd_params)) = (
+            self.slope[k].get(o).zip(self.slope[k + 1].get(o)),
+            self.sd_params[k].get(o).zip(self.sd_params[k + 1].get(o)),
+        ) else {
+            return f32::INFINITY;
+        };
+        let slope = lerp(lookup.w, *slope.0, *slope.1);
+        let sd_params = lerp(lookup.w, *sd_params.0, *sd_params.1);
+        let var = slope * slope * lookup.var_t + sd_params * sd_params;
+        if var.is_nan() {
+            f32::INFINITY
+        } else {
+            crate::scalar::Real::sqrt(var)
+        }
+    }
+
+    /// The uncertainty from the outputs' standard uncertainties `sd` (in
+    /// [`OUTPUT_NAMES`]' order) at `lookup`.
+    pub fn assemble(&self, lookup: &Lookup, sd: [f32; OUTPUTS]) -> Uncertainty {
+        let t_oil = crate::scalar::Real::sqrt(lookup.var_t);
         let [x, p_a, p_b, q_total, compensation_error] = sd;
         Uncertainty {
             t_oil,
@@ -378,6 +411,24 @@ impl UncertaintyTable {
             compensation_error: if self.machine { compensation_error } else { f32::NAN },
         }
     }
+}
+
+/// `a + w (b - a)`.
+#[inline(always)]
+fn lerp(w: f32, a: f32, b: f32) -> f32 {
+    a + w * (b - a)
+}
+
+/// Where a temperature falls on an [`UncertaintyTable`]'s grid
+/// ([`UncertaintyTable::lookup`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lookup {
+    /// The grid row below.
+    k: usize,
+    /// The weight of the row above, in `[0, 1]`.
+    w: f32,
+    /// The oil temperature's variance [C^2].
+    var_t: f32,
 }
 
 #[cfg(test)]

@@ -137,6 +137,8 @@ pub struct Dirk<T> {
     h_b: [T; MAX_STAGES],
     /// What the whole step's stages share.
     full: StepFactors<T>,
+    /// `1 / gamma`: the step of an implicit Euler piece from the stages' `h gamma`.
+    inv_gamma: T,
 }
 
 /// What the stages of a step of one length share: `h gamma` and the
@@ -292,6 +294,7 @@ impl<T: Real> Dirk<T> {
             alpha,
             h_b,
             full: StepFactors::new(T::from_f64(h * tableau.gamma), c),
+            inv_gamma: T::from_f64(1.0 / tableau.gamma),
         }
     }
 
@@ -352,6 +355,19 @@ impl<T: Real> Dirk<T> {
         let h_a_x = if frac == T::ONE { c.a_x } else { c.a_x * frac };
         yi[0] = y[0].dot_add_compensated(h_a_x, &self.h_b[..stages], &ws[..stages], xi_carry);
         yi
+    }
+
+    /// A held piece of `frac` of the step by implicit Euler, L-stable and
+    /// of first order: one stage for each chamber where the scheme's step
+    /// takes `stages`. What a core without an FPU takes for the held rest
+    /// of a substep after its second event ([`super::Twin::tick`]).
+    pub fn held_euler(&self, c: &Coefficients<T>, y: &State<T>, frac: T) -> State<T> {
+        let f = StepFactors::new(self.full.hg * frac * self.inv_gamma, c);
+        let (ta, tb) = time_constants(c, y[0]);
+        let e = c.drive(T::ZERO);
+        let ua = chamber(c, ta, &f, c.supply() - y[2], e).u;
+        let ub = chamber(c, tb, &f, y[3], e).u;
+        [y[0], T::ZERO, c.supply() - ua, ub]
     }
 
     /// A held step: `xi` kept, `w = 0`, each chamber's pressure alone (the

@@ -551,7 +551,17 @@ impl<F: Float, T: Real> Twin<F, T> {
         if events == 0 {
             // No event left: held for the rest (its pressures relax with the
             // plunger at rest, never with the pumping of a motion the stop
-            // forbids); a lift-off waits for the next substep.
+            // forbids); a lift-off waits for the next substep. Fixed point
+            // (the cores without an FPU) holds it by implicit Euler: the
+            // substep's third step (a touch: an impact, a free rest, an
+            // impact again) made a Cortex-M0 tick over three plain ones.
+            if T::SATURATES
+                && !fine
+                && let Engine::Dirk(d) = &self.engine
+            {
+                *carry = T::ZERO;
+                return Ok((d.held_euler(&self.coefficients, &at, rest), IMPACT));
+            }
             let (end, _) = self.held_piece(&at, rest, contact, carry, 0, fine)?;
             return Ok((end, IMPACT));
         }

@@ -9,14 +9,15 @@ use crate::compensation;
 use crate::dynamics::Twin;
 use crate::dynamics::coefficients::Coefficients;
 use crate::dynamics::fsi::{Contact, Fsi};
-use crate::dynamics::linear::characteristic_polynomial;
+use crate::dynamics::linear::{characteristic_polynomial, fsi_characteristic_polynomial};
+use crate::dynamics::schemes::OdeSystem;
 use crate::equilibrium::{Stop, a_parameter, balance_for};
 use crate::error::ModelError;
 use crate::fluid::{FluidPoint, WaltherLog};
 use crate::params::Params;
 use crate::scalar::Real;
 use crate::throttle::FlowLaws;
-use crate::uncertainty::{Uncertainty, UncertaintyTable};
+use crate::uncertainty::{Lookup, Uncertainty, UncertaintyTable};
 
 /// The temperature-only jobs, one per tick in turn (the uncertainty's
 /// depends on the observer's variance too).
@@ -246,8 +247,10 @@ fn apply<T: Real>(
 
 /// Routh-Hurwitz tests per slice of the Stability job's decay-rate search
 /// on a core without an FPU ([`Pending::Search`]): the usual case, the
-/// hint confirmed, is one slice; a whole search (at most ten tests) four.
-pub(super) const SEARCH_STEPS: u32 = 3;
+/// hint confirmed (two tests), is one slice; a whole search (at most ten
+/// tests) five. A test costs a Cortex-M0 about 3,800 instructions in
+/// software `f32`: three on one tick made the costliest slice.
+pub(super) const SEARCH_STEPS: u32 = 2;
 
 /// The characteristic polynomial of the linearisation at the equilibrium
 /// (in the twin's model units), in `f32` whatever the twin's scalar. A
@@ -264,10 +267,7 @@ fn stability_polynomial<T: Real>(twin: &Twin<f32, T>, statics: &Statics) -> [f32
 /// The Jacobian whose characteristic polynomial [`stability_polynomial`] is.
 #[inline(always)]
 fn stability_jacobian<T: Real>(twin: &Twin<f32, T>, statics: &Statics) -> [[f32; 4]; 4] {
-    let coefficients = stability_coefficients(twin);
-    let sys = linearised(&coefficients);
-    let y = &statics.y_equilibrium;
-    sys.jacobian_with(y, sys.orifice_a(y), sys.orifice_b(y))
+    linearised(&stability_coefficients(twin)).jacobian(&statics.y_equilibrium)
 }
 
 /// The twin's coefficients in `f32` for the Stability job's linearisation
@@ -344,6 +344,11 @@ pub(super) enum Pending {
     /// \[C^2\] (the observer's, taken on the job's first tick), the
     /// table's input.
     Uncertainty(f32, f32),
+    /// The Uncertainty job's place on the table and its first three
+    /// outputs' standard uncertainties (`x`, `p_a`, `p_b`), the rest next:
+    /// the five outputs' square roots on one tick made the Cortex-M0's
+    /// costliest slice, about 12,000 instructions in software `f32`.
+    UncertaintyRest(Lookup, [f32; 3]),
     /// The Stability job's decay-rate search.
     Search(DecaySearch),
 }
@@ -411,7 +416,13 @@ pub(super) fn resume<T: Real>(
             }),
         ),
         Pending::Uncertainty(t, variance) => {
-            statics.uncertainty = table.at(t, variance);
+            let lookup = table.lookup(t, variance);
+            let first = [0, 1, 2].map(|o| table.output(&lookup, o));
+            (Job::Uncertainty, Ok(Some(Pending::UncertaintyRest(lookup, first))))
+        }
+        Pending::UncertaintyRest(lookup, [x, p_a, p_b]) => {
+            let (q_total, error) = (table.output(&lookup, 3), table.output(&lookup, 4));
+            statics.uncertainty = table.assemble(&lookup, [x, p_a, p_b, q_total, error]);
             (Job::Uncertainty, Ok(None))
         }
         Pending::Linearise(coefficients, a) => {
@@ -423,7 +434,7 @@ pub(super) fn resume<T: Real>(
             )
         }
         Pending::Jacobian(m) => {
-            let poly = characteristic_polynomial(&m);
+            let poly = fsi_characteristic_polynomial(&m);
             statics.stable = quartic_hurwitz(&poly);
             let next = if statics.stable {
                 Some(Pending::Search(DecaySearch::new(&poly, statics.slowest_rate)))
