@@ -32,7 +32,7 @@ use crate::variables::{
     VR_P_OUTLET, VR_P_SUPPLY, VR_SECOND_READING, VR_TIME, field_of, fields, input_of, output,
 };
 use compensator::dynamics::config::choose;
-use compensator::dynamics::{TwinConfig, TwinMemory};
+use compensator::dynamics::{Owed, TwinConfig, TwinMemory};
 use compensator::estimator::health::HEALTH_FIELDS;
 use compensator::estimator::{EstimatorConfig, Flags, NO_LAG, Plant};
 use compensator::monitor::{HealthEstimate, Monitor, MonitorSettings, PER_READING, PlantView, ProbeModel, ProbeSample};
@@ -999,6 +999,9 @@ impl Instance {
                     state,
                     xi_carry,
                     abrupt,
+                    // A floating-point twin never leaves an event's rest
+                    // to the next tick.
+                    owed: Owed::NONE,
                 });
                 sim.time = time;
                 sim.flags = flags;

@@ -134,6 +134,31 @@ pub const ABRUPT_CHANGE: f64 = 0.01;
 /// substep's end, a release at its start).
 pub const EVENTS_PER_SUBSTEP: u8 = 1;
 
+/// The rest of a substep that a stop event left to the next substep, in a
+/// fixed-point twin (the cores without an FPU): the state stands at the
+/// event (an impact, a release), up to one substep behind the substep's
+/// end, and the next substep is longer by `frac` (one step of `1 + frac`
+/// substeps). An event then costs its substep no second step, and the
+/// twin still follows real time: it is behind by at most one substep, for
+/// one substep.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Owed<T> {
+    /// The rest, in substeps: `0 <= frac <= 1`.
+    pub frac: T,
+    /// The rest is free motion (after a release, or an impact the force
+    /// pulls off again at once), whatever the contact test says at the
+    /// event, where the force is zero to within rounding.
+    pub free: bool,
+}
+
+impl<T: Real> Owed<T> {
+    /// Nothing owed.
+    pub const NONE: Owed<T> = Owed {
+        frac: T::ZERO,
+        free: false,
+    };
+}
+
 /// Largest pressure drop [`Twin::set_pressures`] takes, in units of the
 /// design's `dp` (either sign).
 pub const MAX_DROP: f64 = 64.0;
@@ -211,6 +236,8 @@ pub struct Twin<F, T> {
     xi_carry: T,
     /// The coefficients changed abruptly since the last tick.
     abrupt: bool,
+    /// The rest of a substep an event left to the next one ([`Owed`]).
+    owed: Owed<T>,
     /// Pieces of a graded substep: the first no longer than [`GRADED_FIRST`].
     graded_pieces: u8,
     config: TwinConfig,
@@ -245,6 +272,7 @@ impl<F: Float, T: Real> Twin<F, T> {
             state: model.equilibrium_state(&eq),
             xi_carry: T::ZERO,
             abrupt: false,
+            owed: Owed::NONE,
             graded_pieces: timing.graded_pieces,
             model,
             config,
@@ -403,7 +431,11 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// events at most [`EVENTS_PER_SUBSTEP`] of them, each adding one free
     /// or one held step; a graded substep at most [`MAX_GRADED_PIECES`]
     /// such pieces (host simulations of abrupt steps: the estimator never
-    /// changes the coefficients abruptly).
+    /// changes the coefficients abruptly). In fixed point (the cores
+    /// without an FPU, where a step is the tick's cost) an event's rest is
+    /// not stepped in its substep but added to the next one ([`Owed`]): a
+    /// substep is then one step with or without an event, and the state at
+    /// the tick's end may stand up to one substep behind it, at the event.
     ///
     /// # Errors
     ///
@@ -421,11 +453,13 @@ impl<F: Float, T: Real> Twin<F, T> {
         self.abrupt = false;
         for k in 0..self.substeps {
             let mut carry = self.xi_carry;
-            let (next, e) = self.substep(&self.state, &mut carry, graded && k == 0)?;
+            let mut owed = Owed::NONE;
+            let (next, e) = self.substep(&self.state, &mut carry, graded && k == 0, self.owed, &mut owed)?;
             self.check(&next)?;
             events |= e;
             self.state = next;
             self.xi_carry = carry;
+            self.owed = owed;
         }
         Ok(TickReport {
             contact: self.coefficients.contact(&self.state),
@@ -471,11 +505,28 @@ impl<F: Float, T: Real> Twin<F, T> {
 
     /// `frac` of a substep from `y`; `carry` is `xi`'s compensated-summation carry.
     /// `fine`: a piece of a graded substep (see [`Twin::substep`]).
-    fn piece(&self, y: &[T; 4], frac: T, carry: &mut T, fine: bool) -> Result<([T; 4], u8), StepError> {
+    /// `owed`: where an event's rest is left to the next substep.
+    fn piece(
+        &self,
+        y: &[T; 4],
+        frac: T,
+        carry: &mut T,
+        fine: bool,
+        owed: &mut Owed<T>,
+    ) -> Result<([T; 4], u8), StepError> {
         match self.coefficients.contact(y) {
-            Contact::Free => self.free_piece(y, frac, carry, EVENTS_PER_SUBSTEP, fine, None),
-            held => self.held_piece(y, frac, held, carry, EVENTS_PER_SUBSTEP, fine),
+            Contact::Free => self.free_piece(y, frac, carry, EVENTS_PER_SUBSTEP, fine, None, owed),
+            held => self.held_piece(y, frac, held, carry, EVENTS_PER_SUBSTEP, fine, owed),
         }
+    }
+
+    /// An event's rest of `rest` substeps is left to the next substep
+    /// ([`Owed`]): fixed point, a plain substep's SDIRK step, and a rest of
+    /// at most one substep (a rest longer than that, left by a substep
+    /// that was itself longer, is stepped at once, so that the twin is
+    /// never more than one substep behind).
+    fn defers(&self, rest: T, fine: bool) -> bool {
+        T::SATURATES && !fine && rest <= T::ONE && matches!(self.engine, Engine::Dirk(_))
     }
 
     /// One substep from `y`; after an abrupt change of the coefficients the
@@ -484,20 +535,49 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// change starts (the pressures re-equilibrating, the plunger
     /// accelerating into its new motion) is followed rather than stepped
     /// over.
-    fn substep(&self, y: &[T; 4], carry: &mut T, graded: bool) -> Result<([T; 4], u8), StepError> {
+    ///
+    /// `from`: the rest an event of the last substep left to this one
+    /// (taken with the substep: one step of `1 + from.frac` substeps, or
+    /// with a graded substep's last piece); `owed`: the rest this one
+    /// leaves to the next.
+    fn substep(
+        &self,
+        y: &[T; 4],
+        carry: &mut T,
+        graded: bool,
+        from: Owed<T>,
+        owed: &mut Owed<T>,
+    ) -> Result<([T; 4], u8), StepError> {
+        // Only fixed point leaves a rest ([`Twin::defers`]): a float twin
+        // compiles none of this.
+        let from = if T::SATURATES { from } else { Owed::NONE };
         if !graded {
-            return self.piece(y, T::ONE, carry, false);
+            let frac = T::ONE + from.frac;
+            if from.free {
+                return self.free_piece(y, frac, carry, EVENTS_PER_SUBSTEP, false, None, owed);
+            }
+            return self.piece(y, frac, carry, false, owed);
         }
         let mut frac = T::ONE;
         for _ in 1..self.graded_pieces {
             frac *= T::HALF;
         }
-        let (mut state, mut events) = self.piece(y, frac, carry, true)?;
-        for _ in 1..self.graded_pieces {
-            let (next, e) = self.piece(&state, frac, carry, true)?;
+        // Graded pieces are fine: they leave nothing owed. The last takes
+        // the rest owed to this substep.
+        let mut none = Owed::NONE;
+        let (mut state, mut events) = (*y, 0u8);
+        for k in 0..self.graded_pieces {
+            let piece = if k + 1 == self.graded_pieces {
+                frac + from.frac
+            } else {
+                frac
+            };
+            let (next, e) = self.piece(&state, piece, carry, true, &mut none)?;
             state = next;
             events |= e;
-            frac = frac + frac;
+            if k > 0 {
+                frac = frac + frac;
+            }
         }
         Ok((state, events))
     }
@@ -511,6 +591,9 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// the piece's end; a step that ends back beyond that stop returns that
     /// held state (the release did not last: see [`Twin::held_piece`]).
     /// Returns the state and the events.
+    // The piece's state, length, carries and budget: one recursion's
+    // arguments, not a record worth naming.
+    #[allow(clippy::too_many_arguments)]
     fn free_piece(
         &self,
         y: &[T; 4],
@@ -519,6 +602,7 @@ impl<F: Float, T: Real> Twin<F, T> {
         events: u8,
         fine: bool,
         released: Option<(Contact, &[T; 4])>,
+        owed: &mut Owed<T>,
     ) -> Result<([T; 4], u8), StepError> {
         let mut tried = *carry;
         let next = self.step(y, frac, Contact::Free, &mut tried, fine)?;
@@ -548,6 +632,16 @@ impl<F: Float, T: Real> Twin<F, T> {
         if !(rest > T::ZERO) {
             return Ok((at, IMPACT));
         }
+        // Held for the rest, unless the plunger travelled before the impact
+        // and the force there pulls it off the stop again (a touch).
+        let touch = theta > T::ZERO && away_from(&self.coefficients, contact, &at) > T::ZERO;
+        if self.defers(rest, fine) {
+            *owed = Owed {
+                frac: rest,
+                free: touch,
+            };
+            return Ok((at, IMPACT));
+        }
         if events == 0 {
             // No event left: held for the rest (its pressures relax with the
             // plunger at rest, never with the pumping of a motion the stop
@@ -562,15 +656,13 @@ impl<F: Float, T: Real> Twin<F, T> {
                 *carry = T::ZERO;
                 return Ok((d.held_euler(&self.coefficients, &at, rest), IMPACT));
             }
-            let (end, _) = self.held_piece(&at, rest, contact, carry, 0, fine)?;
+            let (end, _) = self.held_piece(&at, rest, contact, carry, 0, fine, owed)?;
             return Ok((end, IMPACT));
         }
-        // Held for the rest, unless the plunger travelled before the impact
-        // and the force there pulls it off the stop again (a touch).
-        let (end, e) = if theta > T::ZERO && away_from(&self.coefficients, contact, &at) > T::ZERO {
-            self.free_piece(&at, rest, carry, events - 1, fine, None)?
+        let (end, e) = if touch {
+            self.free_piece(&at, rest, carry, events - 1, fine, None, owed)?
         } else {
-            self.held_piece(&at, rest, contact, carry, events - 1, fine)?
+            self.held_piece(&at, rest, contact, carry, events - 1, fine, owed)?
         };
         Ok((end, e | IMPACT))
     }
@@ -587,6 +679,9 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// the held step's state: it did not leave in the net, and the held
     /// rest after the bounce would cost a third step for a motion below the
     /// step's resolution.
+    // The piece's state, length, carries and budget: one recursion's
+    // arguments, not a record worth naming.
+    #[allow(clippy::too_many_arguments)]
     fn held_piece(
         &self,
         y: &[T; 4],
@@ -595,6 +690,7 @@ impl<F: Float, T: Real> Twin<F, T> {
         carry: &mut T,
         events: u8,
         fine: bool,
+        owed: &mut Owed<T>,
     ) -> Result<([T; 4], u8), StepError> {
         let c = &self.coefficients;
         // On the stop exactly: nothing is left to carry.
@@ -610,7 +706,7 @@ impl<F: Float, T: Real> Twin<F, T> {
             // Held although pulled away at the start (the piece after an
             // impact at its start): released there.
             let back = (!fine).then_some((held, &end));
-            let (end, e) = self.free_piece(&y0, frac, carry, events - 1, fine, back)?;
+            let (end, e) = self.free_piece(&y0, frac, carry, events - 1, fine, back, owed)?;
             return Ok((end, e | RELEASE));
         }
         // Released where the held force, interpolated linearly over the
@@ -632,8 +728,12 @@ impl<F: Float, T: Real> Twin<F, T> {
         if !(rest > T::ZERO) {
             return Ok((at, RELEASE));
         }
+        if self.defers(rest, fine) {
+            *owed = Owed { frac: rest, free: true };
+            return Ok((at, RELEASE));
+        }
         let back = (!fine).then_some((held, &end));
-        let (end, e) = self.free_piece(&at, rest, carry, events - 1, fine, back)?;
+        let (end, e) = self.free_piece(&at, rest, carry, events - 1, fine, back, owed)?;
         Ok((end, e | RELEASE))
     }
 
@@ -683,6 +783,7 @@ impl<F: Float, T: Real> Twin<F, T> {
     pub fn set_state(&mut self, s: &DynamicState<F>) {
         self.state = self.model.scales.from_si(s);
         self.xi_carry = T::ZERO;
+        self.owed = Owed::NONE;
     }
 
     /// What the next ticks depend on besides the configuration and the
@@ -696,6 +797,7 @@ impl<F: Float, T: Real> Twin<F, T> {
             state: self.state,
             xi_carry: self.xi_carry,
             abrupt: self.abrupt,
+            owed: self.owed,
         }
     }
 
@@ -706,6 +808,7 @@ impl<F: Float, T: Real> Twin<F, T> {
         self.state = memory.state;
         self.xi_carry = memory.xi_carry;
         self.abrupt = memory.abrupt;
+        self.owed = memory.owed;
     }
 }
 
@@ -719,6 +822,9 @@ pub struct TwinMemory<T> {
     pub xi_carry: T,
     /// The next tick starts graded (the coefficients changed abruptly).
     pub abrupt: bool,
+    /// The rest of a substep an event left to the next tick (fixed point
+    /// only; [`Owed::NONE`] in floating point).
+    pub owed: Owed<T>,
 }
 
 impl<F: Float, T: Real> super::Dynamic<F> for Twin<F, T> {

@@ -7,14 +7,18 @@
 //! 1. the oil-temperature observer predicts to this tick ([`OilObserver`]:
 //!    a Kalman filter of the oil temperature, its rate and the probe's
 //!    lagging temperature);
-//! 2. the latest reading (if any) is checked: not finite or outside the
+//! 2. the twin advances one tick (its coefficients from the last Fluid
+//!    job), driven by the estimated oil temperature, not the reading;
+//! 3. the latest reading (if any) is checked: not finite or outside the
 //!    oil's range is a fault; further than `spike_threshold` from the
 //!    reading the observer expects is a spike and rejected, unless it is
 //!    the `spike_limit + 1`-th consecutive out-of-band reading agreeing
 //!    (within the threshold) with the one before: then it is a real step
-//!    and the observer restarts at it; else the observer updates with it;
-//! 3. the twin advances one tick (its coefficients from the last Fluid
-//!    job), driven by the estimated oil temperature, not the reading;
+//!    and the observer restarts at it; else the observer updates with it.
+//!    Where the twin is fixed point (no FPU) a reading that arrives on a
+//!    tick the twin spent on an event (step 2) is held back to the first
+//!    tick without one, at most [`MAX_DEFERRED`] ticks; a newer reading
+//!    supersedes it;
 //! 4. one temperature-only job runs, in turn: the oil's properties (one
 //!    Walther evaluation, handed to the twin and the flow laws) at the
 //!    estimated temperature, reached at a bounded slew ([`TWIN_SLEW`]: the
@@ -478,15 +482,14 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
             Ok(None) => None,
         };
         // Without an FPU a reading's update costs about a job's slice, and
-        // on a tick the twin spent on an event it is held back to the next
-        // tick (one tick late: the probe's lag is seconds), which offers it
-        // whatever that tick holds. A reading of the next tick supersedes
-        // one held back.
-        let held = self.held_reading.take();
-        if T::SATURATES && eventful && held.is_none() && reading.is_some() {
-            self.held_reading = reading.take();
-        } else if reading.is_none() {
-            reading = held;
+        // on a tick the twin spent on an event it is held back until a
+        // tick without one (at most MAX_DEFERRED ticks late: the probe's
+        // lag is seconds). A newer reading supersedes one held back.
+        if T::SATURATES {
+            reading = reading.or(self.held_reading.take());
+            if eventful {
+                self.held_reading = reading.take();
+            }
         }
         // A reading's update took this tick (without an FPU it costs about
         // a job slice: the tick then runs no job).
@@ -496,7 +499,8 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
             updated = verdict == Verdict::Accepted;
             match verdict {
                 Verdict::Accepted | Verdict::Step => {
-                    self.since_sample = 0;
+                    // A reading held back is as old as the tick it came on.
+                    self.since_sample = self.tick.wrapping_sub(at);
                     #[cfg(feature = "monitor")]
                     if self.monitor.is_some() {
                         self.probe_sample = Some((t, at));
@@ -523,7 +527,10 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
         // the update costs about what a job's slice does, and the two on
         // one tick made the worst tick.
         let busy = T::SATURATES && updated && !self.yielded;
-        self.yielded = busy;
+        // Only a job tick given up to a reading counts: the next reading's
+        // update then shares its tick with the job, so that readings on
+        // every tick cannot starve the jobs.
+        self.yielded = busy && !due && !eventful;
         if !due && !eventful && !busy {
             // A job tick (a telemetry tick only publishes: the costliest
             // tick is spared); a waiting reading of the second sensor takes
