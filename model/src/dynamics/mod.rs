@@ -31,7 +31,7 @@ pub mod units;
 pub use coefficients::Model;
 pub use schemes::{Scheme, StepError};
 pub use stops::Contact;
-pub use twin::{Owed, TickReport, Twin, TwinConfig, TwinMemory};
+pub use twin::{Owed, Rest, TickReport, Twin, TwinConfig, TwinMemory};
 pub use units::DynamicState;
 
 use crate::error::ModelError;

@@ -143,19 +143,34 @@ pub const EVENTS_PER_SUBSTEP: u8 = 1;
 /// one substep.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Owed<T> {
-    /// The rest, in substeps: `0 <= frac <= 1`.
+    /// The rest, in substeps: `0 <= frac <= 2`.
     pub frac: T,
-    /// The rest is free motion (after a release, or an impact the force
-    /// pulls off again at once), whatever the contact test says at the
-    /// event, where the force is zero to within rounding.
-    pub free: bool,
+    /// How the rest is taken.
+    pub rest: Rest,
+}
+
+/// How an owed rest ([`Owed`]) is taken: as the event left the plunger,
+/// not as the contact test at the event finds it (the force there is zero
+/// to within rounding).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rest {
+    /// Nothing owed: the contact test at the substep's start decides.
+    Tested,
+    /// Held on this stop (an impact).
+    Held(Contact),
+    /// Free (a touch: an impact the force at the stop pulls off again).
+    Free,
+    /// Free after a release from this stop; a rest that ends back beyond
+    /// it leaves the plunger held for the whole substep, its pressures by
+    /// implicit Euler (the release did not last; [`Twin::held_piece`]).
+    Released(Contact),
 }
 
 impl<T: Real> Owed<T> {
     /// Nothing owed.
     pub const NONE: Owed<T> = Owed {
         frac: T::ZERO,
-        free: false,
+        rest: Rest::Tested,
     };
 }
 
@@ -203,6 +218,17 @@ impl<T: Real> Timing<T> {
             graded_pieces,
         }
     }
+}
+
+/// The state a free piece just released from a stop returns when it ends
+/// back beyond that stop ([`Twin::free_piece`]).
+#[derive(Clone, Copy, Debug)]
+enum Back<'a, T> {
+    /// The held step's, already taken.
+    Held(&'a [T; 4]),
+    /// Held from the piece's start by implicit Euler (a rest owed after a
+    /// release: no held step was taken).
+    Euler(&'a Dirk<T>),
 }
 
 /// The integrator behind a twin.
@@ -459,7 +485,9 @@ impl<F: Float, T: Real> Twin<F, T> {
             events |= e;
             self.state = next;
             self.xi_carry = carry;
-            self.owed = owed;
+            if T::SATURATES {
+                self.owed = owed;
+            }
         }
         Ok(TickReport {
             contact: self.coefficients.contact(&self.state),
@@ -526,7 +554,7 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// that was itself longer, is stepped at once, so that the twin is
     /// never more than one substep behind).
     fn defers(&self, rest: T, fine: bool) -> bool {
-        T::SATURATES && !fine && rest <= T::ONE && matches!(self.engine, Engine::Dirk(_))
+        T::SATURATES && !fine && rest <= T::TWO && matches!(self.engine, Engine::Dirk(_))
     }
 
     /// One substep from `y`; after an abrupt change of the coefficients the
@@ -553,10 +581,17 @@ impl<F: Float, T: Real> Twin<F, T> {
         let from = if T::SATURATES { from } else { Owed::NONE };
         if !graded {
             let frac = T::ONE + from.frac;
-            if from.free {
-                return self.free_piece(y, frac, carry, EVENTS_PER_SUBSTEP, false, None, owed);
-            }
-            return self.piece(y, frac, carry, false, owed);
+            let events = EVENTS_PER_SUBSTEP;
+            return match (from.rest, &self.engine) {
+                (Rest::Released(stop), Engine::Dirk(d)) => {
+                    self.free_piece(y, frac, carry, events, false, Some((stop, Back::Euler(d))), owed)
+                }
+                (Rest::Free | Rest::Released(_), _) => self.free_piece(y, frac, carry, events, false, None, owed),
+                (Rest::Held(stop), _) if stop != Contact::Free => {
+                    self.held_piece(y, frac, stop, carry, events, false, owed)
+                }
+                _ => self.piece(y, frac, carry, false, owed),
+            };
         }
         let mut frac = T::ONE;
         for _ in 1..self.graded_pieces {
@@ -601,7 +636,7 @@ impl<F: Float, T: Real> Twin<F, T> {
         carry: &mut T,
         events: u8,
         fine: bool,
-        released: Option<(Contact, &[T; 4])>,
+        released: Option<(Contact, Back<'_, T>)>,
         owed: &mut Owed<T>,
     ) -> Result<([T; 4], u8), StepError> {
         let mut tried = *carry;
@@ -614,11 +649,16 @@ impl<F: Float, T: Real> Twin<F, T> {
             *carry = tried;
             return Ok((next, 0));
         };
-        if let Some((from, held)) = released
+        if let Some((from, back)) = released
             && from == contact
         {
             *carry = T::ZERO;
-            return Ok((*held, RELEASE | IMPACT));
+            let held = match back {
+                Back::Held(held) => *held,
+                Back::Euler(d) if T::SATURATES => d.held_euler(&self.coefficients, &[y[0], T::ZERO, y[2], y[3]], frac),
+                Back::Euler(_) => *y,
+            };
+            return Ok((held, RELEASE | IMPACT));
         }
         *carry = T::ZERO;
         let theta = self.impact_fraction(y, &next, frac, stop);
@@ -638,7 +678,7 @@ impl<F: Float, T: Real> Twin<F, T> {
         if self.defers(rest, fine) {
             *owed = Owed {
                 frac: rest,
-                free: touch,
+                rest: if touch { Rest::Free } else { Rest::Held(contact) },
             };
             return Ok((at, IMPACT));
         }
@@ -705,7 +745,7 @@ impl<F: Float, T: Real> Twin<F, T> {
         if f0 > T::ZERO {
             // Held although pulled away at the start (the piece after an
             // impact at its start): released there.
-            let back = (!fine).then_some((held, &end));
+            let back = (!fine).then_some((held, Back::Held(&end)));
             let (end, e) = self.free_piece(&y0, frac, carry, events - 1, fine, back, owed)?;
             return Ok((end, e | RELEASE));
         }
@@ -729,10 +769,13 @@ impl<F: Float, T: Real> Twin<F, T> {
             return Ok((at, RELEASE));
         }
         if self.defers(rest, fine) {
-            *owed = Owed { frac: rest, free: true };
+            *owed = Owed {
+                frac: rest,
+                rest: Rest::Released(held),
+            };
             return Ok((at, RELEASE));
         }
-        let back = (!fine).then_some((held, &end));
+        let back = (!fine).then_some((held, Back::Held(&end)));
         let (end, e) = self.free_piece(&at, rest, carry, events - 1, fine, back, owed)?;
         Ok((end, e | RELEASE))
     }

@@ -499,8 +499,9 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
             updated = verdict == Verdict::Accepted;
             match verdict {
                 Verdict::Accepted | Verdict::Step => {
-                    // A reading held back is as old as the tick it came on.
-                    self.since_sample = self.tick.wrapping_sub(at);
+                    // A reading held back (fixed point only) is as old as
+                    // the tick it came on.
+                    self.since_sample = if T::SATURATES { self.tick.wrapping_sub(at) } else { 0 };
                     #[cfg(feature = "monitor")]
                     if self.monitor.is_some() {
                         self.probe_sample = Some((t, at));
