@@ -535,6 +535,11 @@ pub struct Monitor {
     sd_model: f32,
     /// The twin's oil temperature at the last reading \[C\].
     last_oil: f32,
+    /// The twin's transient in the second sensor's temperature \[K\]
+    /// (`|y_twin - y_eq| / |dy/dT|`), through the probe's lag: a standard
+    /// deviation of the probe's prediction that does not average down
+    /// ([`Monitor::begin`]).
+    twin_bias: f32,
     /// The reading's stages not yet run ([`Monitor::begin`]).
     pending: Pending,
 }
@@ -663,6 +668,7 @@ impl Monitor {
             reference: [0.0; PARAMETERS],
             sd_model,
             last_oil: f32::NAN,
+            twin_bias: 0.0,
             pending: Pending::NONE,
         })
     }
@@ -851,6 +857,20 @@ impl Monitor {
                     && !self.at_stop(y, theta[OFFSET]) =>
             {
                 let inv = -1.0 / dy_dt;
+                // The twin's transient is the device's only as far as the
+                // twin's drive (the observer's oil temperature, whose rate is
+                // off by tenths of a kelvin a second at a ramp's knee) is the
+                // oil's: through a plunger as slow as a second (the seeded
+                // designs' slowest time constants reach 1.4 s) it moves the
+                // second sensor's temperature by tenths of a kelvin for
+                // seconds, a bias the probe's lag passes whole, not a noise
+                // it averages down. Its size through the lag is a standard
+                // deviation of the probe's prediction (`test`).
+                let bias = libm::fabsf(transient * inv);
+                if bias.is_finite() {
+                    let p = self.decay.probe;
+                    self.twin_bias = p * self.twin_bias + (1.0 - p) * bias;
+                }
                 let d = clamp((y - predicted) * -inv, -MAX_DEVIATION, MAX_DEVIATION);
                 u[OIL] = t_twin + d;
                 for k in 0..=OFFSET {
@@ -873,6 +893,7 @@ impl Monitor {
             }
             _ => {
                 u[UNINFORMED] = 1.0;
+                self.twin_bias *= self.decay.probe;
                 false
             }
         };
@@ -1015,7 +1036,10 @@ impl Monitor {
         // (`c n_k`), the uninformed share's error.
         let spread = uninformed * UNINFORMED_ERROR;
         let c = 0.5 * (1.0 - self.decay.probe);
-        let r = probe.reading_sd * probe.reading_sd + c * c * self.last_fresh + spread * spread;
+        let r = probe.reading_sd * probe.reading_sd
+            + c * c * self.last_fresh
+            + spread * spread
+            + self.twin_bias * self.twin_bias;
         let s = self.filter.innovation_variance(&h) + r;
         self.correlated = None;
         let z = nu / <f32 as Real>::sqrt(s);
