@@ -111,7 +111,10 @@ pub fn temperatures(raw: &RawParams) -> [f64; 4] {
 /// What the twin is driven through: held at both ends of the oil range,
 /// abrupt steps across the validated range both ways, from its middle
 /// into cold and hot oil and back, and from one end of the oil range to
-/// the other.
+/// the other; then ramps across the validated range both ways in 0.4 s,
+/// under the twin's abrupt change per tick, whose stop events in fixed
+/// point leave their rests to the next substep (its longest steps, up to
+/// three substeps: `dynamics::Owed`).
 pub fn scenarios(raw: &RawParams) -> Vec<Profile> {
     let (cold, hot) = oil_ends(raw);
     let (lo, hi) = (raw.estimator.valid_min, raw.estimator.valid_max);
@@ -130,6 +133,11 @@ pub fn scenarios(raw: &RawParams) -> Vec<Profile> {
     ]
     .into_iter()
     .map(|(from, to)| Profile::Step { from, to })
+    .chain([(lo, hi), (hi, lo)].map(|(from, to)| Profile::Ramp {
+        from,
+        to,
+        rate: (hi - lo).abs() / 0.4,
+    }))
     .collect()
 }
 

@@ -298,8 +298,10 @@ impl<T: Real> Dirk<T> {
         }
     }
 
-    /// One step of `frac` times the prepared step (`0 < frac <= 1`;
-    /// `T::ONE` for a whole substep) from `y` in `contact`. Held on a stop
+    /// One step of `frac` times the prepared step (`0 < frac <= 3`:
+    /// `T::ONE` for a whole substep, less for a piece of one, more for a
+    /// fixed-point substep that takes the rest an event left it,
+    /// [`super::Owed`]; the fixed-point audit's ramps take them) from `y` in `contact`. Held on a stop
     /// the plunger does not move (`xi` kept, `w = 0`) and only the
     /// pressures evolve.
     ///

@@ -136,11 +136,12 @@ pub const EVENTS_PER_SUBSTEP: u8 = 1;
 
 /// The rest of a substep that a stop event left to the next substep, in a
 /// fixed-point twin (the cores without an FPU): the state stands at the
-/// event (an impact, a release), up to one substep behind the substep's
-/// end, and the next substep is longer by `frac` (one step of `1 + frac`
+/// event (an impact, a release), behind the substep's end by the rest, and
+/// the next substep is longer by `frac` (one step of `1 + frac`
 /// substeps). An event then costs its substep no second step, and the
-/// twin still follows real time: it is behind by at most one substep, for
-/// one substep.
+/// twin still follows real time: behind by at most two substeps (an event
+/// in a substep that took a rest can leave a longer one; a rest beyond two
+/// substeps is stepped at once), for as long as events follow each other.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Owed<T> {
     /// The rest, in substeps: `0 <= frac <= 2`.
@@ -310,9 +311,10 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// caller whose steps are not whole ticks (an FMU's communication
     /// steps). A shorter tick is at least as accurate as the configured
     /// one (the same substeps, each shorter); the result equals a twin
-    /// built with `tick` from the start and given the same state. Costs a
-    /// few `f64` operations (the scheme's step prepared again), nothing
-    /// per tick.
+    /// built with `tick` from the start and given the same state. A rest
+    /// an event left to the next substep ([`Owed`], fixed point) keeps its
+    /// length in time, up to two of the new substeps. Costs a few `f64`
+    /// operations (the scheme's step prepared again), nothing per tick.
     ///
     /// # Errors
     ///
@@ -322,6 +324,12 @@ impl<F: Float, T: Real> Twin<F, T> {
         let config = TwinConfig { tick, ..self.config };
         config.validate()?;
         let timing = Timing::new(&config, self.model.scales.time.to_f64(), &self.coefficients);
+        // A rest owed in substeps of the old tick, in the new one's (at most
+        // two of them: the longest step the twin takes stays three).
+        if self.owed.frac > T::ZERO {
+            let frac = self.owed.frac.to_f64() * self.config.tick / tick;
+            self.owed.frac = T::from_f64(frac.min(2.0));
+        }
         self.engine = timing.engine;
         self.fine_dirk = timing.fine_dirk;
         self.h_a_x = timing.h_a_x;
@@ -460,8 +468,10 @@ impl<F: Float, T: Real> Twin<F, T> {
     /// changes the coefficients abruptly). In fixed point (the cores
     /// without an FPU, where a step is the tick's cost) an event's rest is
     /// not stepped in its substep but added to the next one ([`Owed`]): a
-    /// substep is then one step with or without an event, and the state at
-    /// the tick's end may stand up to one substep behind it, at the event.
+    /// substep is then one step with or without an event (two when a rest
+    /// beyond two substeps is stepped at once, or a held rest is pulled
+    /// off at both ends), and the state at the tick's end may stand up to
+    /// two substeps behind it, at the event.
     ///
     /// # Errors
     ///
@@ -550,9 +560,9 @@ impl<F: Float, T: Real> Twin<F, T> {
 
     /// An event's rest of `rest` substeps is left to the next substep
     /// ([`Owed`]): fixed point, a plain substep's SDIRK step, and a rest of
-    /// at most one substep (a rest longer than that, left by a substep
-    /// that was itself longer, is stepped at once, so that the twin is
-    /// never more than one substep behind).
+    /// at most two substeps (a rest longer than that, left by a substep
+    /// that was itself lengthened, is stepped at once, so that the twin is
+    /// never more than two substeps behind, nor a step longer than three).
     fn defers(&self, rest: T, fine: bool) -> bool {
         T::SATURATES && !fine && rest <= T::TWO && matches!(self.engine, Engine::Dirk(_))
     }

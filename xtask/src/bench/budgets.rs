@@ -16,8 +16,13 @@ pub const BUDGET_FLASH: u64 = 64 * 1024;
 /// Flash budget of the QEMU twin image: the board's estimator and, on top,
 /// the replay's harness the board has not (its schedule, checkpoints and
 /// self-checks, about 7.5 KiB of code and tables, and the start-up
-/// characteristic it prints, about 7 KiB) [bytes].
-pub const BUDGET_QEMU_TWIN_FLASH: u64 = 72 * 1024;
+/// characteristic it prints, about 7 KiB). 72 KiB until the fixed-point
+/// twin left an event's rest to the next substep: the pieces' generic code,
+/// shared with `f32`, carries the rest's bookkeeping (a float twin never
+/// owes one, but the compiler keeps the arguments), and the image measured
+/// 73,768 bytes, 40 over; the board image, what a user flashes, stays
+/// within its 64 KiB [bytes].
+pub const BUDGET_QEMU_TWIN_FLASH: u64 = 73 * 1024;
 
 /// Flash budget of the board image built for a second sensor (the
 /// condition monitor: its health filter, the probe's lag, change and
