@@ -6,6 +6,9 @@
 //!
 //! * [`clock`]: real time from the tick counter (defmt timestamps).
 //! * [`deadline`]: the tick periods elapsed between ticks (late ticks).
+//! * [`softfloat`]: `f32` multiply, add and subtract for the Cortex-M0
+//!   (`__aeabi_fmul`, `__aeabi_fadd`, `__aeabi_fsub`) and their start-up
+//!   check.
 //! * `qemu` (QEMU images): semihosting exit, the shared panic and
 //!   HardFault handling, the defmt logger over semihosting.
 //!
@@ -17,6 +20,7 @@
 
 pub mod clock;
 pub mod deadline;
+pub mod softfloat;
 
 #[cfg(all(feature = "qemu", target_os = "none"))]
 pub mod qemu;

@@ -47,6 +47,7 @@ pub mod monitor;
 pub mod params;
 pub mod scalar;
 pub mod sensor;
+pub mod softfloat;
 pub mod throttle;
 pub mod uncertainty;
 

@@ -611,6 +611,14 @@ fn main() -> ! {
         );
         exit(false)
     }
+    // The Cortex-M0's own f32 fast paths against compiler_builtins'.
+    if let Err(m) = compensator_firmware::softfloat::self_check(100_000) {
+        error!(
+            "f32 {=str} wrong: operands {=u32:#x} {=u32:#x}, got {=u32:#x}, want {=u32:#x}",
+            m.operation, m.operands.0, m.operands.1, m.got, m.want
+        );
+        exit(false)
+    }
     let Ok(params) = Params::<f32>::new(&RAW_PARAMS) else {
         error!("parameters rejected");
         exit(false)

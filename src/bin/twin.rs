@@ -135,6 +135,15 @@ impl Checks {
 
 #[entry]
 fn main() -> ! {
+    // The Cortex-M0's f32 fast paths against compiler_builtins' routines
+    // (nothing to check on the other cores).
+    if let Err(m) = compensator_firmware::softfloat::self_check(3000) {
+        error!(
+            "f32 {=str} wrong: operands {=u32:#x} {=u32:#x}, got {=u32:#x}, want {=u32:#x}",
+            m.operation, m.operands.0, m.operands.1, m.got, m.want
+        );
+        exit(false)
+    }
     let params = match Params::<f32>::new(&RAW_PARAMS) {
         Ok(p) => p,
         Err(e) => {
