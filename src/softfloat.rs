@@ -48,7 +48,8 @@ mod v6m {
     // against IEEE 754): the Rust compiled to about as many instructions
     // as compiler_builtins' routines on this core, spilling its values to
     // the stack. The operands are kept in r12 and lr (lr is pushed) for
-    // the full routine, which every other case calls.
+    // the full routine, which every other case calls; the pushes keep the
+    // stack 8-byte aligned for that call (AAPCS), r3 pushed as padding.
     core::arch::global_asm!(
         ".syntax unified",
         ".thumb",
@@ -179,7 +180,7 @@ mod v6m {
         ".type __aeabi_fadd,%function",
         ".thumb_func",
         "__aeabi_fadd:",
-        "push {{r4, r5, r6, r7, lr}}",
+        "push {{r3, r4, r5, r6, r7, lr}}",
         "mov r12, r0",
         "mov lr, r1",
         // The larger magnitude in r0 (its sign is the sum's).
@@ -205,7 +206,7 @@ mod v6m {
         "mov r0, r12",
         "mov r1, lr",
         "ands r0, r1",
-        "pop {{r4, r5, r6, r7, pc}}",
+        "pop {{r3, r4, r5, r6, r7, pc}}",
         "11:",
         // The smaller is finite; a zero leaves the larger, a subnormal
         // goes to the full routine.
@@ -214,7 +215,7 @@ mod v6m {
         "bls 2f",
         "cmp r3, #0",
         "bne 90f",
-        "pop {{r4, r5, r6, r7, pc}}",
+        "pop {{r3, r4, r5, r6, r7, pc}}",
         "2:",
         // The significands with three bits below (27 bits).
         "movs r7, #1",
@@ -295,15 +296,15 @@ mod v6m {
         "lsrs r0, r0, #31",
         "lsls r0, r0, #31",
         "orrs r0, r2",
-        "pop {{r4, r5, r6, r7, pc}}",
+        "pop {{r3, r4, r5, r6, r7, pc}}",
         "8:",
         "movs r0, #0",
-        "pop {{r4, r5, r6, r7, pc}}",
+        "pop {{r3, r4, r5, r6, r7, pc}}",
         "90:",
         "mov r0, r12",
         "mov r1, lr",
         "bl __addsf3",
-        "pop {{r4, r5, r6, r7, pc}}",
+        "pop {{r3, r4, r5, r6, r7, pc}}",
         ".size __aeabi_fadd, . - __aeabi_fadd",
     );
 }
