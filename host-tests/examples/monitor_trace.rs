@@ -6,6 +6,10 @@
 //!
 //!     cargo run --release -p host-tests --example monitor_trace -- [design] [seed] [hours] [sensor] [fault] [every]
 //!
+//! `TRACE_FROM` and `TRACE_TO` (seconds) print only that window, every
+//! reading in it with `every` 0; the trace ends 5 s after the first alarm
+//! (with `TRACE_RESET=1` the monitor is reset after each alarm, as in the
+//! campaign's healthy runs, and the trace goes on, a `#` line per alarm).
 //! `design` 0 is the paper preset (the campaign's onset, `monitor_campaign`'s), `n` the seeded `host_tests::campaign::design(seed * 1000 + n - 1)`.
 use compensator::Params;
 use compensator::estimator::{Estimator, EstimatorConfig};
@@ -57,8 +61,22 @@ fn main() {
         .with_monitor(settings(&s.sensor, &s.nominal))
         .unwrap();
     let mut tick = 0u64;
+    // `TRACE_FROM` / `TRACE_TO` [s]: print only that window (every reading
+    // in it with `every` 0).
+    let from: f64 = std::env::var("TRACE_FROM")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0.0);
+    let to: f64 = std::env::var("TRACE_TO")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(f64::INFINITY);
     let mut last_row = -1e9;
     let mut last_alarm = -1e9;
+    let mut first_alarm = f64::INFINITY;
+    // `TRACE_RESET=1`: reset the monitor after each alarm and go on, as the
+    // campaign's healthy runs do, printing a `#` line per alarm.
+    let keep_on = std::env::var("TRACE_RESET").is_ok_and(|v| v == "1");
     println!("t T_true T_est dT T_s y pred truth twin z cusum divider sd_div bias offset flags");
     for r in records {
         while tick < r.tick {
@@ -77,8 +95,12 @@ fn main() {
         let alarm = e.flags.0 & ALARMS.0 != 0;
         if alarm {
             last_alarm = r.t;
+            first_alarm = first_alarm.min(r.t);
         }
-        if r.t - last_row >= every || r.t - last_alarm < 5.0 {
+        if r.t > to {
+            break;
+        }
+        if r.t >= from && (r.t - last_row >= every || r.t - last_alarm < 5.0) {
             last_row = r.t;
             println!(
                 "{:.2} {:.3} {:.3} {:.3} {:.3} {:.6e} {:.6e} {:.6e} {:.4e} {:.2} {:.2} {:.4} {:.4} {:.4} {:.3e} {:08x}",
@@ -100,7 +122,13 @@ fn main() {
                 e.flags.0
             );
         }
-        if alarm && r.t - last_alarm > 4.9 {
+        if alarm && keep_on {
+            println!(
+                "# alarm at {:.2} s, oil {:.3} C, flags {:08x}, offset {:.3e}, divider {:.4}",
+                r.t, r.t_true, e.flags.0, h.offset, h.divider
+            );
+            est.reset_monitor();
+        } else if alarm && r.t - first_alarm > 4.9 {
             break;
         }
     }

@@ -91,6 +91,73 @@ fn a_healthy_device_raises_nothing() {
     assert_eq!(run(Quantity::Displacement, |_| {}), None);
 }
 
+/// A reset (an inspection found the device healthy) in the middle of a
+/// warming at 0.3 C/s, read through the preset's 6 s probe: the probe
+/// trails the oil by 1.8 K there, which the monitor's lag still holds
+/// after the reset, so the healthy device raises nothing before or after
+/// it, and the innovations right after it are those of a healthy device.
+#[test]
+fn a_reset_in_a_ramp_raises_nothing() {
+    let raw = compensator_cli::load(&repo_root().join("presets/paper.toml")).unwrap();
+    let tau = raw.probe.time_constant;
+    assert!(
+        raw.probe.well_time_constant == 0.0 && tau >= 5.0,
+        "a lagging probe without a well"
+    );
+    let p = Params::<f32>::new(&raw).unwrap();
+    let cfg = EstimatorConfig::new(&raw).unwrap();
+    for q in [Quantity::ChamberA, Quantity::Displacement] {
+        let sd = if q == Quantity::Displacement {
+            1e-3 * raw.core.stroke
+        } else {
+            100.0
+        };
+        let settings = MonitorSettings {
+            quantity: q,
+            sd_noise: sd as f32,
+            sd_accuracy: (2.5 * sd) as f32,
+            sample_period: 0.01,
+            probe: ProbeModel::new(&raw),
+        };
+        let mut est = Estimator::new(&p, cfg, 40.0).unwrap().with_monitor(settings).unwrap();
+        let mut rng = Rng::new(13);
+        // 120 s at 40 C, 60 s of warming at 0.3 C/s, 60 s at 58 C; the
+        // probe's first-order lag in closed form; the reset at 150 s.
+        let (t0, t1, rate) = (120.0f64, 180.0f64, 0.3f64);
+        let oil = |t: f64| 40.0 + rate * (t.clamp(t0, t1) - t0);
+        let probe = |t: f64| {
+            let trail = rate * tau * (1.0 - (-(t.clamp(t0, t1) - t0) / tau).exp());
+            oil(t) - trail * (-(t - t1).max(0.0) / tau).exp()
+        };
+        let (mut largest, mut reset) = (0.0f32, false);
+        for k in 0..240_000u64 {
+            let t = k as f64 * 1e-3;
+            if !reset && t >= 150.0 {
+                est.reset_monitor();
+                reset = true;
+            }
+            let e = est.tick(Ok(k.is_multiple_of(20).then_some(probe(t) as f32)));
+            if k.is_multiple_of(10) {
+                let pt = equilibrium(&raw.core, oil(t));
+                let y = match q {
+                    Quantity::ChamberA => pt.p_a,
+                    _ => pt.x,
+                };
+                let n = (rng.unit() + rng.unit() + rng.unit() + rng.unit() - 2.0) * 3f64.sqrt();
+                est.offer_second(Ok((y + n * sd) as f32));
+            }
+            let alarm = e.flags.0 & (Flags::DEVICE_CHANGED.0 | compensator::monitor::LATCHED.0);
+            assert_eq!(alarm, 0, "{q:?}: {:?} at {t} s", Flags(alarm));
+            if (150.0..155.0).contains(&t) && est.health().innovation.is_finite() {
+                largest = largest.max(est.health().innovation.abs());
+            }
+        }
+        // Without the lag kept, the first innovations after the reset are
+        // the probe's 1.8 K trail over a few hundredths of a kelvin.
+        assert!(largest < 4.0, "{q:?}: |z| up to {largest} in the 5 s after the reset");
+    }
+}
+
 /// The monitor's stages run one per call (`begin`, then `advance` until it
 /// returns the estimate) give `update`'s estimates bit for bit: the
 /// estimator spreads a reading over its job ticks without changing what

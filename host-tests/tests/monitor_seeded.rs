@@ -35,3 +35,47 @@ fn seeded_designs_raise_nothing_through_their_ramps_knees() {
         }
     }
 }
+
+/// Design 4's simulated day with the displacement sensor, through its
+/// first two hours: as built, its plunger reaches the upper stop at a
+/// lower oil temperature than the file's (at 73.6 C, 7,226 s into the
+/// day), where the filter had learned an offset of +4.8e-5 m (1.1 % of
+/// the stroke) that is the device's, not the sensor's zero. Less that
+/// offset, the reading at the stop looked 4.8e-5 m short of it, so it
+/// went on informing the probe's prediction while the plunger rested,
+/// and the CUSUM fired. The stop is now taken to read anywhere between
+/// the reading as read and the reading less the offset.
+#[test]
+fn a_plunger_at_its_stop_as_built_raises_nothing() {
+    use compensator::Params;
+    use compensator::estimator::{Estimator, EstimatorConfig, Flags};
+    use host_tests::monitor_campaign::{ALARMS, settings};
+    let s = healthy(4, Quantity::X, 24.0);
+    let p32 = Params::<f32>::new(&s.nominal).unwrap();
+    let config = EstimatorConfig::new(&s.nominal).unwrap();
+    let mut records = s.records().unwrap().peekable();
+    let first = records.peek().and_then(|r| r.probe).unwrap();
+    let mut est = Estimator::new(&p32, config, first as f32)
+        .unwrap()
+        .with_monitor(settings(&s.sensor, &s.nominal))
+        .unwrap();
+    let (mut tick, mut at_stop) = (0u64, 0u32);
+    for r in records.take_while(|r| r.t < 7_400.0) {
+        while tick < r.tick {
+            est.tick(Ok(None));
+            tick += 1;
+        }
+        if let Some(y) = r.second {
+            est.offer_second(Ok(y as f32));
+        }
+        let e = est.tick(Ok(r.probe.map(|v| v as f32)));
+        tick += 1;
+        let alarm = Flags(e.flags.0 & ALARMS.0);
+        assert!(alarm.is_empty(), "{alarm:?} at {} s, oil {:.2} C", r.t, r.t_true);
+        if r.truth.x >= s.device.stroke - 1e-9 {
+            at_stop += 1;
+        }
+    }
+    // The history does take the plunger to its stop.
+    assert!(at_stop > 100, "{at_stop} records at the upper stop");
+}

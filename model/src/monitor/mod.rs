@@ -684,11 +684,42 @@ impl Monitor {
     }
 
     /// Clears the latched faults and restarts the health parameters at
-    /// their priors (after the device's maintenance).
+    /// their priors (after the device's maintenance, or an inspection that
+    /// found the device healthy).
+    ///
+    /// The probe's lag is kept: it holds the oil's recent past, which a
+    /// reset does not change, with the parameters' change taken back
+    /// through the lagged Jacobians (as the filter's updates move it), and
+    /// the lag's noise. A lag restarted at rest on the current reading
+    /// predicts a probe at the oil's temperature; in a ramp the probe
+    /// trails it by the rate times its time constant (0.3 C/s through an
+    /// 8 s probe: 2.4 K), which the restarted filter took for a fault and
+    /// alarmed on again within a second, reset after reset.
     pub fn reset(&mut self, params: &Params<f32>) {
-        if let Ok(m) = Monitor::new(params, self.settings) {
-            *self = m;
+        let Ok(mut m) = Monitor::new(params, self.settings) else {
+            return;
+        };
+        if self.started {
+            let theta = self.filter.theta();
+            let mut lag = self.lag;
+            for (k, t) in theta.iter().enumerate().take(OFFSET + 1) {
+                lag.add_scaled(OIL, D_THETA + k, -t);
+            }
+            lag.add_scaled(OIL, D_THETA + OFFSET, -theta[MODEL]);
+            for i in SIGNATURE..UNINFORMED {
+                lag.clear(i);
+            }
+            m.lag = lag;
+            m.decay = self.decay;
+            m.started = true;
+            m.filter.restart_noise(self.filter.covariance()[NOISE][NOISE]);
+            m.filter.shift(NOISE, self.filter.noise());
+            m.last_fresh = self.last_fresh;
+            m.rest_share = self.rest_share;
+            m.twin_bias = self.twin_bias;
+            m.last_oil = self.last_oil;
         }
+        *self = m;
     }
 
     /// The twin's reading of the measured quantity (`x` for the
@@ -703,15 +734,22 @@ impl Monitor {
     }
 
     /// A displacement reading `y` within three standard deviations (its
-    /// noise and the twin's accuracy) of a stop, less the estimated
-    /// `offset`: the plunger may rest there whatever the oil does.
+    /// noise and the twin's accuracy) of a stop, or beyond it: the plunger
+    /// may rest there whatever the oil does. Where the stop reads is
+    /// known only between the reading as read and the reading less the
+    /// estimated `offset`: the offset is the sensor's zero and the
+    /// device's own (a preload or a spring built off the file's) alike,
+    /// and only the sensor's zero moves where a stop reads. Taken as the
+    /// sensor's zero alone, an offset learned on a device that leaves its
+    /// stop late made the readings at the stop look informed, which
+    /// taught the filter more of the same offset.
     fn at_stop(&self, y: f32, offset: f32) -> bool {
         if self.design.quantity != Quantity::Displacement {
             return false;
         }
         let sd = self.settings.sd_noise + self.sd_model;
-        let x = y - offset;
-        !(x > 3.0 * sd && x < self.design.stroke - 3.0 * sd)
+        let (low, high) = if offset > 0.0 { (offset, 0.0) } else { (0.0, offset) };
+        !(y - low > 3.0 * sd && y - high < self.design.stroke - 3.0 * sd)
     }
 
     /// A change is being watched or isolated: the hypotheses' signatures
