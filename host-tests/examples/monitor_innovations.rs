@@ -5,11 +5,9 @@
 //! (`docs/monitoring.md`).
 //!
 //!     cargo run --release -p host-tests --example monitor_innovations -- [designs] [seed] [hours] [sensors]
-use compensator::Params;
-use compensator::estimator::{Estimator, EstimatorConfig};
 use host_tests::campaign::Injection;
 use host_tests::campaign::{Quantity, Scenario, design};
-use host_tests::monitor_campaign::settings;
+use host_tests::monitor_campaign::Replay;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -35,27 +33,11 @@ fn main() {
                 design(seed.wrapping_mul(1000) + d - 1)
             };
             let s = Scenario::ordinary(&nominal, q, Injection::HEALTHY, hours * 3600.0, seed + d);
-            let p32 = Params::<f32>::new(&s.nominal).unwrap();
-            let config = EstimatorConfig::new(&s.nominal).unwrap();
-            let mut records = s.records().unwrap().peekable();
-            let first = records.peek().and_then(|r| r.probe).unwrap();
-            let mut est = Estimator::new(&p32, config, first as f32)
-                .unwrap()
-                .with_monitor(settings(&s.sensor, &s.nominal))
-                .unwrap();
-            let mut tick = 0u64;
+            let mut replay = Replay::new(&s).unwrap();
             let mut zs: Vec<f64> = Vec::new();
             let mut last = f32::NAN;
-            for r in records {
-                while tick < r.tick {
-                    est.tick(Ok(None));
-                    tick += 1;
-                }
-                if let Some(y) = r.second {
-                    est.offer_second(Ok(y as f32));
-                }
-                est.tick(Ok(r.probe.map(|v| v as f32)));
-                tick += 1;
+            while let Some((r, _)) = replay.next_fed() {
+                let est = &mut replay.estimator;
                 let z = est.health().innovation;
                 if z.is_finite() && z.to_bits() != last.to_bits() && r.t > 300.0 {
                     zs.push(f64::from(z));

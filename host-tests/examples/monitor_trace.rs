@@ -11,10 +11,8 @@
 //! (with `TRACE_RESET=1` the monitor is reset after each alarm, as in the
 //! campaign's healthy runs, and the trace goes on, a `#` line per alarm).
 //! `design` 0 is the paper preset (the campaign's onset, `monitor_campaign`'s), `n` the seeded `host_tests::campaign::design(seed * 1000 + n - 1)`.
-use compensator::Params;
-use compensator::estimator::{Estimator, EstimatorConfig};
 use host_tests::campaign::{Fault, Injection, Quantity, Scenario, catalogue_before_move, design};
-use host_tests::monitor_campaign::{ALARMS, settings};
+use host_tests::monitor_campaign::{ALARMS, Replay};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -52,15 +50,7 @@ fn main() {
         "probe class {:.3}, sensor offset {:.4e}, onset {:.0} s",
         s.probe_class, s.sensor_offset, s.injection.onset
     );
-    let p32 = Params::<f32>::new(&s.nominal).unwrap();
-    let config = EstimatorConfig::new(&s.nominal).unwrap();
-    let mut records = s.records().unwrap().peekable();
-    let first = records.peek().and_then(|r| r.probe).unwrap();
-    let mut est = Estimator::new(&p32, config, first as f32)
-        .unwrap()
-        .with_monitor(settings(&s.sensor, &s.nominal))
-        .unwrap();
-    let mut tick = 0u64;
+    let mut replay = Replay::new(&s).unwrap();
     // `TRACE_FROM` / `TRACE_TO` [s]: print only that window (every reading
     // in it with `every` 0).
     let from: f64 = std::env::var("TRACE_FROM")
@@ -78,16 +68,8 @@ fn main() {
     // campaign's healthy runs do, printing a `#` line per alarm.
     let keep_on = std::env::var("TRACE_RESET").is_ok_and(|v| v == "1");
     println!("t T_true T_est dT T_s y pred truth twin z cusum divider sd_div bias offset flags");
-    for r in records {
-        while tick < r.tick {
-            est.tick(Ok(None));
-            tick += 1;
-        }
-        if let Some(y) = r.second {
-            est.offer_second(Ok(y as f32));
-        }
-        let e = est.tick(Ok(r.probe.map(|v| v as f32)));
-        tick += 1;
+    while let Some((r, e)) = replay.next_fed() {
+        let est = &mut replay.estimator;
         if r.second.is_none() {
             continue;
         }

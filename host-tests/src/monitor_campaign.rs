@@ -4,9 +4,9 @@
 //! the probe's readings on their ticks and the second sensor's offered as
 //! they come, and what the monitor's flags said and when.
 
-use crate::campaign::{Fault, MOVE, Quantity, Scenario, SecondSensor};
+use crate::campaign::{Fault, MOVE, Quantity, Records, Sample, Scenario, SecondSensor};
 use compensator::Params;
-use compensator::estimator::{Estimator, EstimatorConfig, Flags};
+use compensator::estimator::{Estimator, EstimatorConfig, Flags, StateEstimate};
 use compensator::monitor::{self, MonitorSettings};
 
 /// The monitor's flags that name or announce a device change (not the
@@ -60,6 +60,67 @@ pub fn expected(fault: Fault, quantity: Quantity) -> Option<Flags> {
     }
 }
 
+/// A scenario's records through the firmware's `f32` estimator of its
+/// nominal design with the monitor of its second sensor, as the firmware
+/// runs them: a tick per estimator period, the probe's readings on theirs,
+/// each second-sensor reading offered before its record's tick.
+pub struct Replay {
+    /// The estimator.
+    pub estimator: Estimator,
+    /// The scenario's records not yet fed.
+    pub records: core::iter::Peekable<Records>,
+    tick: u64,
+}
+
+impl Replay {
+    /// The estimator started on `scenario`'s first probe reading.
+    ///
+    /// # Errors
+    ///
+    /// A scenario the records or the estimator refuse, or whose first
+    /// record has no probe reading.
+    pub fn new(scenario: &Scenario) -> Result<Replay, String> {
+        let nominal = &scenario.nominal;
+        let p32 = Params::<f32>::new(nominal).map_err(|e| e.to_string())?;
+        let config = EstimatorConfig::new(nominal).map_err(|e| e.to_string())?;
+        let mut records = scenario.records()?.peekable();
+        let first = records
+            .peek()
+            .and_then(|s| s.probe)
+            .ok_or("the first record has no probe reading")?;
+        let estimator = Estimator::new(&p32, config, first as f32)
+            .map_err(|e| e.to_string())?
+            .with_monitor(settings(&scenario.sensor, nominal))
+            .map_err(|e| e.to_string())?;
+        Ok(Replay {
+            estimator,
+            records,
+            tick: 0,
+        })
+    }
+
+    /// Feeds record `r` (the ticks without a reading before it, its second
+    /// sensor's reading, its own tick) and returns its tick's estimate.
+    pub fn feed(&mut self, r: &Sample) -> StateEstimate {
+        while self.tick < r.tick {
+            self.estimator.tick(Ok(None));
+            self.tick += 1;
+        }
+        if let Some(y) = r.second {
+            self.estimator.offer_second(Ok(y as f32));
+        }
+        self.tick += 1;
+        self.estimator.tick(Ok(r.probe.map(|v| v as f32)))
+    }
+
+    /// The next record, fed, with its estimate.
+    pub fn next_fed(&mut self) -> Option<(Sample, StateEstimate)> {
+        let r = self.records.next()?;
+        let e = self.feed(&r);
+        Some((r, e))
+    }
+}
+
 /// What one scenario's run found.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Outcome {
@@ -102,18 +163,7 @@ const FOLLOW: f64 = 900.0;
 ///
 /// A scenario the records or the estimator refuse.
 pub fn run(scenario: &Scenario) -> Result<Outcome, String> {
-    let nominal = &scenario.nominal;
-    let p32 = Params::<f32>::new(nominal).map_err(|e| e.to_string())?;
-    let config = EstimatorConfig::new(nominal).map_err(|e| e.to_string())?;
-    let mut records = scenario.records()?.peekable();
-    let first = records
-        .peek()
-        .and_then(|s| s.probe)
-        .ok_or("the first record has no probe reading")?;
-    let mut est = Estimator::new(&p32, config, first as f32)
-        .map_err(|e| e.to_string())?
-        .with_monitor(settings(&scenario.sensor, nominal))
-        .map_err(|e| e.to_string())?;
+    let mut replay = Replay::new(scenario)?;
     let fault = scenario.injection.fault;
     let onset = if fault == Fault::None {
         f64::INFINITY
@@ -140,9 +190,8 @@ pub fn run(scenario: &Scenario) -> Result<Outcome, String> {
     };
     let stroke = scenario.device.stroke;
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    let mut tick = 0u64;
     let names = Flags(ALARMS.0 & !Flags::DEVICE_CHANGED.0);
-    for s in records {
+    while let Some(s) = replay.records.next() {
         if s.t >= onset {
             lo = lo.min(s.t_true);
             hi = hi.max(s.t_true);
@@ -160,15 +209,7 @@ pub fn run(scenario: &Scenario) -> Result<Outcome, String> {
             }
             continue;
         }
-        while tick < s.tick {
-            est.tick(Ok(None));
-            tick += 1;
-        }
-        if let Some(y) = s.second {
-            est.offer_second(Ok(y as f32));
-        }
-        let e = est.tick(Ok(s.probe.map(|v| v as f32)));
-        tick += 1;
+        let e = replay.feed(&s);
         let alarm = Flags(e.flags.0 & ALARMS.0);
         if alarm.is_empty() {
             continue;
@@ -180,7 +221,7 @@ pub fn run(scenario: &Scenario) -> Result<Outcome, String> {
                 // A false alarm ends a faulty run's use: the monitor latched it.
                 break;
             }
-            est.reset_monitor();
+            replay.estimator.reset_monitor();
             continue;
         }
         out.detected.get_or_insert(s.t - onset);
@@ -189,6 +230,6 @@ pub fn run(scenario: &Scenario) -> Result<Outcome, String> {
             out.named = Some((s.t - onset, named));
         }
     }
-    out.rejected = est.health().rejected;
+    out.rejected = replay.estimator.health().rejected;
     Ok(out)
 }

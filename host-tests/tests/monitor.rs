@@ -13,14 +13,10 @@ use compensator_reference::statics::equilibrium;
 use host_tests::random::Rng;
 use host_tests::repo_root;
 
-/// Runs 60 s at 60 C, then a cooling at 0.1 C/s with the device changed by
-/// `fault` from 60 s on; returns the first named flags and their time.
-fn run(q: Quantity, fault: fn(&mut RawCore)) -> Option<(f64, Flags)> {
-    let mut raw = compensator_cli::load(&repo_root().join("presets/paper.toml")).unwrap();
-    raw.probe.time_constant = 0.01;
-    raw.probe.well_time_constant = 0.0;
-    let p = Params::<f32>::new(&raw).unwrap();
-    let cfg = EstimatorConfig::new(&raw).unwrap();
+/// The monitor's settings for quantity `q` on `raw`'s probe, read every
+/// 10 ms with a noise of 0.1 % of the stroke or 100 Pa (returned) and a
+/// class of 2.5 times that.
+fn sensor(raw: &compensator::params::RawParams, q: Quantity) -> (MonitorSettings, f64) {
     let sd = if q == Quantity::Displacement {
         1e-3 * raw.core.stroke
     } else {
@@ -31,8 +27,25 @@ fn run(q: Quantity, fault: fn(&mut RawCore)) -> Option<(f64, Flags)> {
         sd_noise: sd as f32,
         sd_accuracy: (2.5 * sd) as f32,
         sample_period: 0.01,
-        probe: ProbeModel::new(&raw),
+        probe: ProbeModel::new(raw),
     };
+    (settings, sd)
+}
+
+/// A zero-mean noise of unit variance (the sum of four uniforms).
+fn unit_noise(rng: &mut Rng) -> f64 {
+    (rng.unit() + rng.unit() + rng.unit() + rng.unit() - 2.0) * 3f64.sqrt()
+}
+
+/// Runs 60 s at 60 C, then a cooling at 0.1 C/s with the device changed by
+/// `fault` from 60 s on; returns the first named flags and their time.
+fn run(q: Quantity, fault: fn(&mut RawCore)) -> Option<(f64, Flags)> {
+    let mut raw = compensator_cli::load(&repo_root().join("presets/paper.toml")).unwrap();
+    raw.probe.time_constant = 0.01;
+    raw.probe.well_time_constant = 0.0;
+    let p = Params::<f32>::new(&raw).unwrap();
+    let cfg = EstimatorConfig::new(&raw).unwrap();
+    let (settings, sd) = sensor(&raw, q);
     let mut est = Estimator::new(&p, cfg, 60.0).unwrap().with_monitor(settings).unwrap();
     let mut bad = raw.core;
     fault(&mut bad);
@@ -51,7 +64,7 @@ fn run(q: Quantity, fault: fn(&mut RawCore)) -> Option<(f64, Flags)> {
                 Quantity::Difference => pt.p_b - pt.p_a,
                 Quantity::Displacement => pt.x,
             };
-            let n = (rng.unit() + rng.unit() + rng.unit() + rng.unit() - 2.0) * 3f64.sqrt();
+            let n = unit_noise(&mut rng);
             est.offer_second(Ok((y + n * sd) as f32));
         }
         let named = Flags(e.flags.0 & names.0);
@@ -107,18 +120,7 @@ fn a_reset_in_a_ramp_raises_nothing() {
     let p = Params::<f32>::new(&raw).unwrap();
     let cfg = EstimatorConfig::new(&raw).unwrap();
     for q in [Quantity::ChamberA, Quantity::Displacement] {
-        let sd = if q == Quantity::Displacement {
-            1e-3 * raw.core.stroke
-        } else {
-            100.0
-        };
-        let settings = MonitorSettings {
-            quantity: q,
-            sd_noise: sd as f32,
-            sd_accuracy: (2.5 * sd) as f32,
-            sample_period: 0.01,
-            probe: ProbeModel::new(&raw),
-        };
+        let (settings, sd) = sensor(&raw, q);
         let mut est = Estimator::new(&p, cfg, 40.0).unwrap().with_monitor(settings).unwrap();
         let mut rng = Rng::new(13);
         // 120 s at 40 C, 60 s of warming at 0.3 C/s, 60 s at 58 C; the
@@ -143,7 +145,7 @@ fn a_reset_in_a_ramp_raises_nothing() {
                     Quantity::ChamberA => pt.p_a,
                     _ => pt.x,
                 };
-                let n = (rng.unit() + rng.unit() + rng.unit() + rng.unit() - 2.0) * 3f64.sqrt();
+                let n = unit_noise(&mut rng);
                 est.offer_second(Ok((y + n * sd) as f32));
             }
             let alarm = e.flags.0 & (Flags::DEVICE_CHANGED.0 | compensator::monitor::LATCHED.0);

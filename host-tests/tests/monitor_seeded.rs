@@ -47,29 +47,12 @@ fn seeded_designs_raise_nothing_through_their_ramps_knees() {
 /// the reading as read and the reading less the offset.
 #[test]
 fn a_plunger_at_its_stop_as_built_raises_nothing() {
-    use compensator::Params;
-    use compensator::estimator::{Estimator, EstimatorConfig, Flags};
-    use host_tests::monitor_campaign::{ALARMS, settings};
+    use compensator::estimator::Flags;
+    use host_tests::monitor_campaign::{ALARMS, Replay};
     let s = healthy(4, Quantity::X, 24.0);
-    let p32 = Params::<f32>::new(&s.nominal).unwrap();
-    let config = EstimatorConfig::new(&s.nominal).unwrap();
-    let mut records = s.records().unwrap().peekable();
-    let first = records.peek().and_then(|r| r.probe).unwrap();
-    let mut est = Estimator::new(&p32, config, first as f32)
-        .unwrap()
-        .with_monitor(settings(&s.sensor, &s.nominal))
-        .unwrap();
-    let (mut tick, mut at_stop) = (0u64, 0u32);
-    for r in records.take_while(|r| r.t < 7_400.0) {
-        while tick < r.tick {
-            est.tick(Ok(None));
-            tick += 1;
-        }
-        if let Some(y) = r.second {
-            est.offer_second(Ok(y as f32));
-        }
-        let e = est.tick(Ok(r.probe.map(|v| v as f32)));
-        tick += 1;
+    let mut replay = Replay::new(&s).unwrap();
+    let mut at_stop = 0u32;
+    while let Some((r, e)) = replay.next_fed().filter(|(r, _)| r.t < 7_400.0) {
         let alarm = Flags(e.flags.0 & ALARMS.0);
         assert!(alarm.is_empty(), "{alarm:?} at {} s, oil {:.2} C", r.t, r.t_true);
         if r.truth.x >= s.device.stroke - 1e-9 {
