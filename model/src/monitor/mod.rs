@@ -471,6 +471,9 @@ const OIL: usize = 0;
 const D_THETA: usize = 1;
 const SIGNATURE: usize = D_THETA + OFFSET + 1;
 const UNINFORMED: usize = SIGNATURE + HYPOTHESES;
+/// The sticking test's signature (the last hypothesis): it runs through
+/// the lag at every reading, not from a run's start (`Monitor::predict`).
+const HELD: usize = UNINFORMED - 1;
 const SIGNALS: usize = UNINFORMED + 1;
 
 /// The condition monitor (see the module docs). `f32`; one reading costs
@@ -507,8 +510,27 @@ pub struct Monitor {
     held: f32,
     /// Half width of the sticking test's play band \[m\].
     design_width: f32,
-    /// The sticking test's own held plunger \[m\].
+    /// The sticking test's own held plunger \[m\]: where the free plunger
+    /// stood when the oil last rested, played through the design band
+    /// since.
     test_held: f32,
+    /// The free plunger's position at the last reading \[m\], and its
+    /// change per reading averaged over the probe lag's memory \[m\]: the
+    /// oil rests while that change over the memory stays within the
+    /// reading's noise and the twin's accuracy.
+    last_free: f32,
+    free_change: f32,
+    /// The oil rested at the last reading (see `last_free`).
+    resting: bool,
+    /// The design band's half width in oil temperature at the last
+    /// informed reading \[K\] (`design_width / |dy/dT|`).
+    width_oil: f32,
+    /// The sticking test in the probe's terms: the probe's corrected
+    /// reading before this one \[C\], and the temperature a held second
+    /// sensor would give, played through the design band on the probe's
+    /// readings since the oil last rested \[C\].
+    last_probe: f32,
+    probe_held: f32,
     /// CUSUM statistics for innovations up and down.
     cusum: [f32; 2],
     /// The change is detected (`DEVICE_CHANGED`) and not yet isolated.
@@ -555,6 +577,10 @@ struct Pending {
     step: bool,
     /// The probe's reading to test, and the twin's oil temperature \[C\].
     test: Option<(ProbeSample, f32)>,
+    /// The sticking test's signature of this reading (zero for a reading
+    /// that does not inform), which steps through the lag whether a
+    /// change is watched or not.
+    held: f32,
     /// The hypotheses' signatures of this reading at the filter's
     /// parameters (their derivatives, `inv dy/dtheta`), zero for a reading
     /// that does not inform: what a change's test seeds the signatures'
@@ -584,6 +610,7 @@ impl Pending {
         signatures: None,
         step: false,
         test: None,
+        held: 0.0,
         onset: [0.0; HYPOTHESES],
         estimate: None,
     };
@@ -655,6 +682,12 @@ impl Monitor {
             held: f32::NAN,
             design_width: STICKING_DESIGN * (plunger.preload + 0.5 * plunger.stroke),
             test_held: f32::NAN,
+            last_free: f32::NAN,
+            free_change: 0.0,
+            resting: false,
+            width_oil: 0.0,
+            last_probe: f32::NAN,
+            probe_held: f32::NAN,
             cusum: [0.0; 2],
             detected: false,
             fit_b: [0.0; HYPOTHESES],
@@ -806,9 +839,11 @@ impl Monitor {
             return None;
         }
         if self.pending.step {
-            // No signature this reading: their signals step with zero.
-            self.lag
-                .step_signals(&[0.0; SIGNALS], &self.decay, SIGNATURE..UNINFORMED);
+            // No signature this reading: their signals step with zero but
+            // the sticking test's.
+            let mut u = [0.0f32; SIGNALS];
+            u[HELD] = self.pending.held;
+            self.lag.step_signals(&u, &self.decay, SIGNATURE..UNINFORMED);
             self.pending.step = false;
         }
         if let Some((sample, t)) = self.pending.test.take() {
@@ -887,6 +922,7 @@ impl Monitor {
         u[OIL] = t_twin;
         let mut signatures = None;
         let mut onset = [0.0f32; HYPOTHESES];
+        let mut held_signature = 0.0f32;
         let informed = match reading {
             Some(y)
                 if sd_t < MAX_TEMPERATURE_SD
@@ -916,6 +952,11 @@ impl Monitor {
                 }
                 for (o, h) in onset.iter_mut().zip(Hypothesis::ALL) {
                     *o = h.derivative(&jacobian, sticking) * inv;
+                }
+                held_signature = sticking * inv;
+                let width = self.design_width * libm::fabsf(inv);
+                if width.is_finite() {
+                    self.width_oil = width;
                 }
                 if self.running() {
                     signatures = Some(SignatureInputs {
@@ -997,6 +1038,7 @@ impl Monitor {
             signatures: if step { signatures } else { None },
             step,
             test: view.probe.map(|sample| (sample, t_twin)),
+            held: held_signature,
             onset,
             estimate: Some((estimate.predicted, estimate.oil, flags, t_twin)),
         };
@@ -1086,6 +1128,31 @@ impl Monitor {
         }
         estimate.innovation = z;
         self.innovation = z;
+        // The sticking test's signature in the probe's terms: a held
+        // plunger's reading stays, so the second sensor's temperature stays
+        // where the oil was when it was held, and the probe's innovation is
+        // the probe's own travel since, through the play of the design
+        // band (the plunger dragged at the band's edge). The probe reads
+        // the oil through its lag as the innovation does; the twin's oil
+        // (the observer's, off by up to a kelvin and more for seconds at a
+        // ramp's start, `UNINFORMED_ERROR`) does not. The reading before
+        // this one, so that the regressor does not share this reading's
+        // noise with the innovation.
+        let corrected = sample.value - theta[PROBE] * tolerance;
+        let displacement = self.design.quantity == Quantity::Displacement;
+        let held_gap = if displacement && self.last_probe.is_finite() && self.probe_held.is_finite() {
+            self.last_probe - self.probe_held
+        } else {
+            0.0
+        };
+        if corrected.is_finite() {
+            self.probe_held = if !self.probe_held.is_finite() || (self.resting && !self.running()) {
+                corrected
+            } else {
+                play(self.probe_held, corrected, self.width_oil)
+            };
+            self.last_probe = corrected;
+        }
         if self.settling > 0 {
             self.settling -= 1;
             self.learn(&h, nu, s, r);
@@ -1097,20 +1164,21 @@ impl Monitor {
             self.fit_b = [0.0; HYPOTHESES];
             self.fit_c = [0.0; HYPOTHESES];
             self.energy = 0.0;
-            self.test_held = f32::NAN;
             self.window = (t_oil, t_oil);
             // The change's onset is taken between the last reading and this
             // one (where the CUSUM last stood at zero, Page's estimate):
             // the innovation holds one step of the lag's response to it, and
             // so must the signatures, or the first readings' fit, far above
             // the noise for a large change, favours whichever hypothesis'
-            // shape the missing step happens to resemble.
+            // shape the missing step happens to resemble. The sticking
+            // test's signature has run through the lag all along, from the
+            // oil's last rest (`predict`), and keeps its memory.
             let mut u = [0.0f32; SIGNALS];
-            for i in 0..HYPOTHESES {
+            for i in 0..HYPOTHESES - 1 {
                 self.lag.clear(SIGNATURE + i);
                 u[SIGNATURE + i] = onset[i];
             }
-            self.lag.step_signals(&u, &self.decay, SIGNATURE..UNINFORMED);
+            self.lag.step_signals(&u, &self.decay, SIGNATURE..HELD);
         }
         let zc = clamp(z, -CUSUM_CLIP, CUSUM_CLIP);
         self.cusum[0] = clamp(self.cusum[0] + zc - CUSUM_DRIFT, 0.0, f32::MAX);
@@ -1122,7 +1190,11 @@ impl Monitor {
             );
             self.energy += nu * nu / s;
             for i in 0..HYPOTHESES {
-                let g = self.lag.probe(SIGNATURE + i);
+                let g = if SIGNATURE + i == HELD {
+                    held_gap
+                } else {
+                    self.lag.probe(SIGNATURE + i)
+                };
                 self.fit_b[i] += g * nu / s;
                 self.fit_c[i] += g * g / s;
             }
@@ -1229,7 +1301,26 @@ impl Monitor {
         if x != self.held {
             jacobian = [0.0; PARAMETERS];
         }
-        let test = if self.test_held.is_finite() {
+        // The sticking test's plunger is held from where the free one stood
+        // when the oil last rested (a plunger that starts to stick does so
+        // where it stands): a held plunger's reading stays from the oil's
+        // first move on, long before the CUSUM's run starts (the innovation
+        // grows with the travel through the probe's lag), and a hold taken
+        // from the run's start misses the travel before it, a constant
+        // that the step faults fit. The oil rests while the free plunger's
+        // travel over the lag's memory stays within the reading's noise and
+        // the twin's accuracy (what the reading cannot resolve); a run
+        // under way keeps its hold (a plunger dragged, then at rest, stays
+        // off its free position).
+        let p = self.decay.probe;
+        if self.last_free.is_finite() && free.is_finite() {
+            self.free_change = p * self.free_change + (1.0 - p) * (free - self.last_free);
+        }
+        self.last_free = free;
+        let resolved = self.settings.sd_noise + self.sd_model;
+        let resting = libm::fabsf(self.free_change) < resolved * (1.0 - p);
+        self.resting = resting;
+        let test = if self.test_held.is_finite() && !(resting && !self.running()) {
             self.test_held
         } else {
             free
@@ -1263,7 +1354,8 @@ impl Monitor {
         }
         let span = self.window.1 - self.window.0;
         let margin = ISOLATION_MARGIN + 0.5 * MODEL_ERROR * MODEL_ERROR * self.energy;
-        if gain[best] - second >= margin && span >= ISOLATION_SPAN {
+        let spanned = span >= ISOLATION_SPAN || Hypothesis::ALL[best] == Hypothesis::Sticking;
+        if gain[best] - second >= margin && spanned {
             Some(Hypothesis::ALL[best])
         } else {
             None
