@@ -70,9 +70,11 @@
 //!    lag (a generalised likelihood ratio over the window, [`Hypothesis`]);
 //!    the fault whose fit explains the innovations better than every
 //!    other's by [`ISOLATION_MARGIN`] in log-likelihood, over at least
-//!    [`ISOLATION_SPAN`] of oil temperature, is named (its flag latches),
-//!    its parameter moves by the fitted size and its variance reopens, and
-//!    watching resumes. While a change is detected and not yet isolated,
+//!    [`ISOLATION_SPAN`] of oil temperature (sticking at any span: its
+//!    signature is the probe's own travel since the oil last rested,
+//!    through the play band, its amplitude bounded), is named (its flag
+//!    latches), its parameter moves by the fitted size and its variance
+//!    reopens, and watching resumes. While a change is detected and not yet isolated,
 //!    or a CUSUM run is past a quarter of the threshold, the health
 //!    parameters are held, so that the filter does not absorb the change it
 //!    is trying to name; the lag's noise still follows the readings (a
@@ -258,6 +260,12 @@ pub const REST_FORGOTTEN: f32 = 0.01;
 /// spring's force at mid-stroke (`F = f c (x0 + x_max / 2)`): the play
 /// band's half width of the fitted signature.
 pub const STICKING_DESIGN: f32 = 0.05;
+
+/// The largest friction the sticking test fits, in [`STICKING_DESIGN`]'s
+/// play bands: the fitted width that `Monitor::confirm` enters, and the
+/// bound of the test's amplitude (a held plunger's innovation is the
+/// probe's travel through the true band, at most a few design bands).
+const STICKING_MOST: f32 = 4.0;
 
 /// What the monitor needs of its sensor (from the device file's
 /// `[monitor]`) and of the oil-temperature probe (its `[probe]`).
@@ -1320,7 +1328,8 @@ impl Monitor {
         let resolved = self.settings.sd_noise + self.sd_model;
         let resting = libm::fabsf(self.free_change) < resolved * (1.0 - p);
         self.resting = resting;
-        let test = if self.test_held.is_finite() && !(resting && !self.running()) {
+        let rehold = resting && !self.running();
+        let test = if self.test_held.is_finite() && !rehold {
             self.test_held
         } else {
             free
@@ -1334,10 +1343,20 @@ impl Monitor {
     fn isolated(&self) -> Option<Hypothesis> {
         // Log-likelihood gain of each single-fault fit, `b^2 / (2 c)`, with
         // the fault's sign (an amplitude of the wrong sign gains nothing).
+        // The sticking test's amplitude is bounded by `STICKING_MOST`: its
+        // regressor is the probe's travel since the oil rested, which
+        // barely differs from zero while the oil has hardly moved, and an
+        // unbounded amplitude then fits a step fault's first readings
+        // whole (a capillary's restriction named sticking 0.02 s after its
+        // onset, 2 mK into a cooling).
         let mut gain = [0.0f32; HYPOTHESES];
-        for ((g, b), c) in gain.iter_mut().zip(&self.fit_b).zip(&self.fit_c) {
+        for (i, ((g, b), c)) in gain.iter_mut().zip(&self.fit_b).zip(&self.fit_c).enumerate() {
             if *c > 0.0 && *b > 0.0 {
-                *g = 0.5 * b * b / c;
+                *g = if Hypothesis::ALL[i] == Hypothesis::Sticking && *b > STICKING_MOST * c {
+                    STICKING_MOST * b - 0.5 * STICKING_MOST * STICKING_MOST * c
+                } else {
+                    0.5 * b * b / c
+                };
             }
         }
         let mut best = 0;
@@ -1385,7 +1404,7 @@ impl Monitor {
             let room = 0.1 * libm::fabsf(by);
             self.filter.reopen(k, <f32 as Real>::sqrt(sd * sd + room * room));
         } else {
-            self.friction_width += clamp(amplitude, 0.0, 4.0) * self.design_width;
+            self.friction_width += clamp(amplitude, 0.0, STICKING_MOST) * self.design_width;
             self.held = f32::NAN;
         }
         self.reference = self.filter.theta();
