@@ -220,6 +220,11 @@ pub struct Estimator<T = f32, U = UncertaintyTable, O = ObserverDesign> {
     /// tick it was taken on: the next tick offers it.
     held_reading: Option<(f32, u32)>,
     /// The condition monitor, with a second sensor ([`Estimator::with_monitor`]).
+    /// Only with the `monitor` feature: an image without a second sensor
+    /// carries none, so that its RAM and its ticks do not move with the
+    /// monitor's state (a field the size of the monitor's placed the
+    /// tick's hot fields at offsets the loads' immediates could not reach).
+    #[cfg(feature = "monitor")]
     monitor: Option<Monitor>,
     /// The second sensor's reading not yet given to the monitor (it runs
     /// in a job's place: [`Estimator::offer_second`]).
@@ -283,6 +288,7 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
             deferred: 0,
             yielded: false,
             held_reading: None,
+            #[cfg(feature = "monitor")]
             monitor: None,
             #[cfg(feature = "monitor")]
             second: None,
@@ -313,7 +319,10 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
 
     /// The condition monitor, if one is fitted.
     pub fn monitor(&self) -> Option<&Monitor> {
-        self.monitor.as_ref()
+        #[cfg(feature = "monitor")]
+        return self.monitor.as_ref();
+        #[cfg(not(feature = "monitor"))]
+        None
     }
 
     /// Clears the monitor's latched faults and restarts its health
