@@ -482,6 +482,7 @@ const UNINFORMED: usize = SIGNATURE + HYPOTHESES;
 /// The sticking test's signature (the last hypothesis): it runs through
 /// the lag at every reading, not from a run's start (`Monitor::predict`).
 const HELD: usize = UNINFORMED - 1;
+const _: () = assert!(matches!(Hypothesis::ALL[HYPOTHESES - 1], Hypothesis::Sticking));
 const SIGNALS: usize = UNINFORMED + 1;
 
 /// The condition monitor (see the module docs). `f32`; one reading costs
