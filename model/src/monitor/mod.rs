@@ -1147,20 +1147,21 @@ impl Monitor {
         // ramp's start, `UNINFORMED_ERROR`) does not. The reading before
         // this one, so that the regressor does not share this reading's
         // noise with the innovation.
-        let corrected = sample.value - theta[PROBE] * tolerance;
-        let displacement = self.design.quantity == Quantity::Displacement;
-        let held_gap = if displacement && self.last_probe.is_finite() && self.probe_held.is_finite() {
-            self.last_probe - self.probe_held
-        } else {
-            0.0
-        };
-        if corrected.is_finite() {
-            self.probe_held = if !self.probe_held.is_finite() || (self.resting && !self.running()) {
-                corrected
-            } else {
-                play(self.probe_held, corrected, self.width_oil)
-            };
-            self.last_probe = corrected;
+        // A pressure sensor has no sticking test: none of it is kept.
+        let mut held_gap = 0.0;
+        if self.design.quantity == Quantity::Displacement {
+            if self.last_probe.is_finite() && self.probe_held.is_finite() {
+                held_gap = self.last_probe - self.probe_held;
+            }
+            let corrected = sample.value - theta[PROBE] * tolerance;
+            if corrected.is_finite() {
+                self.probe_held = if !self.probe_held.is_finite() || (self.resting && !self.running()) {
+                    corrected
+                } else {
+                    play(self.probe_held, corrected, self.width_oil)
+                };
+                self.last_probe = corrected;
+            }
         }
         if self.settling > 0 {
             self.settling -= 1;
