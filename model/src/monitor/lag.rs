@@ -164,6 +164,15 @@ impl<const N: usize> Lag<N> {
         (self.well[i] - self.probe[i]) / probe.time_constant
     }
 
+    /// Signal `i` alone, its input and stages.
+    pub fn signal(&self, i: usize) -> Lag<1> {
+        Lag {
+            input: [self.input[i]],
+            well: [self.well[i]],
+            probe: [self.probe[i]],
+        }
+    }
+
     /// Signal `i` back to zero, input and stages.
     pub fn clear(&mut self, i: usize) {
         self.input[i] = 0.0;

@@ -71,10 +71,11 @@
 //!    the fault whose fit explains the innovations better than every
 //!    other's by [`ISOLATION_MARGIN`] in log-likelihood, over at least
 //!    [`ISOLATION_SPAN`] of oil temperature (sticking at any span: its
-//!    signature is the probe's own travel since the oil last rested,
-//!    through the play band, its amplitude bounded), is named (its flag
-//!    latches), its parameter moves by the fitted size and its variance
-//!    reopens, and watching resumes. While a change is detected and not yet isolated,
+//!    signature is the probe less the lag of a held second sensor's
+//!    temperature since its hold, through the play band, its amplitude
+//!    bounded), is named (its flag latches), its parameter moves by the
+//!    fitted size and its variance reopens, and watching resumes. While a
+//!    change is detected and not yet isolated,
 //!    or a CUSUM run is past a quarter of the threshold, the health
 //!    parameters are held, so that the filter does not absorb the change it
 //!    is trying to name; the lag's noise still follows the readings (a
@@ -547,11 +548,22 @@ pub struct Monitor {
     /// informed reading \[K\] (`design_width / |dy/dT|`).
     width_oil: f32,
     /// The sticking test in the probe's terms: the probe's corrected
-    /// reading before this one \[C\], and the temperature a held second
-    /// sensor would give, played through the design band on the probe's
-    /// readings since the oil last rested \[C\].
+    /// reading before this one \[C\], and the probe's reading predicted
+    /// then for a held second sensor \[C\].
     last_probe: f32,
-    probe_held: f32,
+    last_held: f32,
+    /// The temperature a held second sensor gives \[C\] (NaN: no hold),
+    /// played through the design band on the twin's oil moved to where
+    /// the second sensor's temperature stood at the hold (`held_shift`,
+    /// \[K\]).
+    held_oil: f32,
+    held_shift: f32,
+    /// The lag of the temperature the held second sensor gives, from the
+    /// lagged temperature's at the hold.
+    held_lag: Lag<1>,
+    /// The sticking test's sums since its hold, `sum g nu / S` and `sum
+    /// g^2 / S`.
+    held_fit: [f32; 2],
     /// CUSUM statistics for innovations up and down.
     cusum: [f32; 2],
     /// The change is detected (`DEVICE_CHANGED`) and not yet isolated.
@@ -586,6 +598,10 @@ pub struct Monitor {
     reference: [f32; PARAMETERS],
     /// The model-error state's stationary standard deviation \[Pa or m\].
     sd_model: f32,
+    /// The farthest the sensor's zero may sit from the file's \[Pa or m\]:
+    /// its class limit (`sqrt 3` of its standard uncertainty), and each
+    /// offset named since ([`Monitor::at_stop`]).
+    zero_limit: f32,
     /// The twin's oil temperature at the last reading \[C\].
     last_oil: f32,
     /// The twin's transient in the second sensor's temperature \[K\]
@@ -718,7 +734,11 @@ impl Monitor {
             resting: false,
             width_oil: 0.0,
             last_probe: f32::NAN,
-            probe_held: f32::NAN,
+            last_held: f32::NAN,
+            held_oil: f32::NAN,
+            held_shift: 0.0,
+            held_lag: Lag::at_rest([f32::NAN]),
+            held_fit: [0.0; 2],
             cusum: [0.0; 2],
             detected: false,
             fit_b: [0.0; HYPOTHESES],
@@ -733,6 +753,7 @@ impl Monitor {
             window: (f32::NAN, f32::NAN),
             reference: [0.0; PARAMETERS],
             sd_model,
+            zero_limit: 1.732_050_8 * settings.sd_accuracy,
             last_oil: f32::NAN,
             twin_bias: 0.0,
             pending: Pending::NONE,
@@ -809,12 +830,22 @@ impl Monitor {
     /// sensor's zero alone, an offset learned on a device that leaves its
     /// stop late made the readings at the stop look informed, which
     /// taught the filter more of the same offset.
+    ///
+    /// The sensor's zero is within its class (`sqrt 3` of its standard
+    /// uncertainty, the uniform limit), and an offset named since: what
+    /// the filter holds beyond it is the device's. Taken whole, an offset
+    /// the filter learned while the plunger was held (along what one
+    /// temperature cannot tell apart: the divider, the probe's error and
+    /// the offset, 70 times the sensor's class in 20 s of a slow cooling)
+    /// put a held plunger's reading at the stop, and the tests never
+    /// resumed.
     fn at_stop(&self, y: f32, offset: f32) -> bool {
         if self.design.quantity != Quantity::Displacement {
             return false;
         }
         let sd = self.settings.sd_noise + self.sd_model;
-        let (low, high) = if offset > 0.0 { (offset, 0.0) } else { (0.0, offset) };
+        let zero = clamp(offset, -self.zero_limit, self.zero_limit);
+        let (low, high) = if zero > 0.0 { (zero, 0.0) } else { (0.0, zero) };
         !(y - low > 3.0 * sd && y - high < self.design.stroke - 3.0 * sd)
     }
 
@@ -1037,6 +1068,10 @@ impl Monitor {
             self.lag.step_signals(&u, &self.decay, OIL..SIGNATURE);
             self.lag.step_signals(&u, &self.decay, UNINFORMED..SIGNALS);
             step = true;
+            if self.held_oil.is_finite() && t_twin.is_finite() {
+                self.held_oil = play(self.held_oil, t_twin + self.held_shift, self.width_oil);
+                self.held_lag.step(&[self.held_oil], &self.decay);
+            }
             // The lag's noise: `e_k = p e_(k-1) + c (1 + p) n_(k-1)`.
             let p = self.decay.probe;
             let drive = 0.5 * (1.0 - p) * (1.0 + p);
@@ -1164,28 +1199,38 @@ impl Monitor {
         // The sticking test's signature in the probe's terms: a held
         // plunger's reading stays, so the second sensor's temperature stays
         // where the oil was when it was held, and the probe's innovation is
-        // the probe's own travel since, through the play of the design
-        // band (the plunger dragged at the band's edge). The probe reads
+        // the probe's reading less the lag of that held temperature (from
+        // the lagged temperature's stages at the hold; dragged through the
+        // design band by the twin's oil's travel since). The probe reads
         // the oil through its lag as the innovation does; the twin's oil
         // (the observer's, off by up to a kelvin and more for seconds at a
-        // ramp's start, `UNINFORMED_ERROR`) does not. The reading before
-        // this one, so that the regressor does not share this reading's
-        // noise with the innovation.
+        // ramp's start, `UNINFORMED_ERROR`) enters only the drag. The
+        // probe's own travel since the hold is not it: that carries the
+        // probe's catching up with the oil's travel before the hold (20 s
+        // into a ramp through an 8 s lag, the lagged travel is 0.63 of the
+        // probe's), and the fit's amplitude fell short of the held
+        // plunger's by as much. The hold is renewed (a plunger that starts
+        // to stick does so where it stands) while the oil rests or the
+        // test's evidence since the hold is not positive, Page's estimate
+        // of the onset as the CUSUM's, and kept through a run. The
+        // reading before this one, so that the regressor does not share
+        // this reading's noise with the innovation.
         // A pressure sensor has no sticking test: none of it is kept.
         let mut held_gap = 0.0;
         if self.design.quantity == Quantity::Displacement {
-            if self.last_probe.is_finite() && self.probe_held.is_finite() {
-                held_gap = self.last_probe - self.probe_held;
+            if self.last_probe.is_finite() && self.last_held.is_finite() {
+                held_gap = self.last_probe - self.last_held;
             }
             let corrected = sample.value - theta[PROBE] * tolerance;
-            if corrected.is_finite() {
-                self.probe_held = if !self.probe_held.is_finite() || (self.resting && !self.running()) {
-                    corrected
-                } else {
-                    play(self.probe_held, corrected, self.width_oil)
-                };
-                self.last_probe = corrected;
+            let renew = self.resting || !(self.held_fit[0] > 0.0);
+            if !self.held_oil.is_finite() || (renew && !self.running()) {
+                self.held_fit = [0.0; 2];
+                self.held_lag = self.lag.signal(OIL);
+                self.held_oil = self.lag.input(OIL);
+                self.held_shift = self.held_oil - t_oil;
             }
+            self.last_probe = corrected;
+            self.last_held = self.held_lag.probe(0) - age * self.held_lag.probe_rate(0, &probe);
         }
         if self.settling > 0 {
             self.settling -= 1;
@@ -1243,6 +1288,9 @@ impl Monitor {
         if self.cusum[0] > CUSUM_THRESHOLD || self.cusum[1] > CUSUM_THRESHOLD {
             self.detected = true;
         }
+        // The sticking test's evidence since its hold (its renewal).
+        self.held_fit[0] += held_gap * nu / s;
+        self.held_fit[1] += held_gap * held_gap / s;
         let suspicious = self.cusum[0] > 0.25 * CUSUM_THRESHOLD || self.cusum[1] > 0.25 * CUSUM_THRESHOLD;
         if z * z <= GATE * GATE && (self.detected || suspicious) && self.rest_share < REST_FORGOTTEN {
             // The parameters are held; the lag's noise follows the reading.
@@ -1393,7 +1441,7 @@ impl Monitor {
         // Log-likelihood gain of each single-fault fit, `b^2 / (2 c)`, with
         // the fault's sign (an amplitude of the wrong sign gains nothing).
         // The sticking test's amplitude is bounded by `STICKING_MOST`: its
-        // regressor is the probe's travel since the oil rested, which
+        // regressor is the oil's lagged travel since the hold, which
         // barely differs from zero while the oil has hardly moved, and an
         // unbounded amplitude then fits a step fault's first readings
         // whole (a capillary's restriction named sticking 0.02 s after its
@@ -1401,8 +1449,8 @@ impl Monitor {
         let mut gain = [0.0f32; HYPOTHESES];
         for (i, ((g, b), c)) in gain.iter_mut().zip(&self.fit_b).zip(&self.fit_c).enumerate() {
             if *c > 0.0 && *b > 0.0 {
-                *g = if Hypothesis::ALL[i] == Hypothesis::Sticking && *b > STICKING_MOST * c {
-                    STICKING_MOST * b - 0.5 * STICKING_MOST * STICKING_MOST * c
+                *g = if Hypothesis::ALL[i] == Hypothesis::Sticking {
+                    sticking_gain(*b, *c)
                 } else {
                     0.5 * b * b / c
                 };
@@ -1491,6 +1539,9 @@ impl Monitor {
         if k < PARAMETERS {
             let by = h.sign() * amplitude;
             self.filter.shift(k, by);
+            if k == OFFSET {
+                self.zero_limit += libm::fabsf(by);
+            }
             // Room for the linearisation's error (a tenth of the change).
             let room = 0.1 * libm::fabsf(by);
             self.filter.reopen(k, <f32 as Real>::sqrt(sd * sd + room * room));
@@ -1507,8 +1558,22 @@ impl Monitor {
         self.fit_b = [0.0; HYPOTHESES];
         self.fit_c = [0.0; HYPOTHESES];
         self.fit_x = [0.0; 2];
+        self.held_fit = [0.0; 2];
         self.energy = 0.0;
         self.bias_energy = 0.0;
+    }
+}
+
+/// The log-likelihood gain of the sticking test's fit from its sums `b =
+/// sum g nu / S` and `c = sum g^2 / S`: a positive amplitude, at most
+/// [`STICKING_MOST`] design bands.
+fn sticking_gain(b: f32, c: f32) -> f32 {
+    if !(c > 0.0 && b > 0.0) {
+        0.0
+    } else if b > STICKING_MOST * c {
+        STICKING_MOST * b - 0.5 * STICKING_MOST * STICKING_MOST * c
+    } else {
+        0.5 * b * b / c
     }
 }
 
