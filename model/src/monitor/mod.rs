@@ -327,18 +327,6 @@ pub enum Hypothesis {
 /// Hypotheses the isolation fits.
 pub const HYPOTHESES: usize = 6;
 
-/// The divider's hypotheses' indices in [`Hypothesis::ALL`] (up, down),
-/// and the offset's (up, down).
-const DIVIDERS: [usize; 2] = [0, 1];
-const OFFSET_UP: usize = 3;
-const OFFSET_DOWN: usize = 4;
-const _: () = assert!(
-    matches!(Hypothesis::ALL[DIVIDERS[0]], Hypothesis::CapillaryRestricted)
-        && matches!(Hypothesis::ALL[DIVIDERS[1]], Hypothesis::OrificeClogged)
-        && matches!(Hypothesis::ALL[OFFSET_UP], Hypothesis::OffsetUp)
-        && matches!(Hypothesis::ALL[OFFSET_DOWN], Hypothesis::OffsetDown)
-);
-
 impl Hypothesis {
     /// Every hypothesis, in the accumulators' order.
     pub const ALL: [Hypothesis; HYPOTHESES] = [
@@ -572,11 +560,6 @@ pub struct Monitor {
     /// and `sum g^2 / S`.
     fit_b: [f32; HYPOTHESES],
     fit_c: [f32; HYPOTHESES],
-    /// `sum g_i g_offset / S` over the run for the divider's two
-    /// hypotheses (`g_offset` the offset's signature up): how far apart
-    /// the divider's and the offset's signatures have grown
-    /// ([`Monitor::isolated`]).
-    fit_x: [f32; 2],
     /// `sum nu^2 / S` over the run: the signal's energy.
     energy: f32,
     /// `sum b^2 / S` over the run, `b` the twin's transient through the
@@ -743,7 +726,6 @@ impl Monitor {
             detected: false,
             fit_b: [0.0; HYPOTHESES],
             fit_c: [0.0; HYPOTHESES],
-            fit_x: [0.0; 2],
             energy: 0.0,
             bias_energy: 0.0,
             innovation: f32::NAN,
@@ -1242,7 +1224,6 @@ impl Monitor {
         if !self.running() {
             self.fit_b = [0.0; HYPOTHESES];
             self.fit_c = [0.0; HYPOTHESES];
-            self.fit_x = [0.0; 2];
             self.energy = 0.0;
             self.bias_energy = 0.0;
             self.window = (t_oil, t_oil);
@@ -1279,10 +1260,6 @@ impl Monitor {
                 };
                 self.fit_b[i] += g * nu / s;
                 self.fit_c[i] += g * g / s;
-            }
-            let offset = self.lag.probe(SIGNATURE + OFFSET_UP) / s;
-            for (x, i) in self.fit_x.iter_mut().zip(DIVIDERS) {
-                *x += self.lag.probe(SIGNATURE + i) * offset;
             }
         }
         if self.cusum[0] > CUSUM_THRESHOLD || self.cusum[1] > CUSUM_THRESHOLD {
@@ -1421,22 +1398,24 @@ impl Monitor {
 
     /// The hypothesis whose fit beats every other's by the margin (the
     /// noise's, the model error's, [`MODEL_ERROR`], and the twin's
-    /// transient's), if any, once the divider's and the offset's
-    /// signatures are apart ([`Monitor::separable`]).
+    /// transient's), if any.
     ///
     /// The twin's transient (`twin_bias`, through the probe's lag) is a
     /// bias of the probe's prediction, not a noise: counted in `S` as a
     /// variance, it is taken for independent from reading to reading,
-    /// and a fit may gain on it from every reading of a move. A bias `b_k`
-    /// moves a fit's log-likelihood gap by at most `sum b_k^2 / S_k / 2`
-    /// (Cauchy-Schwarz, whatever the signatures), which the margin adds.
-    /// It is large only while the oil moves (a tenth of a kelvin and more
-    /// in a 0.3 C/s ramp through an 8 s probe, where `S` grows tenfold),
-    /// so a fault whose signature stands apart only after the move is
-    /// named once the oil rests; without it an orifice clogged to 0.9 on
-    /// designs 4 and 8 of the campaign was named a transducer's offset
-    /// 3-4 K into its move, and offsets were named divider changes
-    /// (`docs/monitoring.md`).
+    /// and a fit may gain on it from every reading of a move. The margin
+    /// adds the bias's own energy, `sum b_k^2 / S_k / 2`: the most a fit of
+    /// the bias alone gains. It is large only while the oil moves (a
+    /// tenth of a kelvin and more in a 0.3 C/s ramp through an 8 s probe,
+    /// where `S` grows tenfold); with it an orifice clogged to 0.9 on
+    /// designs 4 and 8 of the campaign is no longer named a transducer's
+    /// offset 3-4 K into its move (`docs/monitoring.md`). It does not
+    /// bound the bias's cross term with a large fault's signal; margins
+    /// that did (twice the bias's length on the fits' amplitudes, or
+    /// waiting until the divider's and the offset's signatures stand
+    /// apart by the margin) delayed the paper preset's replay past its
+    /// ramp, where a transducer's offset fitted its restricted capillary
+    /// better and was named.
     fn isolated(&self) -> Option<Hypothesis> {
         // Log-likelihood gain of each single-fault fit, `b^2 / (2 c)`, with
         // the fault's sign (an amplitude of the wrong sign gains nothing).
@@ -1471,53 +1450,11 @@ impl Monitor {
         let span = self.window.1 - self.window.0;
         let margin = ISOLATION_MARGIN + 0.5 * MODEL_ERROR * MODEL_ERROR * self.energy + 0.5 * self.bias_energy;
         let spanned = span >= ISOLATION_SPAN || Hypothesis::ALL[best] == Hypothesis::Sticking;
-        if gain[best] - second >= margin && spanned && self.separable(best, gain[best], margin) {
+        if gain[best] - second >= margin && spanned {
             Some(Hypothesis::ALL[best])
         } else {
             None
         }
-    }
-
-    /// Whether the divider's and the offset's signatures have grown apart
-    /// enough for hypothesis `best`, of fitted gain `gain`, to be told from
-    /// the other of the two: had `best` alone made the innovations, its
-    /// fit would beat the other's best fit (of either sign) by `gain (1 -
-    /// rho^2)`, `rho` the two signatures' correlation over the run; that
-    /// must reach the isolation's `margin`. Until then a gap between the
-    /// fits larger than that is not the named fault's doing but the
-    /// model's: on a design whose divider hardly changes its reading's
-    /// sensitivity over the first 5 C (`1 - rho^2` of 1e-5 to 3e-5 there,
-    /// 1e-4 on the others) the frozen health estimate's error over the
-    /// travel (the probe's tolerance against the divider, the twin's own
-    /// error: hundredths of a kelvin) is as large as the two signatures'
-    /// difference, and the gap it makes grew with the move whichever fault
-    /// was injected (`docs/monitoring.md`). Other hypotheses: always.
-    fn separable(&self, best: usize, gain: f32, margin: f32) -> bool {
-        let c_offset = self.fit_c[OFFSET_UP];
-        let (x, c) = match best {
-            OFFSET_UP | OFFSET_DOWN => {
-                // The divider's hypothesis that fits best, by the fault's sign.
-                let [up, down] = DIVIDERS;
-                let j = if self.fit_b[up] * self.fit_b[up] / self.fit_c[up].max(f32::MIN_POSITIVE)
-                    >= self.fit_b[down] * self.fit_b[down] / self.fit_c[down].max(f32::MIN_POSITIVE)
-                {
-                    0
-                } else {
-                    1
-                };
-                (self.fit_x[j], self.fit_c[DIVIDERS[j]])
-            }
-            i if i == DIVIDERS[0] || i == DIVIDERS[1] => {
-                let j = if i == DIVIDERS[0] { 0 } else { 1 };
-                (self.fit_x[j], self.fit_c[i])
-            }
-            _ => return true,
-        };
-        if !(c > 0.0 && c_offset > 0.0) {
-            return true;
-        }
-        let rho2 = clamp(x * x / (c * c_offset), 0.0, 1.0);
-        gain * (1.0 - rho2) >= margin
     }
 
     /// Accepts hypothesis `h`: its parameter moves by the fitted size and
@@ -1557,7 +1494,6 @@ impl Monitor {
         self.cusum = [0.0; 2];
         self.fit_b = [0.0; HYPOTHESES];
         self.fit_c = [0.0; HYPOTHESES];
-        self.fit_x = [0.0; 2];
         self.held_fit = [0.0; 2];
         self.energy = 0.0;
         self.bias_energy = 0.0;
