@@ -549,9 +549,9 @@ pub struct Monitor {
     /// The lag of the temperature the held second sensor gives, from the
     /// lagged temperature's at the hold.
     held_lag: Lag<1>,
-    /// The sticking test's sums since its hold, `sum g nu / S` and `sum
-    /// g^2 / S`.
-    held_fit: [f32; 2],
+    /// The sticking test's evidence since its hold, `sum g nu / S` (its
+    /// sign renews the hold).
+    held_fit: f32,
     /// CUSUM statistics for innovations up and down.
     cusum: [f32; 2],
     /// The change is detected (`DEVICE_CHANGED`) and not yet isolated.
@@ -721,7 +721,7 @@ impl Monitor {
             held_oil: f32::NAN,
             held_shift: 0.0,
             held_lag: Lag::at_rest([f32::NAN]),
-            held_fit: [0.0; 2],
+            held_fit: 0.0,
             cusum: [0.0; 2],
             detected: false,
             fit_b: [0.0; HYPOTHESES],
@@ -1204,9 +1204,9 @@ impl Monitor {
                 held_gap = self.last_probe - self.last_held;
             }
             let corrected = sample.value - theta[PROBE] * tolerance;
-            let renew = self.resting || !(self.held_fit[0] > 0.0);
+            let renew = self.resting || !(self.held_fit > 0.0);
             if !self.held_oil.is_finite() || (renew && !self.running()) {
-                self.held_fit = [0.0; 2];
+                self.held_fit = 0.0;
                 self.held_lag = self.lag.signal(OIL);
                 self.held_oil = self.lag.input(OIL);
                 self.held_shift = self.held_oil - t_oil;
@@ -1266,8 +1266,7 @@ impl Monitor {
             self.detected = true;
         }
         // The sticking test's evidence since its hold (its renewal).
-        self.held_fit[0] += held_gap * nu / s;
-        self.held_fit[1] += held_gap * held_gap / s;
+        self.held_fit += held_gap * nu / s;
         let suspicious = self.cusum[0] > 0.25 * CUSUM_THRESHOLD || self.cusum[1] > 0.25 * CUSUM_THRESHOLD;
         if z * z <= GATE * GATE && (self.detected || suspicious) && self.rest_share < REST_FORGOTTEN {
             // The parameters are held; the lag's noise follows the reading.
@@ -1494,7 +1493,7 @@ impl Monitor {
         self.cusum = [0.0; 2];
         self.fit_b = [0.0; HYPOTHESES];
         self.fit_c = [0.0; HYPOTHESES];
-        self.held_fit = [0.0; 2];
+        self.held_fit = 0.0;
         self.energy = 0.0;
         self.bias_energy = 0.0;
     }
