@@ -9,7 +9,10 @@
 //! `TRACE_FROM` and `TRACE_TO` (seconds) print only that window, every
 //! reading in it with `every` 0; the trace ends 5 s after the first alarm
 //! (with `TRACE_RESET=1` the monitor is reset after each alarm, as in the
-//! campaign's healthy runs, and the trace goes on, a `#` line per alarm).
+//! campaign's healthy runs, and the trace goes on, a `#` line per alarm;
+//! with `TRACE_ALL=1` it goes on without a reset). `TRACE_GAINS=1` adds
+//! the isolation's gains per hypothesis (`Monitor::isolation`: capillary,
+//! clogged, spring, offset up, offset down, sticking), its margin and span.
 //! `design` 0 is the paper preset (the campaign's onset, `monitor_campaign`'s), `n` the seeded `host_tests::campaign::design(seed * 1000 + n - 1)`.
 use host_tests::campaign::{Fault, Injection, Quantity, Scenario, catalogue_before_move, design};
 use host_tests::monitor_campaign::{ALARMS, Replay};
@@ -67,6 +70,11 @@ fn main() {
     // `TRACE_RESET=1`: reset the monitor after each alarm and go on, as the
     // campaign's healthy runs do, printing a `#` line per alarm.
     let keep_on = std::env::var("TRACE_RESET").is_ok_and(|v| v == "1");
+    // `TRACE_ALL=1`: go on past the first alarm without a reset, to `TRACE_TO`.
+    let all = std::env::var("TRACE_ALL").is_ok_and(|v| v == "1");
+    // `TRACE_GAINS=1`: each row also gives the isolation's gains (in
+    // `Hypothesis::ALL`'s order), its margin and the run's span [K].
+    let gains = std::env::var("TRACE_GAINS").is_ok_and(|v| v == "1");
     println!("t T_true T_est dT T_s y pred truth twin z cusum divider sd_div bias offset flags");
     while let Some((r, e)) = replay.next_fed() {
         let est = &mut replay.estimator;
@@ -82,7 +90,7 @@ fn main() {
         if r.t > to {
             break;
         }
-        if r.t >= from && (r.t - last_row >= every || r.t - last_alarm < 5.0) {
+        if r.t >= from && (r.t - last_row >= every || (!all && r.t - last_alarm < 5.0)) {
             last_row = r.t;
             println!(
                 "{:.2} {:.3} {:.3} {:.3} {:.3} {:.6e} {:.6e} {:.6e} {:.4e} {:.2} {:.2} {:.4} {:.4} {:.4} {:.3e} {:08x}",
@@ -103,6 +111,15 @@ fn main() {
                 h.offset,
                 e.flags.0
             );
+            if let (true, Some(m)) = (gains, est.monitor()) {
+                let iso = m.isolation();
+                println!(
+                    "  gains {:?} margin {:.1} span {:.2}",
+                    iso.gain.map(|g| (g * 10.0).round() / 10.0),
+                    iso.margin,
+                    iso.span
+                );
+            }
         }
         if alarm && keep_on {
             println!(
@@ -110,7 +127,7 @@ fn main() {
                 r.t, r.t_true, e.flags.0, h.offset, h.divider
             );
             est.reset_monitor();
-        } else if alarm && r.t - first_alarm > 4.9 {
+        } else if alarm && !all && r.t - first_alarm > 4.9 {
             break;
         }
     }

@@ -327,6 +327,18 @@ pub enum Hypothesis {
 /// Hypotheses the isolation fits.
 pub const HYPOTHESES: usize = 6;
 
+/// The isolation's state ([`Monitor::isolation`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Isolation {
+    /// Log-likelihood gain of each hypothesis' single-fault fit, in
+    /// [`Hypothesis::ALL`]'s order (0 for an amplitude of the wrong sign).
+    pub gain: [f32; HYPOTHESES],
+    /// What the best gain must beat the next by to name its fault.
+    pub margin: f32,
+    /// The oil's span \[K\] over the run's tested readings.
+    pub span: f32,
+}
+
 impl Hypothesis {
     /// Every hypothesis, in the accumulators' order.
     pub const ALL: [Hypothesis; HYPOTHESES] = [
@@ -1416,6 +1428,34 @@ impl Monitor {
     /// ramp, where a transducer's offset fitted its restricted capillary
     /// better and was named.
     fn isolated(&self) -> Option<Hypothesis> {
+        let iso = self.isolation();
+        let gain = iso.gain;
+        let mut best = 0;
+        for i in 1..HYPOTHESES {
+            if gain[i] > gain[best] {
+                best = i;
+            }
+        }
+        let mut second = 0.0f32;
+        for (i, g) in gain.iter().enumerate() {
+            if i != best && *g > second {
+                second = *g;
+            }
+        }
+        let spanned = iso.span >= ISOLATION_SPAN || Hypothesis::ALL[best] == Hypothesis::Sticking;
+        if gain[best] - second >= iso.margin && spanned {
+            Some(Hypothesis::ALL[best])
+        } else {
+            None
+        }
+    }
+
+    /// The isolation's state over the current CUSUM run (all zero outside
+    /// one): each hypothesis' log-likelihood gain, in [`Hypothesis::ALL`]'s
+    /// order, the margin the best must beat the next by, and the oil's span
+    /// \[K\] of the run's tested readings: what names a fault, for
+    /// diagnostics (`host-tests/examples/monitor_trace.rs`, `TRACE_GAINS`).
+    pub fn isolation(&self) -> Isolation {
         // Log-likelihood gain of each single-fault fit, `b^2 / (2 c)`, with
         // the fault's sign (an amplitude of the wrong sign gains nothing).
         // The sticking test's amplitude is bounded by `STICKING_MOST`: its
@@ -1434,25 +1474,10 @@ impl Monitor {
                 };
             }
         }
-        let mut best = 0;
-        for i in 1..HYPOTHESES {
-            if gain[i] > gain[best] {
-                best = i;
-            }
-        }
-        let mut second = 0.0f32;
-        for (i, g) in gain.iter().enumerate() {
-            if i != best && *g > second {
-                second = *g;
-            }
-        }
-        let span = self.window.1 - self.window.0;
-        let margin = ISOLATION_MARGIN + 0.5 * MODEL_ERROR * MODEL_ERROR * self.energy + 0.5 * self.bias_energy;
-        let spanned = span >= ISOLATION_SPAN || Hypothesis::ALL[best] == Hypothesis::Sticking;
-        if gain[best] - second >= margin && spanned {
-            Some(Hypothesis::ALL[best])
-        } else {
-            None
+        Isolation {
+            gain,
+            margin: ISOLATION_MARGIN + 0.5 * MODEL_ERROR * MODEL_ERROR * self.energy + 0.5 * self.bias_energy,
+            span: self.window.1 - self.window.0,
         }
     }
 
