@@ -336,6 +336,9 @@ pub fn read_log(text: &str, sensor: Option<&SecondSensor>) -> Result<Log, String
     } else {
         second_of(&names, sensor)?
     };
+    if let (None, Some(sensor), false, true) = (second, sensor, telemetry, probe_log) {
+        misnamed_second(&names, sensor)?;
+    }
     let note = (telemetry && sensor.is_some()).then(|| {
         format!(
             "the log is a telemetry CSV ({TELEMETRY_MARK}): its x_m, p_a_pa and p_b_pa are the estimator's estimates, \
@@ -461,6 +464,38 @@ fn second_of(names: &[String], sensor: Option<&SecondSensor>) -> Result<Option<S
         ));
     }
     Ok(Some(*first))
+}
+
+/// Refuses a column that reads as the device file's second sensor's under
+/// another name (`p_a_bar`, `P_A_PA`, `x_mm`, `p_a`): "other columns are
+/// ignored", and a log whose sensor column was ignored replays without the
+/// monitor, or fails on the probe's empty cells beside it.
+///
+/// Errors: the column, the sensor's column and its unit.
+fn misnamed_second(names: &[String], sensor: &SecondSensor) -> Result<(), String> {
+    let column = second_column(sensor.settings.quantity);
+    // The name without its unit: `p_a` of `p_a_pa`, `x` of `x_m`.
+    let stem = column.name.rsplit_once('_').map_or(column.name, |(stem, _)| stem);
+    let looks = |h: &str| {
+        let h = h.trim().to_ascii_lowercase();
+        // The telemetry's standard uncertainties (`x_sd_m`, `p_a_sd_pa`)
+        // are estimates, not a misnamed reading.
+        h == stem
+            || (h.starts_with(stem)
+                && h[stem.len()..].starts_with(['_', ' ', '[', '(', '/'])
+                && !h[stem.len()..].starts_with("_sd"))
+    };
+    match names.iter().find(|h| looks(h)) {
+        Some(h) => Err(format!(
+            "column {h}: the device file's second sensor's readings (monitor.sensor = \"{}\") are read from \
+             column {}, the {}: rename the column, its readings in {}",
+            sensor.settings.quantity.name(),
+            column.name,
+            column.doc,
+            sensor.settings.quantity.unit()
+        )),
+        None => Ok(()),
+    }
 }
 
 /// Checks the second sensor's readings against the device file:

@@ -142,3 +142,31 @@ fn the_two_sensors_on_rows_of_their_own_within_a_tick_are_told_to_share_a_row() 
     assert!(err.contains("row 2 (line 3), column time_s"), "{err}");
     assert!(err.contains("merge rows 1 and 2"), "{err}");
 }
+
+#[test]
+fn a_sensor_column_under_another_name_is_refused_naming_the_right_one() {
+    // `p_a_bar` (or `P_A_PA`) was ignored as an unknown column: `estimate`
+    // ran without the monitor, and with the probe's cells empty beside it
+    // the error named an empty t_c cell.
+    let rows = documented(400);
+    for name in ["p_a_bar", "P_A_PA", "p_a"] {
+        let log = write(&format!("{name}.csv"), &format!("time_s,t_c,{name}"), &rows);
+        for command in ["estimate", "monitor"] {
+            let (code, _, err) = run_cli(&[command, "--params", PARAMS, "--sensor-data", path(&log)]);
+            assert_eq!(code, 2, "{command} {name}: {err}");
+            assert!(
+                err.contains(&format!("column {name}: ")) && err.contains("column p_a_pa"),
+                "{command} {name}: {err}"
+            );
+        }
+    }
+    // A probe log beside the estimates' uncertainties is no sensor log.
+    let probe: Vec<_> = rows
+        .into_iter()
+        .filter(|r| !r.1.is_empty())
+        .map(|(t, probe, _)| (t, probe, "900".to_string()))
+        .collect();
+    let log = write("sd.csv", "time_s,t_c,p_a_sd_pa", &probe);
+    let (code, _, err) = run_cli(&["estimate", "--params", PARAMS, "--sensor-data", path(&log)]);
+    assert_eq!(code, 0, "{err}");
+}
