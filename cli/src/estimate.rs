@@ -336,6 +336,9 @@ pub fn read_log(text: &str, sensor: Option<&SecondSensor>) -> Result<Log, String
     } else {
         second_of(&names, sensor)?
     };
+    if let (None, Some(sensor), false, true) = (second, sensor, telemetry, probe_log) {
+        misnamed_second(&names, sensor)?;
+    }
     let note = (telemetry && sensor.is_some()).then(|| {
         format!(
             "the log is a telemetry CSV ({TELEMETRY_MARK}): its x_m, p_a_pa and p_b_pa are the estimator's estimates, \
@@ -461,6 +464,38 @@ fn second_of(names: &[String], sensor: Option<&SecondSensor>) -> Result<Option<S
         ));
     }
     Ok(Some(*first))
+}
+
+/// Refuses a column that reads as the device file's second sensor's under
+/// another name (`p_a_bar`, `P_A_PA`, `x_mm`, `p_a`): "other columns are
+/// ignored", and a log whose sensor column was ignored replays without the
+/// monitor, or fails on the probe's empty cells beside it.
+///
+/// Errors: the column, the sensor's column and its unit.
+fn misnamed_second(names: &[String], sensor: &SecondSensor) -> Result<(), String> {
+    let column = second_column(sensor.settings.quantity);
+    // The name without its unit: `p_a` of `p_a_pa`, `x` of `x_m`.
+    let stem = column.name.rsplit_once('_').map_or(column.name, |(stem, _)| stem);
+    let looks = |h: &str| {
+        let h = h.trim().to_ascii_lowercase();
+        // The telemetry's standard uncertainties (`x_sd_m`, `p_a_sd_pa`)
+        // are estimates, not a misnamed reading.
+        h == stem
+            || (h.starts_with(stem)
+                && h[stem.len()..].starts_with(['_', ' ', '[', '(', '/'])
+                && !h[stem.len()..].starts_with("_sd"))
+    };
+    match names.iter().find(|h| looks(h)) {
+        Some(h) => Err(format!(
+            "column {h}: the device file's second sensor's readings (monitor.sensor = \"{}\") are read from \
+             column {}, the {}: rename the column, its readings in {}",
+            sensor.settings.quantity.name(),
+            column.name,
+            column.doc,
+            sensor.settings.quantity.unit()
+        )),
+        None => Ok(()),
+    }
 }
 
 /// Checks the second sensor's readings against the device file:
@@ -810,14 +845,29 @@ pub fn replay(raw: &RawParams, log: &Log, mut each: impl FnMut(Tick<'_>)) -> Res
     })?;
     let mut monitor = None;
     let mut second_readings = 0;
+    // The transducer driver's stuck check, which the firmware runs on
+    // every code (`Transducer::read`): a reading repeated on the same code
+    // `stuck_after` times in a row is a stuck sensor, a fault the monitor
+    // is told of (`SECOND_SENSOR_FAULT`), not a reading it takes. The
+    // driver's noisy check is not applied: a log's step of the reading
+    // within one of its 64-reading windows (the campaign's and
+    // `data/logs/monitor-capillary.csv`'s injected faults are steps) would
+    // read as a noisy sensor.
+    let mut checks = None;
     if let (Some(second), Some(sensor)) = (&log.second, SecondSensor::of(raw)?) {
         let rows: Vec<usize> = (0..n).filter(|&i| !second.value[i].is_nan()).collect();
         second_readings = rows.len();
-        let m = sensor.monitor(median(&rows) as f64 * tick);
+        // Fewer than two readings have no interval: the file's own period.
+        let m = if rows.len() < 2 {
+            sensor.monitor(f64::from(sensor.settings.period))
+        } else {
+            sensor.monitor(median(&rows) as f64 * tick)
+        };
         estimator = estimator
             .with_monitor(m)
             .map_err(|e| CliError::Input(format!("--params: {e}")))?;
         monitor = Some(m);
+        checks = Some((sensor.settings, transducer::Checks::new(&sensor.settings)));
     }
     let last = ticks[n - 1];
     let mut next = 0;
@@ -827,7 +877,15 @@ pub fn replay(raw: &RawParams, log: &Log, mut each: impl FnMut(Tick<'_>)) -> Res
             Some(i) => {
                 next += 1;
                 if let Some(y) = log.second.as_ref().map(|s| s.value[i]).filter(|y| !y.is_nan()) {
-                    estimator.offer_second(Ok(y as f32));
+                    let y = y as f32;
+                    let reading = match &mut checks {
+                        Some((settings, checks)) => match checks.update(settings.code_of(y)) {
+                            Err(SensorFault::Noisy(_)) | Ok(()) => Ok(y),
+                            Err(fault) => Err(fault),
+                        },
+                        None => Ok(y),
+                    };
+                    estimator.offer_second(reading);
                 }
                 sample(log, &settings, i)
             }
@@ -925,11 +983,30 @@ fn ticks_of(log: &Log, hz: f64) -> Result<Vec<u64>, CliError> {
                 ));
             }
             if k as u64 == ticks[i - 1] {
+                // A probe reading on one row and the second sensor's on
+                // the other (a logger that writes each sensor's reading on
+                // its own row): the estimator takes one of each a tick, on
+                // one row.
+                let apart = log.second.as_ref().is_some_and(|s| {
+                    let probe = |j: usize| !log.value[j].is_nan();
+                    let second = |j: usize| !s.value[j].is_nan();
+                    (probe(i) && !second(i) && second(i - 1) && !probe(i - 1))
+                        || (second(i) && !probe(i) && probe(i - 1) && !second(i - 1))
+                });
+                let hint = if apart {
+                    format!(
+                        "; the probe's reading and the second sensor's of one tick go on one row: merge rows {} and {}",
+                        i,
+                        i + 1
+                    )
+                } else {
+                    String::new()
+                };
                 return Err(bad(
                     i,
                     format!(
                         "{} after the row before, within one tick of the estimator ({} at estimator.tick_hz = \
-                         {} Hz): it takes one reading a tick",
+                         {} Hz): it takes one reading a tick{hint}",
                         seconds(t - prev),
                         seconds(tick),
                         sig(hz, 6)

@@ -175,10 +175,23 @@ pub fn summarise(raw: &RawParams, log: &Log) -> Result<Summary, CliError> {
         ));
     };
     let column = crate::estimate::second_column(sensor.settings.quantity).name;
-    if log.second.is_none() {
+    let Some(second) = &log.second else {
+        // A telemetry CSV has a column of that name, the estimator's
+        // estimate: say so rather than that the column is missing.
+        let why = match &log.note {
+            Some(note) => format!("{note}; the monitor's input is a log of the sensor's readings"),
+            None => format!(
+                "no column {column}: the readings of the file's second sensor (monitor.sensor = \"{}\") are the \
+                 monitor's input",
+                sensor.settings.quantity.name()
+            ),
+        };
+        return Err(CliError::Input(why));
+    };
+    if second.value.iter().all(|v| v.is_nan()) {
         return Err(CliError::Input(format!(
-            "no column {column}: the readings of the file's second sensor (monitor.sensor = \"{}\") are the \
-             monitor's input",
+            "column {column}: no reading in any row: the readings of the file's second sensor (monitor.sensor = \
+             \"{}\") are the monitor's input",
             sensor.settings.quantity.name()
         )));
     }

@@ -28,8 +28,11 @@ feeds the condition monitor on the row's tick; a row may then leave the
 probe's or the second sensor's cell empty (or NaN), not both, and the
 first row holds a probe reading. A column for another quantity, or one
 evidently in bar, MPa or mm, is refused naming the row and column (the
-file's monitor.range_min..range_max gives the plausible readings). A
-telemetry CSV's x_m, p_a_pa, p_b_pa are estimates, never readings.
+file's monitor.range_min..range_max gives the plausible readings). As the
+firmware's driver, a reading on the same ADC code as the readings before
+it monitor.noise says a healthy sensor repeats once in 1e9 times is a
+stuck sensor: flagged SECOND_SENSOR_FAULT, not taken. A telemetry CSV's
+x_m, p_a_pa, p_b_pa are estimates, never readings.
 
 Output: CSV, one row per telemetry period (estimator.telemetry_hz), or
 per input row with --every-sample; SI units, every digit of the f32
@@ -42,10 +45,12 @@ estimate:
   (NaN without a [machine] section), reseats [-],
   with a second sensor's column, the monitor's health estimate:
   divider [-] (A / A_file), sd_divider [-] (of ln divider), spring [-]
-  (c / c_file), sd_spring [-], offset_pa|_m, sd_offset_pa|_m, friction_n
-  [N], predicted_pa|_m (the reading the monitor predicted), innovation [-]
-  (standardised), cusum [-], rejected [-] (readings not applied); empty
-  before the monitor's first reading,
+  (c / c_file), sd_spring [-], offset_pa|_m, sd_offset_pa|_m,
+  probe_bias_k [K], sd_probe_bias_k [K] (the probe's error within its
+  tolerance), oil_c [C] (the oil temperature the reading gives),
+  friction_n [N], predicted_pa|_m (the reading the monitor predicted),
+  innovation [-] (standardised), cusum [-], rejected [-] (readings not
+  applied); empty before the monitor's first reading (rejected: 0),
   flags (names joined by |, the monitor's among them)
 The *_sd_* columns are standard uncertainties (k = 1): +-1.96 of them is
 the 95 % band (docs/firmware.md). stderr: the readings, their interval and

@@ -1,0 +1,172 @@
+//! `compensator estimate` and `monitor` on second-sensor logs a field
+//! logger writes and a new user hands them: a stuck transducer (the
+//! firmware's driver flags it, so must the replay), a column with no
+//! reading, a telemetry CSV given to `monitor`, the two sensors' readings
+//! on rows of their own within one tick, a single reading of the second
+//! sensor. Each either flagged as the firmware flags it or refused in one
+//! line that names the column and says what to do.
+
+use host_tests::run_cli;
+use std::path::{Path, PathBuf};
+
+const PARAMS: &str = "presets/paper-monitor.toml";
+
+/// The first `rows` rows of the documented log (`docs/monitoring.md`):
+/// the probe every 20 ms, the chamber (a) transducer every 10 ms.
+fn documented(rows: usize) -> Vec<(String, String, String)> {
+    let text = std::fs::read_to_string(host_tests::repo_root().join("data/logs/monitor-capillary.csv")).unwrap();
+    text.lines()
+        .skip(1)
+        .take(rows)
+        .map(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            (c[0].to_string(), c[1].to_string(), c[2].to_string())
+        })
+        .collect()
+}
+
+fn write(name: &str, header: &str, rows: &[(String, String, String)]) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("compensator-cli-monitor-input-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    let mut text = format!("{header}\n");
+    for (t, probe, second) in rows {
+        text.push_str(&format!("{t},{probe},{second}\n"));
+    }
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn path(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn a_stuck_transducer_is_flagged_as_the_firmware_s_driver_flags_it() {
+    // 20 s at 60 C, the transducer stuck on one reading from the start:
+    // the driver's check (37 equal codes for the preset's noise) flags it.
+    let rows: Vec<_> = documented(2001)
+        .into_iter()
+        .map(|(t, probe, second)| {
+            let stuck = if second.is_empty() {
+                second
+            } else {
+                "84395.6".to_string()
+            };
+            (t, probe, stuck)
+        })
+        .collect();
+    let log = write("stuck.csv", "time_s,t_c,p_a_pa", &rows);
+    let (code, out, err) = run_cli(&["monitor", "--params", PARAMS, "--sensor-data", path(&log)]);
+    assert_eq!(code, 0, "{err}");
+    let flags: Vec<&str> = out.lines().skip(1).map(|l| l.split(',').next().unwrap()).collect();
+    assert_eq!(flags, ["SECOND_SENSOR_FAULT"], "{out}");
+    // Raised on the 37th reading (row 37, 0.36 s), not before.
+    let first: Vec<&str> = out.lines().nth(1).unwrap().split(',').collect();
+    assert_eq!(first[1], "37", "{out}");
+    // The healthy readings of the same log raise nothing.
+    let log = write("healthy.csv", "time_s,t_c,p_a_pa", &documented(2001));
+    let (code, out, err) = run_cli(&["monitor", "--params", PARAMS, "--sensor-data", path(&log)]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(out.lines().count(), 1, "{out}");
+}
+
+#[test]
+fn monitor_refuses_a_column_without_a_reading() {
+    let rows: Vec<_> = documented(2001)
+        .into_iter()
+        .filter(|r| !r.1.is_empty())
+        .map(|(t, probe, _)| (t, probe, String::new()))
+        .collect();
+    let log = write("empty-column.csv", "time_s,t_c,p_a_pa", &rows);
+    let (code, _, err) = run_cli(&["monitor", "--params", PARAMS, "--sensor-data", path(&log)]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("column p_a_pa: no reading in any row"), "{err}");
+    assert!(!err.contains("NaN"), "{err}");
+}
+
+#[test]
+fn one_reading_of_the_second_sensor_takes_the_file_s_period() {
+    // No interval to take the median of: the file's monitor.sample_hz
+    // (100 Hz), not one tick.
+    let rows: Vec<_> = documented(2001)
+        .into_iter()
+        .filter(|r| !r.1.is_empty())
+        .enumerate()
+        .map(|(i, (t, probe, second))| (t, probe, if i == 100 { second } else { String::new() }))
+        .collect();
+    let log = write("one-reading.csv", "time_s,t_c,p_a_pa", &rows);
+    let (code, _, err) = run_cli(&["monitor", "--params", PARAMS, "--sensor-data", path(&log)]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("1 readings of the second sensor (p_a_pa), one every 10 ms"),
+        "{err}"
+    );
+}
+
+#[test]
+fn monitor_on_a_telemetry_csv_says_its_pressures_are_estimates() {
+    // A telemetry CSV has a p_a_pa column: the estimator's estimate.
+    let rows: Vec<_> = (0..20)
+        .map(|i| {
+            (
+                format!("{}", f64::from(i) * 0.5 + 0.499),
+                "60.5,60.5".to_string(),
+                "84000".to_string(),
+            )
+        })
+        .collect();
+    let log = write("telemetry.csv", "time_s,t_probe_c,t_oil_c,p_a_pa", &rows);
+    let (code, _, err) = run_cli(&["monitor", "--params", PARAMS, "--sensor-data", path(&log)]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("telemetry CSV"), "{err}");
+    assert!(!err.contains("no column p_a_pa"), "{err}");
+}
+
+#[test]
+fn the_two_sensors_on_rows_of_their_own_within_a_tick_are_told_to_share_a_row() {
+    // A logger writing each sensor's reading on its own row, 0.3 ms apart.
+    let mut rows = Vec::new();
+    for (t, probe, second) in documented(200) {
+        if probe.is_empty() {
+            rows.push((t, probe, second));
+        } else {
+            let later = format!("{:.4}", t.parse::<f64>().unwrap() + 3e-4);
+            rows.push((t, probe, String::new()));
+            rows.push((later, String::new(), second));
+        }
+    }
+    let log = write("async.csv", "time_s,t_c,p_a_pa", &rows);
+    let (code, _, err) = run_cli(&["monitor", "--params", PARAMS, "--sensor-data", path(&log)]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("row 2 (line 3), column time_s"), "{err}");
+    assert!(err.contains("merge rows 1 and 2"), "{err}");
+}
+
+#[test]
+fn a_sensor_column_under_another_name_is_refused_naming_the_right_one() {
+    // `p_a_bar` (or `P_A_PA`) was ignored as an unknown column: `estimate`
+    // ran without the monitor, and with the probe's cells empty beside it
+    // the error named an empty t_c cell.
+    let rows = documented(400);
+    for name in ["p_a_bar", "P_A_PA", "p_a"] {
+        let log = write(&format!("{name}.csv"), &format!("time_s,t_c,{name}"), &rows);
+        for command in ["estimate", "monitor"] {
+            let (code, _, err) = run_cli(&[command, "--params", PARAMS, "--sensor-data", path(&log)]);
+            assert_eq!(code, 2, "{command} {name}: {err}");
+            assert!(
+                err.contains(&format!("column {name}: ")) && err.contains("column p_a_pa"),
+                "{command} {name}: {err}"
+            );
+        }
+    }
+    // A probe log beside the estimates' uncertainties is no sensor log.
+    let probe: Vec<_> = rows
+        .into_iter()
+        .filter(|r| !r.1.is_empty())
+        .map(|(t, probe, _)| (t, probe, "900".to_string()))
+        .collect();
+    let log = write("sd.csv", "time_s,t_c,p_a_sd_pa", &probe);
+    let (code, _, err) = run_cli(&["estimate", "--params", PARAMS, "--sensor-data", path(&log)]);
+    assert_eq!(code, 0, "{err}");
+}
