@@ -9,7 +9,9 @@ use compensator::Params;
 use compensator::estimator::{Estimator, EstimatorConfig, Flags};
 use compensator::monitor::{MonitorSettings, ProbeModel, Quantity};
 use compensator::params::RawCore;
+use compensator::sensor::SensorFault;
 use compensator_reference::statics::equilibrium;
+use core::ops::Range;
 use host_tests::random::Rng;
 use host_tests::repo_root;
 
@@ -38,8 +40,10 @@ fn unit_noise(rng: &mut Rng) -> f64 {
 }
 
 /// Runs 60 s at 60 C, then a cooling at 0.1 C/s with the device changed by
-/// `fault` from 60 s on; returns the first named flags and their time.
-fn run(q: Quantity, fault: fn(&mut RawCore)) -> Option<(f64, Flags)> {
+/// `fault` from 60 s on, the second sensor's readings within `refused`
+/// \[s\] refused by its own checks; `each` sees every tick's time, flags
+/// and whether the estimate is published, and ends the run with `false`.
+fn drive(q: Quantity, fault: fn(&mut RawCore), refused: Range<f64>, mut each: impl FnMut(f64, Flags, bool) -> bool) {
     let mut raw = compensator_cli::load(&repo_root().join("presets/paper.toml")).unwrap();
     raw.probe.time_constant = 0.01;
     raw.probe.well_time_constant = 0.0;
@@ -50,7 +54,6 @@ fn run(q: Quantity, fault: fn(&mut RawCore)) -> Option<(f64, Flags)> {
     let mut bad = raw.core;
     fault(&mut bad);
     let mut rng = Rng::new(7);
-    let names = compensator::monitor::LATCHED;
     for k in 0..120_000u64 {
         let t = k as f64 * 1e-3;
         let temp = if t < 60.0 { 60.0 } else { 60.0 - 0.1 * (t - 60.0) };
@@ -65,18 +68,87 @@ fn run(q: Quantity, fault: fn(&mut RawCore)) -> Option<(f64, Flags)> {
                 Quantity::Displacement => pt.x,
             };
             let n = unit_noise(&mut rng);
-            est.offer_second(Ok((y + n * sd) as f32));
+            est.offer_second(if refused.contains(&t) {
+                Err(SensorFault::Bus)
+            } else {
+                Ok((y + n * sd) as f32)
+            });
         }
-        let named = Flags(e.flags.0 & names.0);
+        if !each(t, e.flags, est.telemetry_due()) {
+            return;
+        }
+    }
+}
+
+/// [`drive`] without refused readings: the first named flags and their
+/// time.
+fn run(q: Quantity, fault: fn(&mut RawCore)) -> Option<(f64, Flags)> {
+    let names = compensator::monitor::LATCHED;
+    let mut first = None;
+    drive(q, fault, 0.0..0.0, |t, flags, _| {
+        let named = Flags(flags.0 & names.0);
         if !named.is_empty() {
-            return Some((t, named));
+            first = Some((t, named));
+            return false;
         }
         assert!(
-            !(t < 60.0 && e.flags.contains(Flags::DEVICE_CHANGED)),
+            !(t < 60.0 && flags.contains(Flags::DEVICE_CHANGED)),
             "a change before the fault at {t}"
         );
+        true
+    });
+    first
+}
+
+/// The monitor runs in a job's place, never on a telemetry tick, and a
+/// reading without a probe reading beside it runs no test: the flags its
+/// estimate raised were on that tick's estimate alone, so that the
+/// telemetry never showed `DEVICE_CHANGED` between a change's detection
+/// and its name, nor a refused reading's `SECOND_SENSOR_FAULT`. Every
+/// published estimate from the detection to the name now says
+/// `DEVICE_CHANGED`, and the first published after refused readings
+/// says `SECOND_SENSOR_FAULT`.
+#[test]
+fn the_published_estimates_carry_the_monitors_flags() {
+    let mut published = Vec::new();
+    drive(
+        Quantity::ChamberA,
+        |c| c.laminar_diameter *= 0.8f64.powf(0.25),
+        30.0..30.05,
+        |t, flags, due| {
+            if due {
+                published.push((t, flags));
+            }
+            !flags.contains(Flags::CAPILLARY_RESTRICTED)
+        },
+    );
+    let refused: Vec<f64> = published
+        .iter()
+        .filter(|(_, f)| f.contains(Flags::SECOND_SENSOR_FAULT))
+        .map(|(t, _)| *t)
+        .collect();
+    // The telemetry's 2 Hz: the first published after 30 s, and only it.
+    assert!(
+        refused.len() == 1 && (30.0..30.5).contains(&refused[0]),
+        "published with SECOND_SENSOR_FAULT at {refused:?} s"
+    );
+    let detected = published
+        .iter()
+        .position(|(_, f)| f.contains(Flags::DEVICE_CHANGED))
+        .expect("no published estimate says DEVICE_CHANGED");
+    let changed = &published[detected..published.len() - 1];
+    assert!(
+        changed.len() >= 10,
+        "DEVICE_CHANGED on {} published estimates",
+        changed.len()
+    );
+    for (t, f) in changed {
+        assert!(
+            f.contains(Flags::DEVICE_CHANGED),
+            "{t} s: {f:?} before the change is named"
+        );
     }
-    None
+    assert!(published[detected].0 >= 60.0, "detected at {} s", published[detected].0);
 }
 
 #[test]

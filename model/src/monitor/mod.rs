@@ -1335,8 +1335,15 @@ impl Monitor {
 
     /// `estimate` with the filter's parameters now (the probe's error at
     /// the oil temperature `t_oil` \[C\]), the tests' state and `flags`.
-    fn publish(&mut self, mut estimate: HealthEstimate, flags: Flags, t_oil: f32) -> HealthEstimate {
+    fn publish(&mut self, mut estimate: HealthEstimate, mut flags: Flags, t_oil: f32) -> HealthEstimate {
         self.latched = Flags(flags.0 & LATCHED.0);
+        // A detected change stays raised until it is named, on readings
+        // that carry no probe reading (no test) as well: the test alone
+        // raised it, and the estimates between the probe's readings, the
+        // telemetry's among them, went without it.
+        if self.detected {
+            flags.insert(Flags::DEVICE_CHANGED);
+        }
         let theta = self.filter.theta();
         estimate.divider = exp(theta[DIVIDER]);
         estimate.sd_divider = self.filter.sd(DIVIDER);
@@ -1545,9 +1552,11 @@ fn sticking_gain(b: f32, c: f32) -> f32 {
     }
 }
 
-/// The flags of one reading only (the estimate of the tick that took it
-/// carries them); the others stay raised: `DEVICE_CHANGED` until the change
-/// is named, the named faults for good.
+/// The flags of one reading only: the estimator's estimates carry them
+/// from the tick that took the reading until one is published (the
+/// telemetry's; without telemetry, the next probe reading's tick). The
+/// others stay raised: `DEVICE_CHANGED` until the change is named, the
+/// named faults for good.
 pub const PER_READING: Flags = Flags(Flags::SECOND_SENSOR_FAULT.0 | Flags::INNOVATION_REJECTED.0);
 
 /// The flags that stay raised once set (the isolated faults).
