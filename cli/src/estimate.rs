@@ -53,7 +53,7 @@ use crate::error::CliError;
 use compensator::Params;
 use compensator::estimator::health::{HEALTH_FIELDS, HealthUnit};
 use compensator::estimator::telemetry::{Encoding, FIELDS, Record};
-use compensator::estimator::{Estimator, EstimatorConfig, StateEstimate};
+use compensator::estimator::{Estimator, EstimatorConfig, Flags, StateEstimate};
 use compensator::monitor::{HealthEstimate, MonitorSettings, ProbeModel, Quantity as MonitorQuantity};
 use compensator::params::RawParams;
 use compensator::sensor::max31865::Settings;
@@ -476,14 +476,19 @@ fn misnamed_second(names: &[String], sensor: &SecondSensor) -> Result<(), String
     let column = second_column(sensor.settings.quantity);
     // The name without its unit: `p_a` of `p_a_pa`, `x` of `x_m`.
     let stem = column.name.rsplit_once('_').map_or(column.name, |(stem, _)| stem);
+    // The stem alone, or with a unit of the quantity's (as a suffix or in
+    // brackets); any other column (`x_ref_m`, `p_a_set_pa`, the
+    // telemetry's `x_sd_m`) is another quantity's, and ignored.
+    const UNITS: [&str; 9] = ["pa", "kpa", "mpa", "bar", "mbar", "psi", "m", "mm", "um"];
     let looks = |h: &str| {
         let h = h.trim().to_ascii_lowercase();
-        // The telemetry's standard uncertainties (`x_sd_m`, `p_a_sd_pa`)
-        // are estimates, not a misnamed reading.
-        h == stem
-            || (h.starts_with(stem)
-                && h[stem.len()..].starts_with(['_', ' ', '[', '(', '/'])
-                && !h[stem.len()..].starts_with("_sd"))
+        let Some(rest) = h.strip_prefix(stem) else {
+            return false;
+        };
+        let unit = rest
+            .trim_start_matches(['_', ' ', '[', '(', '/'])
+            .trim_end_matches([']', ')']);
+        rest.is_empty() || (rest.len() > unit.len() && UNITS.contains(&unit))
     };
     match names.iter().find(|h| looks(h)) {
         Some(h) => Err(format!(
@@ -500,8 +505,10 @@ fn misnamed_second(names: &[String], sensor: &SecondSensor) -> Result<(), String
 
 /// Checks the second sensor's readings against the device file:
 ///
-/// * each inside the sensor's measuring band ([`SecondSensor::band`]),
-///   the likely unit named when a value is not (a displacement in mm);
+/// * at least half of them inside the sensor's measuring band
+///   ([`SecondSensor::band`]), the likely unit named when they are not (a
+///   displacement in mm); fewer outside it are the sensor's level faults,
+///   which [`replay`] flags (`SECOND_SENSOR_FAULT`) as the driver does;
 /// * the column as a whole not evidently in another unit: readings that
 ///   vary, yet all lie within one step of the sensor's ADC of zero, while
 ///   some likely unit (bar, kPa, MPa, psi; mm, um) puts every one inside
@@ -520,21 +527,32 @@ pub fn check_second(log: &Log, second: &Second, sensor: &SecondSensor) -> Result
     let (min, max) = (f64::from(sensor.settings.range.0), f64::from(sensor.settings.range.1));
     let data = crate::data::column(name);
     let hint = |v: f64, lo: f64, hi: f64| data.map_or(String::new(), |c| crate::data::unit_hint(c, v, lo, hi));
-    for (i, &v) in second.value.iter().enumerate() {
-        if v.is_finite() && !(lo..=hi).contains(&v) {
-            return Err(format!(
-                "{}: {} {unit} is outside the second sensor's measuring band {} to {} {unit} \
-                 (monitor.range_min..range_max = {} to {} {unit} with the output's margins; beyond it the sensor \
-                 reports a fault, not a reading){}",
-                log.at(i, name),
-                sig(v, 6),
-                sig(lo, 6),
-                sig(hi, 6),
-                sig(min, 6),
-                sig(max, 6),
-                hint(v, lo, hi)
-            ));
-        }
+    // A few readings outside the band are the sensor's faults (an open
+    // loop, a short), flagged as the driver flags them ([`replay`]); most
+    // of them outside it are a column in another unit, or no sensor.
+    let outside: Vec<usize> = (0..second.value.len())
+        .filter(|&i| second.value[i].is_finite() && !(lo..=hi).contains(&second.value[i]))
+        .collect();
+    let readings = second.value.iter().filter(|v| v.is_finite()).count();
+    if let Some(&i) = outside.first()
+        && 2 * outside.len() > readings
+    {
+        let v = second.value[i];
+        return Err(format!(
+            "{}: {} {unit} is outside the second sensor's measuring band {} to {} {unit} \
+             (monitor.range_min..range_max = {} to {} {unit} with the output's margins; beyond it the sensor \
+             reports a fault, not a reading), as {} of the column's {} readings are: a column in another unit, or \
+             a sensor that failed{}",
+            log.at(i, name),
+            sig(v, 6),
+            sig(lo, 6),
+            sig(hi, 6),
+            sig(min, 6),
+            sig(max, 6),
+            outside.len(),
+            readings,
+            hint(v, lo, hi)
+        ));
     }
     let finite: Vec<(usize, f64)> = second
         .value
@@ -854,6 +872,7 @@ pub fn replay(raw: &RawParams, log: &Log, mut each: impl FnMut(Tick<'_>)) -> Res
     // `data/logs/monitor-capillary.csv`'s injected faults are steps) would
     // read as a noisy sensor.
     let mut checks = None;
+    let mut band = (f64::NEG_INFINITY, f64::INFINITY);
     if let (Some(second), Some(sensor)) = (&log.second, SecondSensor::of(raw)?) {
         let rows: Vec<usize> = (0..n).filter(|&i| !second.value[i].is_nan()).collect();
         second_readings = rows.len();
@@ -868,6 +887,7 @@ pub fn replay(raw: &RawParams, log: &Log, mut each: impl FnMut(Tick<'_>)) -> Res
             .map_err(|e| CliError::Input(format!("--params: {e}")))?;
         monitor = Some(m);
         checks = Some((sensor.settings, transducer::Checks::new(&sensor.settings)));
+        band = sensor.band();
     }
     let last = ticks[n - 1];
     let mut next = 0;
@@ -878,11 +898,23 @@ pub fn replay(raw: &RawParams, log: &Log, mut each: impl FnMut(Tick<'_>)) -> Res
                 next += 1;
                 if let Some(y) = log.second.as_ref().map(|s| s.value[i]).filter(|y| !y.is_nan()) {
                     let y = y as f32;
+                    // As the driver: the level faults first (a reading
+                    // outside the measuring band: an open loop, a short, out
+                    // of range; one resets the checks), then the checks.
                     let reading = match &mut checks {
-                        Some((settings, checks)) => match checks.update(settings.code_of(y)) {
-                            Err(SensorFault::Noisy(_)) | Ok(()) => Ok(y),
-                            Err(fault) => Err(fault),
-                        },
+                        Some((settings, checks)) => {
+                            let code = settings.code_of(y);
+                            match settings.classify(code) {
+                                Err(fault) if !(band.0..=band.1).contains(&f64::from(y)) => {
+                                    checks.reset();
+                                    Err(fault)
+                                }
+                                _ => match checks.update(code) {
+                                    Err(SensorFault::Noisy(_)) | Ok(()) => Ok(y),
+                                    Err(fault) => Err(fault),
+                                },
+                            }
+                        }
                         None => Ok(y),
                     };
                     estimator.offer_second(reading);
@@ -934,8 +966,25 @@ pub fn run(raw: &RawParams, log: &Log, options: Options) -> Result<Replay, CliEr
     let mut out = header(quantity).join(",");
     out.push('\n');
     let mut rows = 0usize;
+    // A reading's own flags are on its tick's estimate (never a published
+    // one's: the monitor runs in a job's place) and on the next published
+    // one; a row per input row carries those of the ticks since the last
+    // row as well.
+    let mut since = Flags::empty();
     let run = replay(raw, log, |t| {
-        if (options.every_sample && t.row.is_some()) || (!options.every_sample && t.published) {
+        if !t.published {
+            since.insert(Flags(t.estimate.flags.0 & compensator::monitor::PER_READING.0));
+        }
+        if options.every_sample && t.row.is_some() {
+            // Those of its own tick are in `since` (a published tick has
+            // none but the ones rows before carried).
+            let mut e = *t.estimate;
+            let own = core::mem::replace(&mut since, Flags::empty());
+            e.flags = Flags((e.flags.0 & !compensator::monitor::PER_READING.0) | own.0);
+            out.push_str(&row(t.time_s, &e, quantity.is_some()));
+            out.push('\n');
+            rows += 1;
+        } else if !options.every_sample && t.published {
             out.push_str(&row(t.time_s, t.estimate, quantity.is_some()));
             out.push('\n');
             rows += 1;

@@ -166,7 +166,82 @@ fn a_sensor_column_under_another_name_is_refused_naming_the_right_one() {
         .filter(|r| !r.1.is_empty())
         .map(|(t, probe, _)| (t, probe, "900".to_string()))
         .collect();
-    let log = write("sd.csv", "time_s,t_c,p_a_sd_pa", &probe);
-    let (code, _, err) = run_cli(&["estimate", "--params", PARAMS, "--sensor-data", path(&log)]);
+    // Nor is another quantity's column whose name starts as the sensor's.
+    for name in ["p_a_sd_pa", "p_a_set_pa", "p_a_ref"] {
+        let log = write(&format!("other-{name}.csv"), &format!("time_s,t_c,{name}"), &probe);
+        let (code, _, err) = run_cli(&["estimate", "--params", PARAMS, "--sensor-data", path(&log)]);
+        assert_eq!(code, 0, "{name}: {err}");
+    }
+}
+
+/// An open loop for a tenth of a second in an otherwise healthy log (the
+/// logger wrote what the ADC read, -25 kPa: below the 4-20 mA band): the
+/// driver reports a level fault there, so the replay flags those readings
+/// `SECOND_SENSOR_FAULT` and goes on, where it refused the whole log. The
+/// rows of `estimate --every-sample` carry the flag, on the row after
+/// each refused reading's tick, and the published rows (the telemetry's)
+/// on the first after it.
+#[test]
+fn a_short_open_loop_is_flagged_not_refused() {
+    let rows: Vec<_> = documented(2001)
+        .into_iter()
+        .enumerate()
+        .map(|(i, (t, probe, second))| {
+            let open = (1000..1010).contains(&i) && !second.is_empty();
+            (t, probe, if open { "-25000".to_string() } else { second })
+        })
+        .collect();
+    let log = write("open.csv", "time_s,t_c,p_a_pa", &rows);
+    let (code, out, err) = run_cli(&["monitor", "--params", PARAMS, "--sensor-data", path(&log)]);
     assert_eq!(code, 0, "{err}");
+    let flags: Vec<Vec<&str>> = out.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    assert_eq!(flags.len(), 1, "{out}");
+    assert_eq!(flags[0][0], "SECOND_SENSOR_FAULT", "{out}");
+    // The first refused reading is row 1000's, taken on the next job tick.
+    assert!(["1000", "1001"].contains(&flags[0][1]), "{out}");
+    for every in [true, false] {
+        let mut args = vec!["estimate", "--params", PARAMS, "--sensor-data", path(&log)];
+        if every {
+            args.push("--every-sample");
+        }
+        let (code, out, err) = run_cli(&args);
+        assert_eq!(code, 0, "{err}");
+        let header: Vec<&str> = out.lines().next().unwrap().split(',').collect();
+        let (t, f) = (
+            header.iter().position(|h| *h == "time_s").unwrap(),
+            header.iter().position(|h| *h == "flags").unwrap(),
+        );
+        let flagged: Vec<f64> = out
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').collect::<Vec<_>>())
+            .filter(|c| c[f].contains("SECOND_SENSOR_FAULT"))
+            .map(|c| c[t].parse().unwrap())
+            .collect();
+        if every {
+            // The ten refused readings' rows (10.00-10.09 s) and the next.
+            assert!(
+                flagged.len() >= 10 && flagged.iter().all(|t| (10.0..10.2).contains(t)),
+                "--every-sample rows flagged at {flagged:?}"
+            );
+        } else {
+            // The first telemetry row after 10.0 s (2 Hz) and no other.
+            assert!(
+                flagged.len() == 1 && (10.0..10.6).contains(&flagged[0]),
+                "telemetry rows flagged at {flagged:?}"
+            );
+        }
+    }
+    // Most of the column outside the band is no sensor's fault: refused.
+    let rows: Vec<_> = documented(2001)
+        .into_iter()
+        .map(|(t, probe, second)| (t, probe, if second.is_empty() { second } else { "-25000".into() }))
+        .collect();
+    let log = write("dead.csv", "time_s,t_c,p_a_pa", &rows);
+    let (code, _, err) = run_cli(&["monitor", "--params", PARAMS, "--sensor-data", path(&log)]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("column p_a_pa") && err.contains("of the column's"),
+        "{err}"
+    );
 }

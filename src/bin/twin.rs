@@ -298,7 +298,7 @@ fn replay(params: &Params<f32>, config: BuiltConfig) -> bool {
         (estimator, second, track, config.ticks_per(transducer.period))
     };
     #[cfg(feature = "monitor")]
-    let mut watch = MonitorWatch::new();
+    let mut watch = MonitorWatch::new(config.telemetry_every as f32 * tick);
     let end = REPLAY_PIECES[REPLAY_PIECES.len() - 1].1;
     let ticks = (end / tick) as u32;
     let sensor_every = config.ticks_per(sensor.sample_period());
@@ -470,7 +470,9 @@ fn tick_path(
 const ALARMS: Flags = Flags(Flags::DEVICE_CHANGED.0 | compensator::monitor::LATCHED.0);
 
 /// Time after the open loop's end in which its flag may still show \[s\]
-/// (the window's last reading is taken on a later tick).
+/// (the window's last reading is taken on a later tick), besides one
+/// telemetry period: the next published estimate carries the flags of the
+/// readings since the last.
 #[cfg(feature = "monitor")]
 const OPEN_LOOP_TAIL: f32 = 0.05;
 
@@ -485,6 +487,9 @@ const OPEN_LOOP_TAIL: f32 = 0.05;
 /// restricted capillary, which are its algorithm's (`docs/monitoring.md`).
 #[cfg(feature = "monitor")]
 struct MonitorWatch {
+    /// Time after the open loop's end in which its flag may still show
+    /// \[s\] ([`OPEN_LOOP_TAIL`]).
+    tail: f32,
     /// The health estimate at the end of the first hold.
     settled: compensator::monitor::HealthEstimate,
     /// Ticks with a health estimate not finite after the first reading.
@@ -512,8 +517,10 @@ struct MonitorWatch {
 
 #[cfg(feature = "monitor")]
 impl MonitorWatch {
-    fn new() -> Self {
+    /// `telemetry` the telemetry's period \[s\].
+    fn new(telemetry: f32) -> Self {
         MonitorWatch {
+            tail: OPEN_LOOP_TAIL + telemetry,
             settled: compensator::monitor::HealthEstimate::NONE,
             not_finite: 0,
             open_flags: Flags::empty(),
@@ -565,7 +572,7 @@ impl MonitorWatch {
         if track.open(time) {
             self.open_flags.insert(e.flags);
         } else if e.flags.contains(Flags::SECOND_SENSOR_FAULT)
-            && !(time >= track.open_loop.0 && time < track.open_loop.1 + OPEN_LOOP_TAIL)
+            && !(time >= track.open_loop.0 && time < track.open_loop.1 + self.tail)
         {
             if self.stray_sensor_faults == 0 {
                 self.first_stray = time;

@@ -163,12 +163,13 @@ flag_table! {
     /// The monitor isolated an offset of the second sensor's reading that
     /// no device fault explains (latched).
     16 SENSOR_OFFSET "SENSOR_OFFSET";
-    /// A reading of the second sensor since the last published estimate was
-    /// refused by its own checks (open loop, out of range, stuck, noisy):
-    /// the monitor skipped it.
+    /// The reading of the second sensor this tick took (or, on a published
+    /// estimate, one since the last published) was refused by its own
+    /// checks (open loop, out of range, stuck, noisy): the monitor skipped it.
     17 SECOND_SENSOR_FAULT "SECOND_SENSOR_FAULT";
-    /// A reading of the second sensor since the last published estimate lay
-    /// beyond the monitor's gate, or was not finite: counted, not applied.
+    /// The reading of the second sensor this tick took (or, on a published
+    /// estimate, one since the last published) lay beyond the monitor's
+    /// gate, or was not finite: counted, not applied.
     18 INNOVATION_REJECTED "INNOVATION_REJECTED";
 }
 

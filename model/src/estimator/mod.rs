@@ -232,10 +232,13 @@ pub struct Estimator<T = f32, U = UncertaintyTable, O = ObserverDesign> {
     second: Option<Result<f32, SensorFault>>,
     /// The monitor's estimate at its last reading.
     health: HealthEstimate,
-    /// Flags of the monitor's last reading for the next estimate; its own
-    /// (`PER_READING`) kept until an estimate is published.
+    /// Flags of the monitor's last reading, for the next estimate only.
     #[cfg(feature = "monitor")]
     health_flags: Flags,
+    /// The monitor's readings' own flags (`PER_READING`) since the last
+    /// published estimate, for the next (kept through a reset).
+    #[cfg(feature = "monitor")]
+    unreported: Flags,
     /// The probe's last accepted reading and its tick, until the monitor
     /// takes it.
     #[cfg(feature = "monitor")]
@@ -296,6 +299,8 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
             health: HealthEstimate::NONE,
             #[cfg(feature = "monitor")]
             health_flags: Flags::empty(),
+            #[cfg(feature = "monitor")]
+            unreported: Flags::empty(),
             #[cfg(feature = "monitor")]
             probe_sample: None,
             #[cfg(feature = "monitor")]
@@ -364,8 +369,9 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
         if monitor.pending() {
             if let Some(health) = monitor.advance() {
                 self.health = health;
-                // A reading's own flags not yet published are kept.
-                self.health_flags = Flags(health.flags.0 | (self.health_flags.0 & crate::monitor::PER_READING.0));
+                self.health_flags = health.flags;
+                self.unreported
+                    .insert(Flags(health.flags.0 & crate::monitor::PER_READING.0));
             }
             return true;
         }
@@ -505,8 +511,6 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
         // A reading's update took this tick (without an FPU it costs about
         // a job slice: the tick then runs no job).
         let mut updated = false;
-        #[cfg(feature = "monitor")]
-        let sampled = reading.is_some();
         if let Some((t, at)) = reading {
             let verdict = self.observer.offer(design, &self.config.spikes, t);
             updated = verdict == Verdict::Accepted;
@@ -558,23 +562,19 @@ impl<T: Real, U: Borrow<UncertaintyTable> + Copy, O: Borrow<ObserverDesign> + Co
                 self.plant.run_job(self.config.table(), t, || observer.variance(design));
             }
         }
-        // A reading's own flags (`PER_READING`) stay on the estimates until
-        // one is published (the telemetry's, or without telemetry the next
-        // probe reading's tick): the monitor runs in a job's place, never on
-        // a telemetry tick, and a flag carried by its tick's estimate alone
-        // never reached the telemetry.
+        // A reading's own flags (`PER_READING`) are on its tick's estimate
+        // and on the next published one (the telemetry's): the monitor runs
+        // in a job's place, never on a telemetry tick, and a flag on its
+        // tick's estimate alone never reached the telemetry.
         #[cfg(feature = "monitor")]
         {
-            let reported = self.publish || (self.config.telemetry_every == 0 && sampled);
-            let unreported = if reported {
-                0
-            } else {
-                self.health_flags.0 & crate::monitor::PER_READING.0
-            };
             flags.insert(core::mem::replace(
                 &mut self.health_flags,
-                Flags((self.health.flags.0 & !crate::monitor::PER_READING.0) | unreported),
+                Flags(self.health.flags.0 & !crate::monitor::PER_READING.0),
             ));
+            if self.publish {
+                flags.insert(core::mem::replace(&mut self.unreported, Flags::empty()));
+            }
         }
         let mut e = self.plant.estimate(t, flags);
         #[cfg(feature = "monitor")]
