@@ -29,9 +29,11 @@ probe's or the second sensor's cell empty (or NaN), not both, and the
 first row holds a probe reading. A column for another quantity, or one
 evidently in bar, MPa or mm, is refused naming the row and column (the
 file's monitor.range_min..range_max gives the plausible readings). As the
-firmware's driver, a reading on the same ADC code as the readings before
-it monitor.noise says a healthy sensor repeats once in 1e9 times is a
-stuck sensor: flagged SECOND_SENSOR_FAULT, not taken. A telemetry CSV's
+firmware's driver, a reading outside the sensor's measuring band (an open
+loop, a short; most of the column outside it is refused), or on the same
+ADC code as the readings before it monitor.noise says a healthy sensor
+repeats once in 1e9 times (stuck), is flagged SECOND_SENSOR_FAULT, not
+taken. A telemetry CSV's
 x_m, p_a_pa, p_b_pa are estimates, never readings.
 
 Output: CSV, one row per telemetry period (estimator.telemetry_hz), or

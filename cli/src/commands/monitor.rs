@@ -13,7 +13,9 @@ sure it is.
 Log (CSV, as estimate reads it): time_s [s], the probe's column (t_c,
 rtd_ohm or code) and the second sensor's, p_a_pa, p_b_pa or dp_ab_pa [Pa]
 or x_m [m] (the file's monitor.sensor); either reading may be empty on a
-row. A column in bar, MPa or mm is refused naming its row and column.
+row. A column in bar, MPa or mm is refused naming its row and column;
+readings outside the sensor's measuring band (a few) or stuck are
+flagged SECOND_SENSOR_FAULT, as the firmware's driver flags them.
 
 Output: CSV, one row per flag of the monitor's raised over the log
 (DEVICE_CHANGED, CAPILLARY_RESTRICTED, ORIFICE_CLOGGED, SPRING_RELAXED,
