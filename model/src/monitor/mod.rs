@@ -1464,10 +1464,12 @@ impl Monitor {
         }
     }
 
-    /// The isolation's state over the current CUSUM run (all zero outside
-    /// one): each hypothesis' log-likelihood gain, in [`Hypothesis::ALL`]'s
-    /// order, the margin the best must beat the next by, and the oil's span
-    /// \[K\] of the run's tested readings: what names a fault, for
+    /// The isolation's state over the current CUSUM run, or the last one
+    /// (its sums restart with the next run and when a fault is named): each
+    /// hypothesis' log-likelihood gain, in [`Hypothesis::ALL`]'s order, the
+    /// margin the best must beat the next by (at least
+    /// [`ISOLATION_MARGIN`]), and the oil's span \[K\] of the run's tested
+    /// readings (NaN before the first run): what names a fault, for
     /// diagnostics (`host-tests/examples/monitor_trace.rs`, `TRACE_GAINS`).
     pub fn isolation(&self) -> Isolation {
         // Log-likelihood gain of each single-fault fit, `b^2 / (2 c)`, with
