@@ -863,16 +863,8 @@ pub fn replay(raw: &RawParams, log: &Log, mut each: impl FnMut(Tick<'_>)) -> Res
     })?;
     let mut monitor = None;
     let mut second_readings = 0;
-    // The transducer driver's stuck check, which the firmware runs on
-    // every code (`Transducer::read`): a reading repeated on the same code
-    // `stuck_after` times in a row is a stuck sensor, a fault the monitor
-    // is told of (`SECOND_SENSOR_FAULT`), not a reading it takes. The
-    // driver's noisy check is not applied: a log's step of the reading
-    // within one of its 64-reading windows (the campaign's and
-    // `data/logs/monitor-capillary.csv`'s injected faults are steps) would
-    // read as a noisy sensor.
+    // The transducer driver's checks on each reading ([`DriverChecks`]).
     let mut checks = None;
-    let mut band = (f64::NEG_INFINITY, f64::INFINITY);
     if let (Some(second), Some(sensor)) = (&log.second, SecondSensor::of(raw)?) {
         let rows: Vec<usize> = (0..n).filter(|&i| !second.value[i].is_nan()).collect();
         second_readings = rows.len();
@@ -886,8 +878,7 @@ pub fn replay(raw: &RawParams, log: &Log, mut each: impl FnMut(Tick<'_>)) -> Res
             .with_monitor(m)
             .map_err(|e| CliError::Input(format!("--params: {e}")))?;
         monitor = Some(m);
-        checks = Some((sensor.settings, transducer::Checks::new(&sensor.settings)));
-        band = sensor.band();
+        checks = Some(DriverChecks::new(&sensor));
     }
     let last = ticks[n - 1];
     let mut next = 0;
@@ -898,25 +889,7 @@ pub fn replay(raw: &RawParams, log: &Log, mut each: impl FnMut(Tick<'_>)) -> Res
                 next += 1;
                 if let Some(y) = log.second.as_ref().map(|s| s.value[i]).filter(|y| !y.is_nan()) {
                     let y = y as f32;
-                    // As the driver: the level faults first (a reading
-                    // outside the measuring band: an open loop, a short, out
-                    // of range; one resets the checks), then the checks.
-                    let reading = match &mut checks {
-                        Some((settings, checks)) => {
-                            let code = settings.code_of(y);
-                            match settings.classify(code) {
-                                Err(fault) if !(band.0..=band.1).contains(&f64::from(y)) => {
-                                    checks.reset();
-                                    Err(fault)
-                                }
-                                _ => match checks.update(code) {
-                                    Err(SensorFault::Noisy(_)) | Ok(()) => Ok(y),
-                                    Err(fault) => Err(fault),
-                                },
-                            }
-                        }
-                        None => Ok(y),
-                    };
+                    let reading = checks.as_mut().map_or(Ok(y), |c| c.reading(y));
                     estimator.offer_second(reading);
                 }
                 sample(log, &settings, i)
@@ -1005,6 +978,48 @@ pub fn run(raw: &RawParams, log: &Log, options: Options) -> Result<Replay, CliEr
         ticks: run.ticks,
         note: run.note("estimate", log, Some((rows, options.every_sample))),
     })
+}
+
+/// The transducer driver's checks (`Transducer::read_reading`), which the
+/// firmware runs on every code, on a log's readings of the second sensor:
+/// first the level faults (a reading outside the measuring band: an open
+/// loop, a short, out of range), one of which resets the checks, then the
+/// stuck check (a reading repeated on the same code `stuck_after` times in
+/// a row). Either is a fault the monitor is told of (`SECOND_SENSOR_FAULT`),
+/// not a reading it takes. The driver's noisy check is not applied: a
+/// log's step of the reading within one of its 64-reading windows (the
+/// campaign's and `data/logs/monitor-capillary.csv`'s injected faults are
+/// steps) would read as a noisy sensor.
+struct DriverChecks {
+    settings: transducer::Settings,
+    checks: transducer::Checks,
+    /// The measuring band \[Pa or m\] ([`SecondSensor::band`]).
+    band: (f64, f64),
+}
+
+impl DriverChecks {
+    fn new(sensor: &SecondSensor) -> Self {
+        DriverChecks {
+            settings: sensor.settings,
+            checks: transducer::Checks::new(&sensor.settings),
+            band: sensor.band(),
+        }
+    }
+
+    /// Reading `y` \[Pa or m\] as the driver would pass it, or its fault.
+    fn reading(&mut self, y: f32) -> Result<f32, SensorFault> {
+        let code = self.settings.code_of(y);
+        match self.settings.classify(code) {
+            Err(fault) if !(self.band.0..=self.band.1).contains(&f64::from(y)) => {
+                self.checks.reset();
+                Err(fault)
+            }
+            _ => match self.checks.update(code) {
+                Err(SensorFault::Noisy(_)) | Ok(()) => Ok(y),
+                Err(fault) => Err(fault),
+            },
+        }
+    }
 }
 
 /// The estimator's tick each row of `log` is delivered on (at `hz`, from
