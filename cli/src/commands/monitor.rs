@@ -29,7 +29,8 @@ INNOVATION_REJECTED), in that order; none: a header alone:
   sd (its standard deviation: of the logarithm for divider and spring),
   z [-] (how many sd the estimate lies from the file's device: ln(f)/sd
   for a factor, offset/sd), cusum_max [-] (the largest CUSUM up to the
-  flag; DEVICE_CHANGED above 10), unit (of estimate and sd)
+  flag; DEVICE_CHANGED above 10), unit (of estimate and sd: 1, Pa, m,
+  N or K; a string in JSON as in CSV)
 stderr: what ran, and the health estimate at the log's end.
 --plot FILE.png|svg: the standardised innovations with the gate, the CUSUM
 with its threshold, the divider and spring factors and the offset, each
