@@ -381,13 +381,23 @@ pub fn cells(text: &str) -> (Vec<&str>, Vec<Vec<&str>>) {
     (header, lines.map(|l| l.split(',').collect()).collect())
 }
 
-/// A cell as a JSON value: a finite number, `true`/`false`, `null` for a
-/// non-finite number (JSON has none) or an empty cell (a row that could not
-/// be computed, a parameter `identify` could not determine), else a string.
-fn json_value(cell: &str) -> serde_json::Value {
+/// A column whose cells are text however they read: a unit's symbol
+/// (`unit`, `residual_unit`), where a dimensionless value's is `1`. JSON
+/// writes its cells as strings, as the CSV's `Pa` and `m` are.
+pub fn is_text_column(name: &str) -> bool {
+    name == "unit" || name.ends_with("_unit")
+}
+
+/// A cell of the column `column` as a JSON value: `null` for an empty cell
+/// (a row that could not be computed, a parameter `identify` could not
+/// determine), a string in a text column ([`is_text_column`]), else a
+/// finite number, `true`/`false`, `null` for a non-finite number (JSON has
+/// none), or a string.
+fn json_value(column: &str, cell: &str) -> serde_json::Value {
     use serde_json::Value;
     match cell {
         "" => Value::Null,
+        _ if is_text_column(column) => Value::String(cell.to_string()),
         "true" => Value::Bool(true),
         "false" => Value::Bool(false),
         _ if !cell.is_empty() && cell.bytes().all(|b| b.is_ascii_digit() || b == b'-') => {
@@ -434,7 +444,7 @@ pub fn render(text: &str, format: Format) -> String {
                     let fields: Vec<String> = header
                         .iter()
                         .zip(row)
-                        .map(|(h, c)| format!("{}: {}", key(h), json_value(c)))
+                        .map(|(h, c)| format!("{}: {}", key(h), json_value(h, c)))
                         .collect();
                     format!("  {{{}}}", fields.join(", "))
                 })
@@ -507,6 +517,22 @@ mod tests {
         // The command's own output may hold NaN: `parse` keeps it.
         let (_, rows) = parse("a\nNaN\n").unwrap();
         assert!(rows[0][0].is_nan());
+    }
+
+    #[test]
+    fn json_keeps_a_unit_column_as_text() {
+        let text = "flag,ticks,estimate,unit,residual_unit\nA,3,1.5,1,Pa\nB,4,,m,1\nC,5,2,,\n";
+        let rows: Vec<serde_json::Value> = serde_json::from_str(&render(text, Format::Json)).unwrap();
+        let get = |r: usize, k: &str| rows[r][k].clone();
+        assert_eq!(get(0, "unit"), serde_json::json!("1"));
+        assert_eq!(get(0, "residual_unit"), serde_json::json!("Pa"));
+        assert_eq!(get(1, "unit"), serde_json::json!("m"));
+        assert_eq!(get(1, "residual_unit"), serde_json::json!("1"));
+        // Other columns as before: numbers, and null for an empty cell.
+        assert_eq!(get(0, "ticks"), serde_json::json!(3));
+        assert_eq!(get(0, "estimate"), serde_json::json!(1.5));
+        assert_eq!(get(1, "estimate"), serde_json::Value::Null);
+        assert_eq!(get(2, "unit"), serde_json::Value::Null);
     }
 
     #[test]

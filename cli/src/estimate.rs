@@ -36,7 +36,11 @@
 //! either reading may be empty (or `NaN`) on a row, not both; the first
 //! row holds a probe reading. A telemetry CSV (it has `t_oil_c`) carries
 //! the estimator's own `x_m`, `p_a_pa` and `p_b_pa`: they are estimates,
-//! never taken as a second sensor's readings.
+//! never taken as a second sensor's readings. Where the second sensor
+//! stopped reporting for a while between its first and last reading
+//! ([`SecondGaps`]: more than one and a half of its period between two
+//! readings), standard error says how many readings are missing and
+//! names the rows of the longest such stretch.
 //!
 //! Bad input, each naming the row, its line and the column: no reading
 //! column or two of them, times that do not increase, two readings within
@@ -767,6 +771,95 @@ pub struct Run {
     pub monitor: Option<MonitorSettings>,
     /// The second sensor's readings (rows with one).
     pub second_readings: usize,
+    /// Where the second sensor stopped reporting between its first and
+    /// last reading ([`SecondGaps::of`]), if it did.
+    pub second_gaps: Option<SecondGaps>,
+}
+
+/// The second sensor's readings missing from a log: between two of its
+/// consecutive readings more than one and a half of its period apart (the
+/// monitor's: the median interval of the column's readings), the readings
+/// due in between, `round(interval / period) - 1`. A sensor slower than
+/// the probe (a reading every few rows) has its median interval for its
+/// period, so its regularly empty cells are none missing; nor are the rows
+/// before its first reading or after its last.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SecondGaps {
+    /// Readings missing over the log.
+    pub missing: u64,
+    /// Stretches where they are missing.
+    pub gaps: usize,
+    /// The longest stretch: the rows of the readings either side (0-based).
+    pub longest: (usize, usize),
+    /// Its first and last row where a reading was due (more than half a
+    /// period from the readings either side), if the log has one.
+    pub due: Option<(usize, usize)>,
+    /// Readings missing in it.
+    pub longest_missing: u64,
+}
+
+impl SecondGaps {
+    /// The gaps of the readings on rows `rows` (0-based, increasing), row
+    /// `i` on tick `ticks[i]`, one due every `period` ticks; `None`
+    /// without one.
+    pub fn of(rows: &[usize], ticks: &[u64], period: u64) -> Option<SecondGaps> {
+        let period = period.max(1);
+        let mut found: Option<SecondGaps> = None;
+        let mut longest_ticks = 0;
+        for w in rows.windows(2) {
+            let (a, b) = (w[0], w[1]);
+            let interval = ticks[b] - ticks[a];
+            if 2 * interval <= 3 * period {
+                continue;
+            }
+            // round(interval / period) - 1, at least 1 past 1.5 periods.
+            let missing = (2 * interval + period) / (2 * period) - 1;
+            let g = found.get_or_insert(SecondGaps {
+                missing: 0,
+                gaps: 0,
+                longest: (a, b),
+                due: None,
+                longest_missing: missing,
+            });
+            g.missing += missing;
+            g.gaps += 1;
+            if interval > longest_ticks {
+                longest_ticks = interval;
+                let due = |j: &usize| 2 * (ticks[*j] - ticks[a]) > period && 2 * (ticks[b] - ticks[*j]) > period;
+                g.longest = (a, b);
+                g.due = (a + 1..b).find(due).zip((a + 1..b).rev().find(due));
+                g.longest_missing = missing;
+            }
+        }
+        found
+    }
+
+    /// The line for standard error naming the longest stretch: the column,
+    /// its first and last row where a reading was due (or the rows either
+    /// side, when the log has none between them), how long, and what is
+    /// missing.
+    pub fn note(&self, log: &Log, column: &str, period: f64) -> String {
+        let (a, b) = self.longest;
+        let row = |i: usize| format!("row {} (line {})", i + 1, log.lines[i]);
+        let rows = match self.due {
+            Some((first, last)) => format!("no reading from {} to {}", row(first), row(last)),
+            None => format!("no reading between {} and {}", row(a), row(b)),
+        };
+        let mut note = format!(
+            "column {column}: {rows}: {} s between the readings either side, where the second sensor reads one \
+             every {}; {} readings missing, the monitor ran without them",
+            sig(log.time_s[b] - log.time_s[a], 6),
+            seconds(period),
+            self.longest_missing
+        );
+        if self.gaps > 1 {
+            note.push_str(&format!(
+                " (the longest of {} stretches, {} readings missing over the log)",
+                self.gaps, self.missing
+            ));
+        }
+        note
+    }
 }
 
 impl Run {
@@ -784,6 +877,7 @@ impl Run {
             self.ticks,
             seconds(self.tick),
         );
+        let mut gap = None;
         if let (Some(m), Some(second)) = (&self.monitor, &log.second) {
             note.push_str(&format!(
                 "; {} readings of the second sensor ({}), one every {} (the monitor's period)",
@@ -791,6 +885,10 @@ impl Run {
                 second.column.name,
                 seconds(f64::from(m.sample_period))
             ));
+            if let Some(g) = &self.second_gaps {
+                note.push_str(&format!(", {} missing", g.missing));
+                gap = Some(g.note(log, second.column.name, f64::from(m.sample_period)));
+            }
         }
         if let Some((rows, every_sample)) = rows {
             note.push_str(&format!("; {rows} rows"));
@@ -802,6 +900,9 @@ impl Run {
                     seconds(self.telemetry_every as f64 * self.tick)
                 ));
             }
+        }
+        if let Some(gap) = gap {
+            note.push_str(&format!("\n{command}: {gap}"));
         }
         if let Some(extra) = &log.note {
             note.push_str(&format!("\n{command}: {extra}"));
@@ -863,6 +964,7 @@ pub fn replay(raw: &RawParams, log: &Log, mut each: impl FnMut(Tick<'_>)) -> Res
     })?;
     let mut monitor = None;
     let mut second_readings = 0;
+    let mut second_gaps = None;
     // The transducer driver's checks on each reading ([`DriverChecks`]).
     let mut checks = None;
     if let (Some(second), Some(sensor)) = (&log.second, SecondSensor::of(raw)?) {
@@ -872,7 +974,9 @@ pub fn replay(raw: &RawParams, log: &Log, mut each: impl FnMut(Tick<'_>)) -> Res
         let m = if rows.len() < 2 {
             sensor.monitor(f64::from(sensor.settings.period))
         } else {
-            sensor.monitor(median(&rows) as f64 * tick)
+            let period = median(&rows);
+            second_gaps = SecondGaps::of(&rows, &ticks, period);
+            sensor.monitor(period as f64 * tick)
         };
         estimator = estimator
             .with_monitor(m)
@@ -913,6 +1017,7 @@ pub fn replay(raw: &RawParams, log: &Log, mut each: impl FnMut(Tick<'_>)) -> Res
         probe_readings: probe.len(),
         monitor,
         second_readings,
+        second_gaps,
     })
 }
 
@@ -1191,6 +1296,44 @@ mod tests {
             "time_s,t_probe_c,t_oil_c,t_oil_sd_c,x_m,x_sd_m,p_a_pa,p_a_sd_pa,p_b_pa,p_b_sd_pa,q_total_m3s,\
              q_total_sd_m3s,compensation_error_m3s,compensation_error_sd_m3s,reseats,flags"
         );
+    }
+
+    #[test]
+    fn second_gaps_count_the_readings_due_at_the_sensor_s_period() {
+        // A reading every 10 ticks on rows 0..=10, none for rows 11..=39
+        // (ticks 110..=390), again from row 40 (tick 400).
+        let ticks: Vec<u64> = (0..60).map(|i| i * 10).collect();
+        let rows: Vec<usize> = (0..60).filter(|i| !(11..40).contains(i)).collect();
+        let g = SecondGaps::of(&rows, &ticks, 10).unwrap();
+        assert_eq!(
+            g,
+            SecondGaps {
+                missing: 29,
+                gaps: 1,
+                longest: (10, 40),
+                due: Some((11, 39)),
+                longest_missing: 29
+            }
+        );
+        // A sensor at a third of the rows' rate: its period, none missing;
+        // stopped, the rows where its readings were due, not the empty
+        // ones beside them.
+        let slow: Vec<usize> = (0..60).step_by(3).collect();
+        assert_eq!(SecondGaps::of(&slow, &ticks, 30), None);
+        let stopped: Vec<usize> = slow.iter().copied().filter(|i| !(12..=27).contains(i)).collect();
+        let g = SecondGaps::of(&stopped, &ticks, 30).unwrap();
+        assert_eq!((g.longest, g.due, g.missing), ((9, 30), Some((11, 28)), 6));
+        // No row between the readings either side: none named as due.
+        assert_eq!(
+            SecondGaps::of(&[0, 1], &[0, 50], 10).map(|g| (g.due, g.missing)),
+            Some((None, 4))
+        );
+        // Jitter within half a period is none; a reading dropped is one;
+        // two stretches, the longer named, both counted.
+        assert_eq!(SecondGaps::of(&[0, 1, 2], &[0, 14, 24], 10), None);
+        assert_eq!(SecondGaps::of(&[0, 1, 2], &[0, 16, 26], 10).map(|g| g.missing), Some(1));
+        let g = SecondGaps::of(&[0, 1, 2, 3], &[0, 20, 60, 70], 10).unwrap();
+        assert_eq!((g.missing, g.gaps, g.longest, g.longest_missing), (4, 2, (1, 2), 3));
     }
 
     #[test]

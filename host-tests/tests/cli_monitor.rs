@@ -6,7 +6,8 @@
 //! monitor`, compared row by row with the firmware's `f32` estimator and
 //! its monitor run here on the same readings; and the logs the commands
 //! refuse (a pressure in bar, a displacement in mm, a column for another
-//! quantity than the file's sensor), each naming its row and column.
+//! quantity than the file's sensor), each naming its row and column; and
+//! `monitor --format json`'s units, strings as in its CSV.
 
 use compensator::Params;
 use compensator::estimator::health::{HEALTH_FIELDS, HealthUnit};
@@ -292,11 +293,7 @@ fn a_column_the_device_file_does_not_measure_is_refused_naming_it() {
     );
     // A displacement in mm: outside the sensor's band, the unit named.
     let x = dir.join("x.toml");
-    let text = params_text()
-        .replace("sensor = \"p_a\"", "sensor = \"x\"")
-        .replace("range_max = 500000.0    # Pa", "range_max = 0.0018    # m")
-        .replace("noise = 100.0    # Pa", "noise = 1e-6    # m");
-    std::fs::write(&x, text).unwrap();
+    std::fs::write(&x, displacement_params_text()).unwrap();
     let log = dir.join("mm.csv");
     std::fs::write(&log, "time_s,t_c,x_m\n0,40,0.18\n0.01,,0.19\n0.02,40,0.2\n0.03,,0.7\n").unwrap();
     let (code, _, err) = run_cli(&["estimate", "--params", path(&x), "--sensor-data", path(&log)]);
@@ -428,4 +425,92 @@ fn the_documented_log_is_what_the_example_writes() {
             "{path} is stale: cargo run --release -p host-tests --example monitor_log"
         );
     }
+}
+
+/// The device file with a displacement sensor over 0-1.8 mm (the
+/// preset's stroke is 1.5 mm) and a micrometre of noise.
+fn displacement_params_text() -> String {
+    params_text()
+        .replace("sensor = \"p_a\"", "sensor = \"x\"")
+        .replace("range_max = 500000.0    # Pa", "range_max = 0.0018    # m")
+        .replace("noise = 100.0    # Pa", "noise = 1e-6    # m")
+}
+
+/// `--format json` wrote a dimensionless value's unit, `1`, as the number
+/// 1, where the CSV's `1` and the other rows' `Pa` or `m` are text: a
+/// reader keying on the unit's string found none. A transducer whose zero
+/// moves by a share of its span at 20 s, then a cooling at 0.1 C/s: the
+/// change is detected (`cusum`, unit `1`) and named once the oil has moved
+/// 3 C (`offset`: `SENSOR_OFFSET` in Pa for a chamber pressure,
+/// `PRELOAD_LOST` in m for the displacement, whose zero moving up is a
+/// lost preload to it).
+#[test]
+fn monitor_s_json_writes_each_unit_as_the_csv_does() {
+    use compensator::monitor::Quantity as Monitored;
+    let dir = temp_dir("json");
+    for (quantity, monitored, column, text, offset) in [
+        (Quantity::PA, Monitored::ChamberA, "p_a_pa", params_text(), 0.01),
+        (
+            Quantity::X,
+            Monitored::Displacement,
+            "x_m",
+            displacement_params_text(),
+            0.02,
+        ),
+    ] {
+        let params = dir.join(format!("{column}.toml"));
+        std::fs::write(&params, &text).unwrap();
+        let raw = compensator_cli::parse(&text).unwrap();
+        let sensor = SecondSensor {
+            noise_sd: raw.monitor.noise,
+            ..SecondSensor::default_for(quantity, &raw.core)
+        };
+        let injection = Injection {
+            fault: Fault::SensorOffset(offset),
+            onset: 20.0,
+        };
+        let profile = Profile::ramp(60.0, 50.0, 0.1, 20.0);
+        let rows: Vec<Row> = Scenario::new(&raw, sensor, injection, profile, 60.0, 11)
+            .records()
+            .unwrap()
+            .map(|s| (s.t, s.probe.filter(|v| v.is_finite()), s.second))
+            .filter(|r| r.1.is_some() || r.2.is_some())
+            .collect();
+        let log = dir.join(format!("{column}.csv"));
+        write_log(&log, column, &rows, 1.0);
+        let args = ["monitor", "--params", path(&params), "--sensor-data", path(&log)];
+        let (code, csv, err) = run_cli(&args);
+        assert_eq!(code, 0, "{column}: {err}");
+        let (code, json, err) = run_cli(&[&args[..], &["--format", "json"]].concat());
+        assert_eq!(code, 0, "{column}: {err}");
+        let objects: Vec<serde_json::Value> = serde_json::from_str(&json).unwrap();
+        let (header, cells) = table(&csv);
+        assert_eq!(objects.len(), cells.len(), "{column}: {json}");
+        let mut units = Vec::new();
+        for (object, row) in objects.iter().zip(&cells) {
+            let flag = &row[col(&header, "flag")];
+            let parameter = &row[col(&header, "parameter")];
+            let unit = object["unit"]
+                .as_str()
+                .unwrap_or_else(|| panic!("{column} {flag}: {object}"));
+            // As the CSV writes it, and the symbol of its health field's
+            // unit for the sensor's quantity.
+            assert_eq!(unit, row[col(&header, "unit")], "{column} {flag}");
+            let field = HEALTH_FIELDS.iter().find(|f| f.name == parameter).unwrap();
+            assert_eq!(unit, field.unit.symbol(monitored), "{column} {flag}");
+            // The numbers stay numbers.
+            assert_eq!(
+                object["first_row"].as_u64().map(|r| r.to_string()).as_ref(),
+                Some(&row[col(&header, "first_row")]),
+                "{column} {flag}"
+            );
+            units.push(unit.to_string());
+        }
+        let reading = if quantity == Quantity::PA { "Pa" } else { "m" };
+        assert!(
+            units.iter().any(|u| u == "1") && units.iter().any(|u| u == reading),
+            "{column}: {json}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

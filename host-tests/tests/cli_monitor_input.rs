@@ -4,7 +4,9 @@
 //! reading, a telemetry CSV given to `monitor`, the two sensors' readings
 //! on rows of their own within one tick, a single reading of the second
 //! sensor. Each either flagged as the firmware flags it or refused in one
-//! line that names the column and says what to do.
+//! line that names the column and says what to do. And a second sensor
+//! that stopped reporting for a while, told with its column and rows,
+//! beside one slower than the probe, whose empty cells are its rate.
 
 use host_tests::run_cli;
 use std::path::{Path, PathBuf};
@@ -242,6 +244,116 @@ fn a_short_open_loop_is_flagged_not_refused() {
     assert_eq!(code, 2, "{err}");
     assert!(
         err.contains("column p_a_pa") && err.contains("of the column's"),
+        "{err}"
+    );
+}
+
+/// The documented log's first 20 s with the second sensor's reading kept
+/// on every `every`-th row only (`every` 1: all of them, every 10 ms; 4:
+/// every 40 ms, on every other probe row) and none from 10.00 s to 13.00
+/// s when `silent`, the rows left with neither reading dropped (a row
+/// holds at least one).
+fn second_every(every: usize, silent: bool) -> Vec<(String, String, String)> {
+    documented(2001)
+        .into_iter()
+        .enumerate()
+        .map(|(i, (t, probe, second))| {
+            let quiet = silent && (1000..1300).contains(&i);
+            let kept = i % every == 0 && !quiet;
+            (t, probe, if kept { second } else { String::new() })
+        })
+        .filter(|r| !r.1.is_empty() || !r.2.is_empty())
+        .collect()
+}
+
+/// The first and last row (0-based) from `from` to `to` \[s\].
+fn rows_within(rows: &[(String, String, String)], from: f64, to: f64) -> (usize, usize) {
+    let t = |r: &(String, String, String)| r.0.parse::<f64>().unwrap();
+    let first = rows.iter().position(|r| t(r) >= from - 1e-9).unwrap();
+    let last = rows.iter().rposition(|r| t(r) <= to + 1e-9).unwrap();
+    (first, last)
+}
+
+/// A chamber transducer that stopped reporting for 3 s in the middle of
+/// the log (its column empty from 10.00 s to 12.99 s while the probe's
+/// goes on) passed without a word: both commands now say how many
+/// readings are missing and name the column and the stretch's rows.
+#[test]
+fn a_second_sensor_that_stopped_reporting_is_named_with_its_rows() {
+    let rows = second_every(1, true);
+    // Readings were due every 10 ms from 10.00 s to 12.99 s.
+    let (first, last) = rows_within(&rows, 10.0, 12.99);
+    // The probe's rows go on every 20 ms in the stretch: 150 of them.
+    assert_eq!(last - first + 1, 150);
+    let log = write("silent.csv", "time_s,t_c,p_a_pa", &rows);
+    let stretch = format!(
+        "column p_a_pa: no reading from row {} (line {}) to row {} (line {}): 3.01 s between the readings either \
+         side, where the second sensor reads one every 10 ms; 300 readings missing",
+        first + 1,
+        first + 2,
+        last + 1,
+        last + 2
+    );
+    for command in ["monitor", "estimate"] {
+        let (code, _, err) = run_cli(&[command, "--params", PARAMS, "--sensor-data", path(&log)]);
+        assert_eq!(code, 0, "{command}: {err}");
+        assert!(
+            err.contains(
+                "1701 readings of the second sensor (p_a_pa), one every 10 ms (the monitor's period), 300 missing"
+            ),
+            "{command}: {err}"
+        );
+        assert!(err.contains(&format!("{command}: {stretch}")), "{command}: {err}");
+    }
+    // Two stretches: the longer is named, both are counted. The readings
+    // of 18.00 s and 18.01 s dropped, the latter's row with them (it has
+    // no probe reading).
+    let mut two = rows.clone();
+    let (j, _) = rows_within(&two, 18.0, 18.0);
+    assert!(!two[j].1.is_empty() && two[j + 1].1.is_empty(), "{:?}", &two[j..j + 2]);
+    two[j].2 = String::new();
+    two.remove(j + 1);
+    let log = write("silent-twice.csv", "time_s,t_c,p_a_pa", &two);
+    let (code, _, err) = run_cli(&["monitor", "--params", PARAMS, "--sensor-data", path(&log)]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains(&stretch) && err.contains("(the longest of 2 stretches, 302 readings missing over the log)"),
+        "{err}"
+    );
+}
+
+/// A second sensor slower than the probe (a reading every 40 ms, on every
+/// other probe row) leaves cells empty at its own rate: none of them is
+/// missing. Stopped for 3 s, it misses the readings due at that rate.
+#[test]
+fn a_slower_second_sensor_s_empty_cells_are_not_missing_readings() {
+    let rows = second_every(4, false);
+    let log = write("slow.csv", "time_s,t_c,p_a_pa", &rows);
+    let (code, _, err) = run_cli(&["monitor", "--params", PARAMS, "--sensor-data", path(&log)]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("501 readings of the second sensor (p_a_pa), one every 40 ms (the monitor's period)"),
+        "{err}"
+    );
+    assert!(!err.contains("missing") && !err.contains("no reading from"), "{err}");
+    let rows = second_every(4, true);
+    // Readings were due every 40 ms from 10.00 s to 12.96 s; the empty
+    // cells at 9.98 s and 12.98 s are the sensor's own rate.
+    let (first, last) = rows_within(&rows, 10.0, 12.96);
+    let log = write("slow-silent.csv", "time_s,t_c,p_a_pa", &rows);
+    let (code, _, err) = run_cli(&["monitor", "--params", PARAMS, "--sensor-data", path(&log)]);
+    assert_eq!(code, 0, "{err}");
+    // 9.96 s to 13.00 s: the 75 readings due every 40 ms, not the
+    // stretch's 151 empty cells.
+    assert!(
+        err.contains(&format!(
+            "monitor: column p_a_pa: no reading from row {} (line {}) to row {} (line {}): 3.04 s between the \
+             readings either side, where the second sensor reads one every 40 ms; 75 readings missing",
+            first + 1,
+            first + 2,
+            last + 1,
+            last + 2
+        )) && err.contains("one every 40 ms (the monitor's period), 75 missing"),
         "{err}"
     );
 }

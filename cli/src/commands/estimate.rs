@@ -56,7 +56,9 @@ estimate:
   flags (names joined by |, the monitor's among them)
 The *_sd_* columns are standard uncertainties (k = 1): +-1.96 of them is
 the 95 % band (docs/firmware.md). stderr: the readings, their interval and
-the ticks run.
+the ticks run; with a second sensor's column, the readings it missed
+(more than 1.5 of its median interval between two of them) and the rows
+of the longest such stretch.
 
 Example:
   compensator estimate --params presets/paper.toml \\

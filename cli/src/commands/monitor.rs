@@ -29,8 +29,12 @@ INNOVATION_REJECTED), in that order; none: a header alone:
   sd (its standard deviation: of the logarithm for divider and spring),
   z [-] (how many sd the estimate lies from the file's device: ln(f)/sd
   for a factor, offset/sd), cusum_max [-] (the largest CUSUM up to the
-  flag; DEVICE_CHANGED above 10), unit (of estimate and sd)
-stderr: what ran, and the health estimate at the log's end.
+  flag; DEVICE_CHANGED above 10), unit (of estimate and sd: 1, Pa, m,
+  N or K; a string in JSON as in CSV)
+stderr: what ran, the second sensor's readings missing (more than 1.5 of
+its median interval between two of them: the rows, line numbers and
+length of the longest such stretch), and the health estimate at the
+log's end.
 --plot FILE.png|svg: the standardised innovations with the gate, the CUSUM
 with its threshold, the divider and spring factors and the offset, each
 with its 95 % band, over time.
