@@ -779,7 +779,10 @@ pub struct Run {
 /// The second sensor's readings missing from a log: between two of its
 /// consecutive readings more than one and a half of its period apart (the
 /// monitor's: the median interval of the column's readings), the readings
-/// due in between, `round(interval / period) - 1`. A sensor slower than
+/// due in between, `round(interval / period) - 1`, where each end's slot
+/// is placed by the readings beside it (up to 8, on average): a reading
+/// stamped early next to one stamped late, each by under half a period,
+/// are no reading missing. A sensor slower than
 /// the probe (a reading every few rows) has its median interval for its
 /// period, so its regularly empty cells are none missing; nor are the rows
 /// before its first reading or after its last.
@@ -804,16 +807,51 @@ impl SecondGaps {
     /// without one.
     pub fn of(rows: &[usize], ticks: &[u64], period: u64) -> Option<SecondGaps> {
         let period = period.max(1);
+        let t = |r: usize| ticks[rows[r]] as f64;
+        // Each reading's slot, counted from the first: one an interval
+        // under two periods (two readings stamped up to half a period off
+        // their slots), round(interval / period) from there.
+        let mut slots = Vec::with_capacity(rows.len());
+        let mut slot = 0u64;
+        for (r, w) in std::iter::once(&[0, 0][..]).chain(rows.windows(2)).enumerate() {
+            if r > 0 {
+                let interval = ticks[w[1]] - ticks[w[0]];
+                slot += if interval < 2 * period {
+                    1
+                } else {
+                    (2 * interval + period) / (2 * period)
+                };
+            }
+            slots.push(slot);
+        }
+        let p = period as f64;
+        // Where reading `at`'s slot lies, as the readings `from` place it
+        // on average: the two readings either side of a long interval may
+        // be stamped late and early by up to half a period each, so their
+        // interval alone can hold one slot too many.
+        let nominal = |from: std::ops::Range<usize>, at: usize| {
+            let n = from.len() as f64;
+            from.map(|j| t(j) + (slots[at] as f64 - slots[j] as f64) * p)
+                .sum::<f64>()
+                / n
+        };
+        const AROUND: usize = 8;
         let mut found: Option<SecondGaps> = None;
         let mut longest_ticks = 0;
-        for w in rows.windows(2) {
-            let (a, b) = (w[0], w[1]);
+        for r in 1..rows.len() {
+            let (a, b) = (rows[r - 1], rows[r]);
             let interval = ticks[b] - ticks[a];
             if 2 * interval <= 3 * period {
                 continue;
             }
-            // round(interval / period) - 1, at least 1 past 1.5 periods.
-            let missing = (2 * interval + period) / (2 * period) - 1;
+            // round(interval / period) - 1 between the slots either side.
+            let before = nominal(r.saturating_sub(AROUND)..r, r - 1);
+            let after = nominal(r..(r + AROUND).min(rows.len()), r);
+            let between = ((after - before) / p).round();
+            if between < 2.0 {
+                continue;
+            }
+            let missing = between as u64 - 1;
             let g = found.get_or_insert(SecondGaps {
                 missing: 0,
                 gaps: 0,
@@ -1334,6 +1372,27 @@ mod tests {
         assert_eq!(SecondGaps::of(&[0, 1, 2], &[0, 16, 26], 10).map(|g| g.missing), Some(1));
         let g = SecondGaps::of(&[0, 1, 2, 3], &[0, 20, 60, 70], 10).unwrap();
         assert_eq!((g.missing, g.gaps, g.longest, g.longest_missing), (4, 2, (1, 2), 3));
+    }
+
+    #[test]
+    fn second_gaps_are_not_made_of_a_timestamp_s_jitter() {
+        // A reading every 10 ticks, each stamped up to 3 ticks early or
+        // late (under half a period): none is missing, though a reading 3
+        // early followed by one 3 late are 16 ticks apart.
+        let jitter = [0i64, 3, -3, 3, -2, 1, -3, 3, 0, -1, 2, -3, 3, -3, 1, 0, 2, -2, 0, 1];
+        let ticks: Vec<u64> = (0..200)
+            .map(|i: i64| (100 + 10 * i + jitter[i as usize % 20]) as u64)
+            .collect();
+        let rows: Vec<usize> = (0..200).collect();
+        assert_eq!(SecondGaps::of(&rows, &ticks, 10), None);
+        // The same readings with 30 of them dropped: 30 missing, one
+        // stretch.
+        let dropped: Vec<usize> = rows.iter().copied().filter(|i| !(90..120).contains(i)).collect();
+        let g = SecondGaps::of(&dropped, &ticks, 10).unwrap();
+        assert_eq!(
+            (g.missing, g.gaps, g.longest, g.longest_missing),
+            (30, 1, (89, 120), 30)
+        );
     }
 
     #[test]

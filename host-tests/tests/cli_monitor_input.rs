@@ -357,3 +357,62 @@ fn a_slower_second_sensor_s_empty_cells_are_not_missing_readings() {
         "{err}"
     );
 }
+
+/// The documented log's first 20 s with each of the transducer's readings
+/// on a row of its own, stamped up to 3 ms early or late (a logger that
+/// timestamps as it gets round to it: under half the sensor's 10 ms
+/// period), none from 10.00 s to 12.99 s when `silent`.
+fn second_jittered(silent: bool) -> Vec<(String, String, String)> {
+    const JITTER_MS: [i64; 10] = [0, 0, -3, 3, 0, 0, 3, -3, 0, 0];
+    let mut rows: Vec<(i64, String, String)> = Vec::new();
+    for (i, (t, probe, second)) in documented(2001).into_iter().enumerate() {
+        let ms = (t.parse::<f64>().unwrap() * 1000.0).round() as i64;
+        if !probe.is_empty() {
+            rows.push((ms, probe, String::new()));
+        }
+        if second.is_empty() || (silent && (1000..1300).contains(&i)) {
+            continue;
+        }
+        let at = ms + JITTER_MS[i % 10];
+        match rows.iter_mut().find(|r| r.0 == at) {
+            Some(r) => r.2 = second,
+            None => rows.push((at, String::new(), second)),
+        }
+    }
+    rows.sort_by_key(|r| r.0);
+    rows.into_iter()
+        .map(|(ms, probe, second)| (format!("{:.3}", ms as f64 / 1000.0), probe, second))
+        .collect()
+}
+
+/// A transducer whose readings are all there but stamped a few ms off its
+/// 10 ms slots was said to miss dozens: a reading 3 ms early then one 3
+/// ms late are 16 ms apart, past 1.5 periods, though neither is missing
+/// (the next interval is that much shorter). The count now places the
+/// slots either side of a long interval by the readings around them.
+#[test]
+fn a_second_sensor_s_jittered_timestamps_are_no_missing_readings() {
+    let log = write("jittered.csv", "time_s,t_c,p_a_pa", &second_jittered(false));
+    for command in ["monitor", "estimate"] {
+        let (code, _, err) = run_cli(&[command, "--params", PARAMS, "--sensor-data", path(&log)]);
+        assert_eq!(code, 0, "{command}: {err}");
+        assert!(
+            err.contains("2001 readings of the second sensor (p_a_pa), one every 10 ms (the monitor's period)"),
+            "{command}: {err}"
+        );
+        assert!(
+            !err.contains("missing") && !err.contains("no reading"),
+            "{command}: {err}"
+        );
+    }
+    // Silent for 3 s as well: the 300 readings due then, one stretch.
+    let log = write("jittered-silent.csv", "time_s,t_c,p_a_pa", &second_jittered(true));
+    let (code, _, err) = run_cli(&["monitor", "--params", PARAMS, "--sensor-data", path(&log)]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains(
+            "1701 readings of the second sensor (p_a_pa), one every 10 ms (the monitor's period), 300 missing"
+        ) && err.contains("; 300 readings missing, the monitor ran without them\n"),
+        "{err}"
+    );
+}
