@@ -880,23 +880,34 @@ impl SecondGaps {
         let (a, b) = self.longest;
         let row = |i: usize| format!("row {} (line {})", i + 1, log.lines[i]);
         let rows = match self.due {
+            Some((first, last)) if first == last => format!("no reading on {}", row(first)),
             Some((first, last)) => format!("no reading from {} to {}", row(first), row(last)),
             None => format!("no reading between {} and {}", row(a), row(b)),
         };
         let mut note = format!(
             "column {column}: {rows}: {} s between the readings either side, where the second sensor reads one \
-             every {}; {} readings missing, the monitor ran without them",
+             every {}; {} missing, the monitor ran without them",
             sig(log.time_s[b] - log.time_s[a], 6),
             seconds(period),
-            self.longest_missing
+            readings(self.longest_missing)
         );
         if self.gaps > 1 {
             note.push_str(&format!(
-                " (the longest of {} stretches, {} readings missing over the log)",
-                self.gaps, self.missing
+                " (the longest of {} stretches, {} missing over the log)",
+                self.gaps,
+                readings(self.missing)
             ));
         }
         note
+    }
+}
+
+/// `1 reading`, `n readings`.
+fn readings(n: u64) -> String {
+    if n == 1 {
+        "1 reading".to_string()
+    } else {
+        format!("{n} readings")
     }
 }
 
