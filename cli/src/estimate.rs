@@ -811,18 +811,15 @@ impl SecondGaps {
         // Each reading's slot, counted from the first: one an interval
         // under two periods (two readings stamped up to half a period off
         // their slots), round(interval / period) from there.
-        let mut slots = Vec::with_capacity(rows.len());
-        let mut slot = 0u64;
-        for (r, w) in std::iter::once(&[0, 0][..]).chain(rows.windows(2)).enumerate() {
-            if r > 0 {
-                let interval = ticks[w[1]] - ticks[w[0]];
-                slot += if interval < 2 * period {
+        let mut slots = vec![0u64; rows.len()];
+        for r in 1..rows.len() {
+            let interval = ticks[rows[r]] - ticks[rows[r - 1]];
+            slots[r] = slots[r - 1]
+                + if interval < 2 * period {
                     1
                 } else {
                     (2 * interval + period) / (2 * period)
                 };
-            }
-            slots.push(slot);
         }
         let p = period as f64;
         // Where reading `at`'s slot lies, as the readings `from` place it
