@@ -139,3 +139,51 @@ fn a_plunger_held_near_its_stop_in_a_slow_cooling_is_named_sticking() {
         "named {named:.1} s after the onset, held at {held:.1} s"
     );
 }
+
+/// A plunger held by a friction of 0.1 of the mid-stroke spring force
+/// (`monitor_campaign -- 10 1 1.5 x`), in a ramp on designs 2, 5 and 9:
+/// the displacement reading stands still while the twin's plunger and the
+/// probe move. Through the probe's lag alone the held plunger was named a
+/// clogged orifice 618 s after the onset (design 2), sticking 20 s after
+/// being held back by half its band (design 5) and a relaxed spring 307 s
+/// after (design 9): the filter learned its first readings as an offset
+/// before the CUSUM ran. The stillness test reads the displacement itself
+/// and names each sticking within 10 s of being held.
+#[test]
+fn a_plunger_held_in_a_ramp_is_named_sticking_within_10_s_of_being_held() {
+    use compensator::estimator::Flags;
+    for n in [2, 5, 9] {
+        let out = run(&campaign_run(n, Quantity::X, Fault::Sticking(0.1))).unwrap();
+        assert_eq!(
+            out.false_alarms, 0,
+            "design {n}: false alarm at {:?} s",
+            out.false_alarm
+        );
+        let held = out.held.expect("the plunger is held back by half its band");
+        let (named, flags) = out.named.unwrap_or_else(|| panic!("design {n}: nothing named"));
+        assert_eq!(
+            flags,
+            Flags::PLUNGER_STICKING,
+            "design {n}: named {flags:?} {named:.1} s after the onset"
+        );
+        assert!(
+            named <= held + 10.0,
+            "design {n}: named {named:.1} s after the onset, held at {held:.1} s"
+        );
+    }
+}
+
+/// Design 3's history ends a 0.9 C/s warming at 74.5 C, 679 s in: the
+/// plunger stops with the oil, while the observer's oil overshoots by 0.9
+/// K and the probe, 6 K behind, catches up. Either alone moves the free
+/// plunger past the still reading by a fifth of the design band; a
+/// stillness test on the twin's travel alone named sticking there on the
+/// healthy device. The probe's travel counts only past what it still had
+/// to catch up at the reading's last move: nothing is raised.
+#[test]
+fn a_ramp_s_end_is_no_held_plunger() {
+    let s = healthy(3, Quantity::X, 0.25);
+    let out = run(&s).unwrap();
+    assert_eq!(out.false_alarms, 0, "first alarm at {:?} s", out.false_alarm);
+    assert!(out.healthy_time >= 800.0, "{} s", out.healthy_time);
+}

@@ -269,6 +269,19 @@ pub const REST_FORGOTTEN: f32 = 0.01;
 /// band's half width of the fitted signature.
 pub const STICKING_DESIGN: f32 = 0.05;
 
+/// The stillness test's bound on a still reading's move, in standard
+/// deviations of the difference of two readings (`sqrt 2` of the
+/// sensor's noise): a held plunger's reading stays within it but once in
+/// 1.7 million readings ([`Monitor::begin`]'s stillness test).
+pub const STILL_READING: f32 = 5.0;
+
+/// The free plunger's travel past a still reading that names sticking,
+/// in half widths of the design's play band ([`STICKING_DESIGN`]): a
+/// friction of the design's is named once the plunger lags half its band
+/// (the goal's, twice the design's, a quarter of its band). A healthy
+/// reading follows the twin's travel within its slope's as-built spread.
+pub const STILL_TRAVEL: f32 = 0.5;
+
 /// The largest friction the sticking test fits, in [`STICKING_DESIGN`]'s
 /// play bands: the fitted width that `Monitor::confirm` enters, and the
 /// bound of the test's amplitude (a held plunger's innovation is the
@@ -551,6 +564,15 @@ pub struct Monitor {
     free_change: f32,
     /// The oil rested at the last reading (see `last_free`).
     resting: bool,
+    /// The stillness test's anchor: the reading \[m\] and the twin's
+    /// plunger \[m\] when the reading last moved (NaN: none).
+    still_reading: f32,
+    still_twin: f32,
+    /// The probe's reading at the anchor \[C\], and its last \[C\].
+    still_probe: f32,
+    probe_now: f32,
+    /// The observer's oil less the probe at the anchor \[K\].
+    still_gap: f32,
     /// The design band's half width in oil temperature at the last
     /// informed reading \[K\] (`design_width / |dy/dT|`).
     width_oil: f32,
@@ -734,6 +756,11 @@ impl Monitor {
             last_free: f32::NAN,
             free_change: 0.0,
             resting: false,
+            still_reading: f32::NAN,
+            still_twin: f32::NAN,
+            still_probe: f32::NAN,
+            probe_now: f32::NAN,
+            still_gap: 0.0,
             width_oil: 0.0,
             last_probe: f32::NAN,
             last_held: f32::NAN,
@@ -819,6 +846,67 @@ impl Monitor {
             Quantity::Difference => view.p_b - view.p_a,
             Quantity::Displacement => view.x,
         }
+    }
+
+    /// The stillness test (a displacement sensor's, until a friction is
+    /// named): a plunger held by friction reads still while the free
+    /// plunger travels. Its anchor is where reading `y` \[m\] last moved
+    /// (by more than [`STILL_READING`] standard deviations of the
+    /// difference of two readings) or stood at a stop: the reading there,
+    /// the twin's plunger (`twin` \[m\]) and the probe's reading. The free
+    /// plunger's travel since is the smaller of two that agree in sign:
+    /// the twin's, whose oil is the observer's (`oil` \[C\]), which
+    /// overshoots a ramp's end by up to a kelvin (on design 3 of the
+    /// campaign, at the end of a 0.9 C/s warming, it moved the twin 2.2e-5
+    /// m, a fifth of its design band, past a reading that had stopped with
+    /// the oil); and the probe's, through `dy_dt` \[m/K\], less what the
+    /// probe still had to catch up with the observer's oil at the anchor
+    /// (after a ramp's end the probe goes on by the ramp's rate times its
+    /// time constant). Once that travel reaches [`STILL_TRAVEL`] of the
+    /// design band's half width, the plunger is held by at least that
+    /// friction: sticking is named and its band, as wide as the travel,
+    /// enters the prediction. `offset` \[m\]: the filter's, for the stops
+    /// ([`Monitor::at_stop`]). Returns whether it named sticking.
+    ///
+    /// The probe-lag sticking test of the isolation sees a held plunger
+    /// only through the probe's lag and once the CUSUM runs, while the
+    /// filter learns its first readings as an offset; this one reads the
+    /// displacement itself (`docs/monitoring.md`, "The stillness test").
+    fn held_still(&mut self, y: f32, twin: f32, offset: f32, dy_dt: f32, oil: f32) -> bool {
+        if self.design.quantity != Quantity::Displacement || self.friction_width > 0.0 || !twin.is_finite() {
+            return false;
+        }
+        let moved = STILL_READING * 1.414_213_6 * self.settings.sd_noise;
+        if !self.still_reading.is_finite()
+            || !self.still_probe.is_finite()
+            || libm::fabsf(y - self.still_reading) > moved
+            || self.at_stop(y, offset)
+        {
+            self.still_reading = y;
+            self.still_twin = twin;
+            self.still_probe = self.probe_now;
+            self.still_gap = libm::fabsf(oil - self.probe_now);
+            return false;
+        }
+        // The free plunger's travel since: the twin's (its oil the
+        // observer's, which overshoots a ramp's end by up to a kelvin) and
+        // the probe's (which trails the oil), the smaller when they agree.
+        let by_twin = twin - self.still_twin;
+        let dp = self.probe_now - self.still_probe;
+        let by_probe = dy_dt * libm::copysignf(libm::fmaxf(libm::fabsf(dp) - self.still_gap, 0.0), dp);
+        let travel = if by_twin * by_probe > 0.0 {
+            libm::fminf(libm::fabsf(by_twin), libm::fabsf(by_probe))
+        } else {
+            0.0
+        };
+        if !(travel >= STILL_TRAVEL * self.design_width) || travel < 4.0 * moved {
+            return false;
+        }
+        self.friction_width = travel;
+        self.held = f32::NAN;
+        self.still_reading = f32::NAN;
+        self.restart_tests();
+        true
     }
 
     /// A displacement reading `y` within three standard deviations (its
@@ -971,6 +1059,14 @@ impl Monitor {
                 None
             }
         };
+        if let Some(p) = view.probe {
+            self.probe_now = p.value;
+        }
+        if let Some(y) = reading {
+            if self.held_still(y, twin, theta[OFFSET], dy_dt, view.oil.state.temperature) {
+                flags.insert(Hypothesis::Sticking.flag(self.design.quantity));
+            }
+        }
         // The second sensor's temperature and the signals the lag carries.
         // The twin's transient (its distance from its own equilibrium) is
         // the device's only as far as the twin's dynamics are the device's:
@@ -1530,6 +1626,13 @@ impl Monitor {
         self.reference[PROBE] = 0.0;
         self.reference[MODEL] = 0.0;
         self.settling = SETTLE_READINGS;
+        self.restart_tests();
+    }
+
+    /// The tests start afresh once a fault is named: no change detected,
+    /// the CUSUM, the isolation's sums and the sticking test's evidence
+    /// at zero.
+    fn restart_tests(&mut self) {
         self.detected = false;
         self.cusum = [0.0; 2];
         self.fit_b = [0.0; HYPOTHESES];
