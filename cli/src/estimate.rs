@@ -3,8 +3,10 @@
 //! The estimator is the firmware's own ([`compensator::estimator::Estimator`],
 //! `f32`), ticking at the file's `estimator.tick_hz`, its oil-temperature
 //! observer designed by [`EstimatorConfig::with_sample_period`] for the
-//! log's reading interval (the median of its intervals, in whole ticks:
-//! 20 ms for a MAX31865 at 50 Hz, 0.5 s for a telemetry log at 2 Hz). It
+//! log's reading interval (the lower median of its intervals, in whole
+//! ticks: 20 ms for a MAX31865 at 50 Hz, 0.5 s for a telemetry log at 2
+//! Hz; of two intervals the shorter, as a reading missing only ever
+//! lengthens one). It
 //! starts at rest at the first reading, and each row is delivered as a
 //! reading on the tick its time falls in (tick `k` covers `t0 + k / tick_hz
 //! ..` one tick on, `t0` the first row's time); ticks between rows get no
@@ -29,8 +31,13 @@
 //! `monitor.sensor`) feeds the estimator's condition monitor
 //! (`Estimator::offer_second`, on the row's tick, before the probe's
 //! reading of the same row), with the monitor's settings from the file
-//! (`MonitorSettings::from_raw`) but its period, the median interval of
-//! the column's readings. The output then gains the health estimate's
+//! (`MonitorSettings::from_raw`) but its period, the lower median interval
+//! of the column's readings. A handful of readings measure no period (the
+//! median of two intervals may be a gap's): with fewer than
+//! [`MIN_INTERVALS`] intervals the monitor takes the device file's
+//! (`monitor.sample_hz`), no reading is counted missing, and standard
+//! error says so, with the intervals the log has. The output then gains
+//! the health estimate's
 //! values ([`compensator::estimator::health::HEALTH_FIELDS`]) before
 //! `flags`, which names the monitor's flags too. With a second column
 //! either reading may be empty (or `NaN`) on a row, not both; the first
@@ -774,11 +781,14 @@ pub struct Run {
     /// Where the second sensor stopped reporting between its first and
     /// last reading ([`SecondGaps::of`]), if it did.
     pub second_gaps: Option<SecondGaps>,
+    /// The shortest and longest interval of the second sensor's readings
+    /// \[s\], when they are too few to measure a period and have one.
+    pub second_intervals: Option<(f64, f64)>,
 }
 
 /// The second sensor's readings missing from a log: between two of its
 /// consecutive readings more than one and a half of its period apart (the
-/// monitor's: the median interval of the column's readings), the readings
+/// monitor's: the lower median interval of the column's readings), the readings
 /// due in between, `round(interval / period) - 1`, where each end's slot
 /// is placed by the readings beside it (up to 8, on average): a reading
 /// stamped early next to one stamped late, each by under half a period,
@@ -899,6 +909,21 @@ impl SecondGaps {
     }
 }
 
+/// Fewest intervals the second sensor's period is measured from (with
+/// fewer, the device file's `monitor.sample_hz`).
+pub const MIN_INTERVALS: usize = 8;
+
+/// The lower median of `v` (reordered; `None` when empty), in O(n): of an
+/// even count the shorter of the two middle values, as a reading missing
+/// only ever lengthens an interval.
+pub fn lower_median(v: &mut [u64]) -> Option<u64> {
+    if v.is_empty() {
+        return None;
+    }
+    let middle = (v.len() - 1) / 2;
+    Some(*v.select_nth_unstable(middle).1)
+}
+
 /// `1 reading`, `n readings`.
 fn readings(n: u64) -> String {
     if n == 1 {
@@ -923,17 +948,24 @@ impl Run {
             self.ticks,
             seconds(self.tick),
         );
-        let mut gap = None;
+        let mut lines = Vec::new();
         if let (Some(m), Some(second)) = (&self.monitor, &log.second) {
+            let name = second.column.name;
+            let period = f64::from(m.sample_period);
             note.push_str(&format!(
-                "; {} readings of the second sensor ({}), one every {} (the monitor's period)",
+                "; {} readings of the second sensor ({name}), one every {}",
                 self.second_readings,
-                second.column.name,
-                seconds(f64::from(m.sample_period))
+                seconds(period)
             ));
+            if self.second_readings <= MIN_INTERVALS {
+                note.push_str(" (the monitor's period, the device file's: too few readings to measure one)");
+                lines.push(self.few_second_readings(name, period));
+            } else {
+                note.push_str(" (the monitor's period)");
+            }
             if let Some(g) = &self.second_gaps {
                 note.push_str(&format!(", {} missing", g.missing));
-                gap = Some(g.note(log, second.column.name, f64::from(m.sample_period)));
+                lines.push(g.note(log, name, period));
             }
         }
         if let Some((rows, every_sample)) = rows {
@@ -947,13 +979,34 @@ impl Run {
                 ));
             }
         }
-        if let Some(gap) = gap {
-            note.push_str(&format!("\n{command}: {gap}"));
+        for line in lines {
+            note.push_str(&format!("\n{command}: {line}"));
         }
         if let Some(extra) = &log.note {
             note.push_str(&format!("\n{command}: {extra}"));
         }
         note
+    }
+
+    /// The line for standard error on a second sensor whose readings are
+    /// too few to measure its period (the monitor ran at `period` \[s\],
+    /// the device file's).
+    fn few_second_readings(&self, column: &str, period: f64) -> String {
+        let n = self.second_readings;
+        let intervals = match self.second_intervals {
+            Some((lo, _)) if n == 2 => format!("1 interval, {}", seconds(lo)),
+            Some((lo, hi)) if lo == hi => format!("{} intervals, each {}", n - 1, seconds(lo)),
+            Some((lo, hi)) => format!("{} intervals, {} to {}", n - 1, seconds(lo), seconds(hi)),
+            None => "no interval".to_string(),
+        };
+        format!(
+            "column {column}: {}, {intervals}: fewer than the {MIN_INTERVALS} intervals the second sensor's period \
+             is measured from; the monitor's period is the device file's, {} (monitor.sample_hz = {} Hz), and no \
+             reading is counted missing",
+            readings(n as u64),
+            seconds(period),
+            sig(1.0 / period, 6)
+        )
     }
 }
 
@@ -981,11 +1034,11 @@ pub fn replay(raw: &RawParams, log: &Log, mut each: impl FnMut(Tick<'_>)) -> Res
     let tick = 1.0 / hz;
     let t0 = log.time_s[0];
     let ticks = ticks_of(log, hz)?;
-    // A reading interval: the median of the intervals, in whole ticks.
+    // A reading interval: the lower median of the intervals, in whole
+    // ticks (of two, the shorter: a missing reading lengthens one).
     let median = |rows: &[usize]| {
-        let mut gaps: Vec<u64> = rows.windows(2).map(|w| ticks[w[1]] - ticks[w[0]]).collect();
-        gaps.sort_unstable();
-        gaps.get(gaps.len() / 2).map_or(1, |&g| g)
+        let mut intervals: Vec<u64> = rows.windows(2).map(|w| ticks[w[1]] - ticks[w[0]]).collect();
+        lower_median(&mut intervals).unwrap_or(1)
     };
     let sample_period = median(&probe) as f64 * tick;
     let config = EstimatorConfig::with_sample_period(raw, sample_period)
@@ -1011,13 +1064,20 @@ pub fn replay(raw: &RawParams, log: &Log, mut each: impl FnMut(Tick<'_>)) -> Res
     let mut monitor = None;
     let mut second_readings = 0;
     let mut second_gaps = None;
+    let mut second_intervals = None;
     // The transducer driver's checks on each reading ([`DriverChecks`]).
     let mut checks = None;
     if let (Some(second), Some(sensor)) = (&log.second, SecondSensor::of(raw)?) {
         let rows: Vec<usize> = (0..n).filter(|&i| !second.value[i].is_nan()).collect();
         second_readings = rows.len();
-        // Fewer than two readings have no interval: the file's own period.
-        let m = if rows.len() < 2 {
+        // Too few readings to measure a period: the file's own.
+        let m = if rows.len() <= MIN_INTERVALS {
+            second_intervals = rows
+                .windows(2)
+                .map(|w| log.time_s[w[1]] - log.time_s[w[0]])
+                .fold(None, |r: Option<(f64, f64)>, d| {
+                    Some(r.map_or((d, d), |(lo, hi)| (lo.min(d), hi.max(d))))
+                });
             sensor.monitor(f64::from(sensor.settings.period))
         } else {
             let period = median(&rows);
@@ -1064,6 +1124,7 @@ pub fn replay(raw: &RawParams, log: &Log, mut each: impl FnMut(Tick<'_>)) -> Res
         monitor,
         second_readings,
         second_gaps,
+        second_intervals,
     })
 }
 
@@ -1401,6 +1462,17 @@ mod tests {
             (g.missing, g.gaps, g.longest, g.longest_missing),
             (30, 1, (89, 120), 30)
         );
+    }
+
+    #[test]
+    fn a_reading_interval_is_the_lower_median() {
+        assert_eq!(lower_median(&mut []), None);
+        assert_eq!(lower_median(&mut [30]), Some(30));
+        // Of two intervals the shorter: the longer may hold a gap.
+        assert_eq!(lower_median(&mut [20, 980]), Some(20));
+        assert_eq!(lower_median(&mut [980, 20]), Some(20));
+        assert_eq!(lower_median(&mut [50, 10, 10]), Some(10));
+        assert_eq!(lower_median(&mut [40, 10, 30, 20]), Some(20));
     }
 
     #[test]

@@ -416,3 +416,61 @@ fn a_second_sensor_s_jittered_timestamps_are_no_missing_readings() {
         "{err}"
     );
 }
+
+/// The documented log's first three probe rows at 0, 20 and 100 ms (the
+/// interval 20 ms, then 80 ms), the transducer read on each.
+fn three_readings() -> Vec<(String, String, String)> {
+    let rows = documented(2001);
+    [0usize, 2, 10].iter().map(|&i| rows[i].clone()).collect()
+}
+
+/// Three readings have two intervals, and the "median" of two was the
+/// longer: a probe read at 0, 20 and 100 ms was taken as one every 80 ms,
+/// and the transducer's period (the monitor's) as 80 ms where the file
+/// says 10 ms. The probe's interval is now the shorter of the two middle
+/// ones (a reading missing only lengthens one); a second sensor with
+/// fewer than 8 intervals measures no period: the monitor takes the
+/// device file's, and says so.
+#[test]
+fn a_handful_of_readings_measure_no_period() {
+    let log = write("three.csv", "time_s,t_c,p_a_pa", &three_readings());
+    for command in ["monitor", "estimate"] {
+        let mut args = vec![command, "--params", PARAMS, "--sensor-data", path(&log)];
+        if command == "estimate" {
+            args.push("--every-sample");
+        }
+        let (code, _, err) = run_cli(&args);
+        assert_eq!(code, 0, "{command}: {err}");
+        assert!(
+            err.contains(&format!(
+                "{command}: 3 readings (t_c) over 0.1 s, one every 20 ms (the median interval"
+            )),
+            "{command}: {err}"
+        );
+        assert!(
+            err.contains(
+                "3 readings of the second sensor (p_a_pa), one every 10 ms (the monitor's period, the device file's: \
+                 too few readings to measure one)"
+            ),
+            "{command}: {err}"
+        );
+        assert!(
+            err.contains(&format!(
+                "{command}: column p_a_pa: 3 readings, 2 intervals, 20 ms to 80 ms: fewer than the 8 intervals the \
+                 second sensor's period is measured from; the monitor's period is the device file's, 10 ms \
+                 (monitor.sample_hz = 100 Hz), and no reading is counted missing"
+            )),
+            "{command}: {err}"
+        );
+    }
+    // Nine readings, eight intervals, one every 40 ms: measured.
+    let rows: Vec<_> = second_every(4, false).into_iter().take(17).collect();
+    assert_eq!(rows.iter().filter(|r| !r.2.is_empty()).count(), 9);
+    let log = write("nine.csv", "time_s,t_c,p_a_pa", &rows);
+    let (code, _, err) = run_cli(&["monitor", "--params", PARAMS, "--sensor-data", path(&log)]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("9 readings of the second sensor (p_a_pa), one every 40 ms (the monitor's period)\n"),
+        "{err}"
+    );
+}
