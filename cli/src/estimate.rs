@@ -3,8 +3,10 @@
 //! The estimator is the firmware's own ([`compensator::estimator::Estimator`],
 //! `f32`), ticking at the file's `estimator.tick_hz`, its oil-temperature
 //! observer designed by [`EstimatorConfig::with_sample_period`] for the
-//! log's reading interval (the median of its intervals, in whole ticks:
-//! 20 ms for a MAX31865 at 50 Hz, 0.5 s for a telemetry log at 2 Hz). It
+//! log's reading interval (the lower median of its intervals, in whole
+//! ticks: 20 ms for a MAX31865 at 50 Hz, 0.5 s for a telemetry log at 2
+//! Hz; of two intervals the shorter, as a reading missing only ever
+//! lengthens one). It
 //! starts at rest at the first reading, and each row is delivered as a
 //! reading on the tick its time falls in (tick `k` covers `t0 + k / tick_hz
 //! ..` one tick on, `t0` the first row's time); ticks between rows get no
@@ -29,8 +31,24 @@
 //! `monitor.sensor`) feeds the estimator's condition monitor
 //! (`Estimator::offer_second`, on the row's tick, before the probe's
 //! reading of the same row), with the monitor's settings from the file
-//! (`MonitorSettings::from_raw`) but its period, the median interval of
-//! the column's readings. The output then gains the health estimate's
+//! (`MonitorSettings::from_raw`) but its period, measured from the
+//! column's readings: the lower median of the intervals of its stretch
+//! with the most readings ([`stretches`]; one stretch, the whole column,
+//! for a sensor that kept its rate). A handful of readings measure no
+//! period (the median of two intervals may be a gap's): with fewer than
+//! [`MIN_INTERVALS`] intervals the monitor takes the device file's
+//! (`monitor.sample_hz`), no reading is counted missing, and standard
+//! error says so, with the intervals the log has. A sensor whose rate
+//! changed for good (10 Hz, then 1 Hz) is not one whose readings went
+//! missing: where the local interval (the lower median of the
+//! [`MIN_INTERVALS`] + 1 around each) moves by more than half as much
+//! again and stays moved over at least [`MIN_INTERVALS`] intervals, a new
+//! stretch begins, and standard error names the row (its line and time)
+//! where the interval changed, from what to what, and the stretch the
+//! monitor's period is of; a long interval or a few in a row stay a gap.
+//! The monitor steps by each reading's own interval whatever its period
+//! (the period is its first step's). The output then gains the health
+//! estimate's
 //! values ([`compensator::estimator::health::HEALTH_FIELDS`]) before
 //! `flags`, which names the monitor's flags too. With a second column
 //! either reading may be empty (or `NaN`) on a row, not both; the first
@@ -38,9 +56,9 @@
 //! the estimator's own `x_m`, `p_a_pa` and `p_b_pa`: they are estimates,
 //! never taken as a second sensor's readings. Where the second sensor
 //! stopped reporting for a while between its first and last reading
-//! ([`SecondGaps`]: more than one and a half of its period between two
-//! readings), standard error says how many readings are missing and
-//! names the rows of the longest such stretch.
+//! ([`SecondGaps`]: more than one and a half of its stretch's period
+//! between two readings), standard error says how many readings are
+//! missing and names the rows of the longest such stretch.
 //!
 //! Bad input, each naming the row, its line and the column: no reading
 //! column or two of them, times that do not increase, two readings within
@@ -755,7 +773,7 @@ pub struct Tick<'a> {
 }
 
 /// What a replay ran ([`replay`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Run {
     /// The probe's reading interval the observer was designed for \[s\].
     pub sample_period: f64,
@@ -772,13 +790,21 @@ pub struct Run {
     /// The second sensor's readings (rows with one).
     pub second_readings: usize,
     /// Where the second sensor stopped reporting between its first and
-    /// last reading ([`SecondGaps::of`]), if it did.
+    /// last reading ([`SecondGaps::over`]), if it did.
     pub second_gaps: Option<SecondGaps>,
+    /// The second sensor's stretches at one interval each
+    /// ([`stretches`]): one for a sensor that kept its rate; none when its
+    /// readings are too few to measure a period (the monitor then takes
+    /// the device file's).
+    pub second_stretches: Vec<Stretch>,
+    /// The shortest and longest interval of the second sensor's readings
+    /// \[s\], when they are too few to measure a period and have one.
+    pub second_intervals: Option<(f64, f64)>,
 }
 
 /// The second sensor's readings missing from a log: between two of its
-/// consecutive readings more than one and a half of its period apart (the
-/// monitor's: the median interval of the column's readings), the readings
+/// consecutive readings more than one and a half of its period apart (its
+/// stretch's, [`stretches`]: the lower median of its intervals), the readings
 /// due in between, `round(interval / period) - 1`, where each end's slot
 /// is placed by the readings beside it (up to 8, on average): a reading
 /// stamped early next to one stamped late, each by under half a period,
@@ -897,6 +923,146 @@ impl SecondGaps {
         }
         note
     }
+
+    /// The gaps of the readings on rows `rows` over its `stretches`
+    /// ([`stretches`]), each counted at its own stretch's period: those of
+    /// all of them, the longest (in time) named; `None` without one.
+    pub fn over(rows: &[usize], ticks: &[u64], stretches: &[Stretch]) -> Option<SecondGaps> {
+        let mut found: Option<SecondGaps> = None;
+        for s in stretches {
+            let Some(g) = SecondGaps::of(&rows[s.readings.0..=s.readings.1], ticks, s.period) else {
+                continue;
+            };
+            let Some(f) = found.as_mut() else {
+                found = Some(g);
+                continue;
+            };
+            let long = |(a, b): (usize, usize)| ticks[b] - ticks[a];
+            if long(g.longest) > long(f.longest) {
+                (f.longest, f.due, f.longest_missing) = (g.longest, g.due, g.longest_missing);
+            }
+            f.missing += g.missing;
+            f.gaps += g.gaps;
+        }
+        found
+    }
+}
+
+/// Fewest intervals a reading period is measured from: the log's for the
+/// second sensor (with fewer, the device file's `monitor.sample_hz`), and
+/// a stretch's at another rate (a shorter one is no change of rate).
+pub const MIN_INTERVALS: usize = 8;
+
+/// The lower median of `v` (reordered; `None` when empty), in O(n): of an
+/// even count the shorter of the two middle values, as a reading missing
+/// only ever lengthens an interval.
+pub fn lower_median(v: &mut [u64]) -> Option<u64> {
+    if v.is_empty() {
+        return None;
+    }
+    let middle = (v.len() - 1) / 2;
+    Some(*v.select_nth_unstable(middle).1)
+}
+
+/// A stretch of the second sensor's readings at one interval
+/// ([`stretches`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Stretch {
+    /// Its first and last reading, as indices into the readings' rows
+    /// (a stretch's last reading is the next one's first).
+    pub readings: (usize, usize),
+    /// Their rows (0-based).
+    pub rows: (usize, usize),
+    /// Its period \[ticks\]: the lower median of its intervals.
+    pub period: u64,
+}
+
+impl Stretch {
+    /// Its intervals.
+    pub fn intervals(&self) -> usize {
+        self.readings.1 - self.readings.0
+    }
+}
+
+/// The stretches of the readings on rows `rows` (row `i` on tick
+/// `ticks[i]`) at one interval each, in order, one for a sensor that kept
+/// its rate. Each interval's local one is the lower median of the
+/// [`MIN_INTERVALS`] + 1 around it: a long interval or a few (a gap) leave
+/// it alone, a rate that lasts moves it. A stretch ends where the local
+/// interval leaves its first one's by more than half as much again (the
+/// 1.5 of a gap); one of fewer than [`MIN_INTERVALS`] intervals is no rate
+/// of its own, but part of the stretch before it (the first, of the one
+/// after), and neighbours within 1.5 of each other's period are one. Empty
+/// with fewer than [`MIN_INTERVALS`] intervals: the log measures no
+/// period. O(n) in the readings.
+pub fn stretches(rows: &[usize], ticks: &[u64]) -> Vec<Stretch> {
+    let d: Vec<u64> = rows.windows(2).map(|w| ticks[w[1]] - ticks[w[0]]).collect();
+    let m = d.len();
+    if m < MIN_INTERVALS {
+        return Vec::new();
+    }
+    const HALF: usize = MIN_INTERVALS / 2;
+    let mut window = [0u64; 2 * HALF + 1];
+    let w = window.len().min(m);
+    let local: Vec<u64> = (0..m)
+        .map(|i| {
+            let from = i.saturating_sub(HALF).min(m - w);
+            window[..w].copy_from_slice(&d[from..from + w]);
+            lower_median(&mut window[..w]).unwrap_or(1)
+        })
+        .collect();
+    let same = |a: u64, b: u64| 2 * a.max(b) <= 3 * a.min(b);
+    // Runs of one local interval, over the intervals `start..end`.
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    let mut start = 0;
+    for i in 1..m {
+        if !same(local[i], local[start]) {
+            runs.push((start, i));
+            start = i;
+        }
+    }
+    runs.push((start, m));
+    // A short run joins the one before it; short runs at the start, the
+    // first long one.
+    let mut kept: Vec<(usize, usize)> = Vec::new();
+    let mut lead = None;
+    for (s, e) in runs {
+        if e - s < MIN_INTERVALS {
+            match kept.last_mut() {
+                Some(last) => last.1 = e,
+                None => {
+                    lead.get_or_insert(s);
+                }
+            }
+        } else {
+            kept.push((lead.take().unwrap_or(s), e));
+        }
+    }
+    if kept.is_empty() {
+        // Short runs only: no rate lasted apart from the others.
+        kept.push((0, m));
+    }
+    let period = |(s, e): (usize, usize)| {
+        let mut v = d[s..e].to_vec();
+        lower_median(&mut v).unwrap_or(1).max(1)
+    };
+    // Neighbours at one rate (a short run between them joined the first).
+    let mut joined: Vec<((usize, usize), u64)> = Vec::new();
+    for run in kept {
+        let p = period(run);
+        match joined.last_mut() {
+            Some((last, q)) if same(*q, p) => last.1 = run.1,
+            _ => joined.push((run, p)),
+        }
+    }
+    joined
+        .into_iter()
+        .map(|(run, _)| Stretch {
+            readings: run,
+            rows: (rows[run.0], rows[run.1]),
+            period: period(run),
+        })
+        .collect()
 }
 
 /// `1 reading`, `n readings`.
@@ -923,17 +1089,37 @@ impl Run {
             self.ticks,
             seconds(self.tick),
         );
-        let mut gap = None;
+        let mut lines = Vec::new();
         if let (Some(m), Some(second)) = (&self.monitor, &log.second) {
+            let name = second.column.name;
+            let period = f64::from(m.sample_period);
+            let stretches = &self.second_stretches;
             note.push_str(&format!(
-                "; {} readings of the second sensor ({}), one every {} (the monitor's period)",
+                "; {} readings of the second sensor ({name}), one every {}",
                 self.second_readings,
-                second.column.name,
-                seconds(f64::from(m.sample_period))
+                seconds(period)
             ));
+            if stretches.is_empty() {
+                note.push_str(" (the monitor's period, the device file's: too few readings to measure one)");
+                lines.push(self.few_second_readings(name, period));
+            } else if stretches.len() == 1 {
+                note.push_str(" (the monitor's period)");
+            } else {
+                let changes = stretches.len() - 1;
+                note.push_str(&format!(
+                    " (the monitor's period), {changes} {} of rate",
+                    if changes == 1 { "change" } else { "changes" }
+                ));
+                lines.extend(self.second_rate_changes(log, name, period));
+            }
             if let Some(g) = &self.second_gaps {
                 note.push_str(&format!(", {} missing", g.missing));
-                gap = Some(g.note(log, second.column.name, f64::from(m.sample_period)));
+                // Counted at the period of the stretch it is in.
+                let at = stretches
+                    .iter()
+                    .find(|s| s.rows.0 <= g.longest.0 && g.longest.1 <= s.rows.1)
+                    .map_or(period, |s| s.period as f64 * self.tick);
+                lines.push(g.note(log, name, at));
             }
         }
         if let Some((rows, every_sample)) = rows {
@@ -947,13 +1133,72 @@ impl Run {
                 ));
             }
         }
-        if let Some(gap) = gap {
-            note.push_str(&format!("\n{command}: {gap}"));
+        for line in lines {
+            note.push_str(&format!("\n{command}: {line}"));
         }
         if let Some(extra) = &log.note {
             note.push_str(&format!("\n{command}: {extra}"));
         }
         note
+    }
+
+    /// The line for standard error on a second sensor whose readings are
+    /// too few to measure its period (the monitor ran at `period` \[s\],
+    /// the device file's).
+    fn few_second_readings(&self, column: &str, period: f64) -> String {
+        let n = self.second_readings;
+        let intervals = match self.second_intervals {
+            Some((lo, _)) if n == 2 => format!("1 interval, {}", seconds(lo)),
+            Some((lo, hi)) if lo == hi => format!("{} intervals, each {}", n - 1, seconds(lo)),
+            Some((lo, hi)) => format!("{} intervals, {} to {}", n - 1, seconds(lo), seconds(hi)),
+            None => "no interval".to_string(),
+        };
+        format!(
+            "column {column}: {}, {intervals}: fewer than the {MIN_INTERVALS} intervals the second sensor's period \
+             is measured from; the monitor's period is the device file's, {} (monitor.sample_hz = {} Hz), and no \
+             reading is counted missing",
+            readings(n as u64),
+            seconds(period),
+            sig(1.0 / period, 6)
+        )
+    }
+
+    /// The lines for standard error on a second sensor whose interval
+    /// changed (the monitor ran at `period` \[s\]): each change, and the
+    /// monitor's period.
+    fn second_rate_changes(&self, log: &Log, column: &str, period: f64) -> Vec<String> {
+        let row = |i: usize| format!("row {} (line {}, {} s)", i + 1, log.lines[i], sig(log.time_s[i], 8));
+        let at = |s: &Stretch| seconds(s.period as f64 * self.tick);
+        let mut lines: Vec<String> = self
+            .second_stretches
+            .windows(2)
+            .map(|w| {
+                let (before, after) = (&w[0], &w[1]);
+                format!(
+                    "column {column}: the second sensor's interval changed from {} to {} at {}: one reading every \
+                     {} from there to {}, {} intervals; a change of its rate, not readings missing (each stretch's \
+                     missing readings are counted at its own interval)",
+                    at(before),
+                    at(after),
+                    row(after.rows.0),
+                    at(after),
+                    row(after.rows.1),
+                    after.intervals()
+                )
+            })
+            .collect();
+        if let Some(most) = self.second_stretches.iter().rev().max_by_key(|s| s.intervals()) {
+            lines.push(format!(
+                "column {column}: the monitor's period is {}, the interval of its stretch with the most readings \
+                 ({} intervals of the column's {}, {} to {}); the monitor steps by each reading's own interval",
+                seconds(period),
+                most.intervals(),
+                self.second_readings.saturating_sub(1),
+                row(most.rows.0),
+                row(most.rows.1)
+            ));
+        }
+        lines
     }
 }
 
@@ -981,13 +1226,12 @@ pub fn replay(raw: &RawParams, log: &Log, mut each: impl FnMut(Tick<'_>)) -> Res
     let tick = 1.0 / hz;
     let t0 = log.time_s[0];
     let ticks = ticks_of(log, hz)?;
-    // A reading interval: the median of the intervals, in whole ticks.
-    let median = |rows: &[usize]| {
-        let mut gaps: Vec<u64> = rows.windows(2).map(|w| ticks[w[1]] - ticks[w[0]]).collect();
-        gaps.sort_unstable();
-        gaps.get(gaps.len() / 2).map_or(1, |&g| g)
+    // A reading interval: the lower median of the intervals, in whole
+    // ticks (of two, the shorter: a missing reading lengthens one).
+    let sample_period = {
+        let mut intervals: Vec<u64> = probe.windows(2).map(|w| ticks[w[1]] - ticks[w[0]]).collect();
+        lower_median(&mut intervals).unwrap_or(1) as f64 * tick
     };
-    let sample_period = median(&probe) as f64 * tick;
     let config = EstimatorConfig::with_sample_period(raw, sample_period)
         .map_err(|e| CliError::Input(format!("--params: {e}")))?;
     check_gaps(log, &ticks, &probe, u64::from(config.stale_after), hz)?;
@@ -1011,18 +1255,30 @@ pub fn replay(raw: &RawParams, log: &Log, mut each: impl FnMut(Tick<'_>)) -> Res
     let mut monitor = None;
     let mut second_readings = 0;
     let mut second_gaps = None;
+    let mut second_stretches = Vec::new();
+    let mut second_intervals = None;
     // The transducer driver's checks on each reading ([`DriverChecks`]).
     let mut checks = None;
     if let (Some(second), Some(sensor)) = (&log.second, SecondSensor::of(raw)?) {
         let rows: Vec<usize> = (0..n).filter(|&i| !second.value[i].is_nan()).collect();
         second_readings = rows.len();
-        // Fewer than two readings have no interval: the file's own period.
-        let m = if rows.len() < 2 {
-            sensor.monitor(f64::from(sensor.settings.period))
-        } else {
-            let period = median(&rows);
-            second_gaps = SecondGaps::of(&rows, &ticks, period);
-            sensor.monitor(period as f64 * tick)
+        second_stretches = stretches(&rows, &ticks);
+        // The period of the stretch with the most readings (the first of
+        // equals); too few readings to measure one: the file's own.
+        let m = match second_stretches.iter().rev().max_by_key(|s| s.intervals()) {
+            Some(most) => {
+                second_gaps = SecondGaps::over(&rows, &ticks, &second_stretches);
+                sensor.monitor(most.period as f64 * tick)
+            }
+            None => {
+                second_intervals = rows
+                    .windows(2)
+                    .map(|w| log.time_s[w[1]] - log.time_s[w[0]])
+                    .fold(None, |r: Option<(f64, f64)>, d| {
+                        Some(r.map_or((d, d), |(lo, hi)| (lo.min(d), hi.max(d))))
+                    });
+                sensor.monitor(f64::from(sensor.settings.period))
+            }
         };
         estimator = estimator
             .with_monitor(m)
@@ -1064,6 +1320,8 @@ pub fn replay(raw: &RawParams, log: &Log, mut each: impl FnMut(Tick<'_>)) -> Res
         monitor,
         second_readings,
         second_gaps,
+        second_stretches,
+        second_intervals,
     })
 }
 
@@ -1401,6 +1659,80 @@ mod tests {
             (g.missing, g.gaps, g.longest, g.longest_missing),
             (30, 1, (89, 120), 30)
         );
+    }
+
+    #[test]
+    fn a_reading_interval_is_the_lower_median() {
+        assert_eq!(lower_median(&mut []), None);
+        assert_eq!(lower_median(&mut [30]), Some(30));
+        // Of two intervals the shorter: the longer may hold a gap.
+        assert_eq!(lower_median(&mut [20, 980]), Some(20));
+        assert_eq!(lower_median(&mut [980, 20]), Some(20));
+        assert_eq!(lower_median(&mut [50, 10, 10]), Some(10));
+        assert_eq!(lower_median(&mut [40, 10, 30, 20]), Some(20));
+    }
+
+    /// Rows `0..n`, row `i` on tick `ticks[i]`: every row a reading.
+    fn stretches_of(ticks: &[u64]) -> Vec<(usize, usize, u64)> {
+        let rows: Vec<usize> = (0..ticks.len()).collect();
+        stretches(&rows, ticks)
+            .iter()
+            .map(|s| (s.readings.0, s.readings.1, s.period))
+            .collect()
+    }
+
+    #[test]
+    fn a_change_of_the_second_sensor_s_rate_is_a_stretch_of_its_own() {
+        // Fewer than 8 intervals: no period measured.
+        assert_eq!(stretches_of(&[0, 10, 20, 30, 40, 50, 60, 70]), []);
+        assert_eq!(stretches_of(&[0, 10, 20, 30, 40, 50, 60, 70, 80]), [(0, 8, 10)]);
+        // A reading every 10 ticks, 100 readings, then every 100: two
+        // stretches meeting on the first reading at 100 (row 100).
+        let mut ticks: Vec<u64> = (0..100).map(|i| 10 * i).collect();
+        ticks.extend((0..20).map(|i| 1000 + 100 * i));
+        assert_eq!(stretches_of(&ticks), [(0, 100, 10), (100, 119, 100)]);
+        // The reverse.
+        let mut ticks: Vec<u64> = (0..20).map(|i| 100 * i).collect();
+        ticks.extend((0..100).map(|i| 2000 + 10 * i));
+        assert_eq!(stretches_of(&ticks), [(0, 20, 100), (20, 119, 10)]);
+        // Back and forth: three.
+        let mut ticks: Vec<u64> = (0..50).map(|i| 10 * i).collect();
+        ticks.extend((0..12).map(|i| 500 + 100 * i));
+        ticks.extend((0..50).map(|i| 1700 + 10 * i));
+        assert_eq!(stretches_of(&ticks), [(0, 50, 10), (50, 62, 100), (62, 111, 10)]);
+        // Seven long intervals in a row are no rate (a gap each): one
+        // stretch, the seven counted missing at its period.
+        let mut ticks: Vec<u64> = (0..50).map(|i| 10 * i).collect();
+        ticks.extend((1..=7).map(|i| 490 + 100 * i));
+        ticks.extend((1..=50).map(|i| 1190 + 10 * i));
+        assert_eq!(stretches_of(&ticks), [(0, 106, 10)]);
+        let rows: Vec<usize> = (0..ticks.len()).collect();
+        let g = SecondGaps::over(&rows, &ticks, &stretches(&rows, &ticks)).unwrap();
+        assert_eq!((g.missing, g.gaps), (63, 7));
+        // Jitter under half a period (intervals of 4 to 16 ticks) moves no
+        // stretch; the lower median of those intervals is 11.
+        let jitter = [0i64, 3, -3, 3, -2, 1, -3, 3, 0, -1, 2, -3, 3, -3, 1, 0, 2, -2, 0, 1];
+        let ticks: Vec<u64> = (0..200)
+            .map(|i: i64| (100 + 10 * i + jitter[i as usize % 20]) as u64)
+            .collect();
+        assert_eq!(stretches_of(&ticks), [(0, 199, 11)]);
+    }
+
+    #[test]
+    fn second_gaps_are_counted_at_their_stretch_s_period() {
+        // Every 10 ticks for 100 readings, then every 100 for 20, the
+        // reading at tick 1500 missing: the slower stretch's intervals are
+        // none missing, the dropped one is one.
+        let mut ticks: Vec<u64> = (0..100).map(|i| 10 * i).collect();
+        ticks.extend((0..20).map(|i| 1000 + 100 * i).filter(|&t| t != 1500));
+        let rows: Vec<usize> = (0..ticks.len()).collect();
+        let s = stretches(&rows, &ticks);
+        assert_eq!(s.iter().map(|s| s.period).collect::<Vec<_>>(), [10, 100]);
+        let g = SecondGaps::over(&rows, &ticks, &s).unwrap();
+        assert_eq!((g.missing, g.gaps, g.longest, g.longest_missing), (1, 1, (104, 105), 1));
+        // One period for the whole column, as before: 17 intervals of 100
+        // ticks, 9 missing each, and the one of 200, 19.
+        assert_eq!(SecondGaps::of(&rows, &ticks, 10).map(|g| g.missing), Some(17 * 9 + 19));
     }
 
     #[test]

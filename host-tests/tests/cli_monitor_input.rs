@@ -416,3 +416,160 @@ fn a_second_sensor_s_jittered_timestamps_are_no_missing_readings() {
         "{err}"
     );
 }
+
+/// The documented log's first three probe rows at 0, 20 and 100 ms (the
+/// interval 20 ms, then 80 ms), the transducer read on each.
+fn three_readings() -> Vec<(String, String, String)> {
+    let rows = documented(2001);
+    [0usize, 2, 10].iter().map(|&i| rows[i].clone()).collect()
+}
+
+/// Three readings have two intervals, and the "median" of two was the
+/// longer: a probe read at 0, 20 and 100 ms was taken as one every 80 ms,
+/// and the transducer's period (the monitor's) as 80 ms where the file
+/// says 10 ms. The probe's interval is now the shorter of the two middle
+/// ones (a reading missing only lengthens one); a second sensor with
+/// fewer than 8 intervals measures no period: the monitor takes the
+/// device file's, and says so.
+#[test]
+fn a_handful_of_readings_measure_no_period() {
+    let log = write("three.csv", "time_s,t_c,p_a_pa", &three_readings());
+    for command in ["monitor", "estimate"] {
+        let mut args = vec![command, "--params", PARAMS, "--sensor-data", path(&log)];
+        if command == "estimate" {
+            args.push("--every-sample");
+        }
+        let (code, _, err) = run_cli(&args);
+        assert_eq!(code, 0, "{command}: {err}");
+        assert!(
+            err.contains(&format!(
+                "{command}: 3 readings (t_c) over 0.1 s, one every 20 ms (the median interval"
+            )),
+            "{command}: {err}"
+        );
+        assert!(
+            err.contains(
+                "3 readings of the second sensor (p_a_pa), one every 10 ms (the monitor's period, the device file's: \
+                 too few readings to measure one)"
+            ),
+            "{command}: {err}"
+        );
+        assert!(
+            err.contains(&format!(
+                "{command}: column p_a_pa: 3 readings, 2 intervals, 20 ms to 80 ms: fewer than the 8 intervals the \
+                 second sensor's period is measured from; the monitor's period is the device file's, 10 ms \
+                 (monitor.sample_hz = 100 Hz), and no reading is counted missing"
+            )),
+            "{command}: {err}"
+        );
+    }
+    // Nine readings, eight intervals, one every 40 ms: measured.
+    let rows: Vec<_> = second_every(4, false).into_iter().take(17).collect();
+    assert_eq!(rows.iter().filter(|r| !r.2.is_empty()).count(), 9);
+    let log = write("nine.csv", "time_s,t_c,p_a_pa", &rows);
+    let (code, _, err) = run_cli(&["monitor", "--params", PARAMS, "--sensor-data", path(&log)]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("9 readings of the second sensor (p_a_pa), one every 40 ms (the monitor's period)\n"),
+        "{err}"
+    );
+}
+
+/// The documented log's first 20 s with the transducer read every 100 ms
+/// up to 10.00 s and every 1 s from there (`slow_first`: every 1 s up to
+/// 10.00 s, every 100 ms from there), without its reading of 15.00 s when
+/// `dropped`; the rows left with neither reading dropped.
+fn second_rate_change(slow_first: bool, dropped: bool) -> Vec<(String, String, String)> {
+    documented(2001)
+        .into_iter()
+        .enumerate()
+        .map(|(i, (t, probe, second))| {
+            let every = if (i < 1000) != slow_first { 10 } else { 100 };
+            let kept = i % every == 0 && !(dropped && i == 1500);
+            (t, probe, if kept { second } else { String::new() })
+        })
+        .filter(|r| !r.1.is_empty() || !r.2.is_empty())
+        .collect()
+}
+
+/// A transducer read at 10 Hz for 10 s, then at 1 Hz (or the reverse),
+/// had one median interval for the log, 100 ms, and each of its 1 s
+/// intervals counted as nine readings missing: 90 over 10 stretches,
+/// where none was. The change of rate is now found (a local median of
+/// the intervals around each that lasts 8 or more), told with its row,
+/// and each stretch's missing readings are counted at its own interval.
+#[test]
+fn a_second_sensor_that_changed_its_rate_misses_no_reading() {
+    let rows = second_rate_change(false, false);
+    assert_eq!(rows.iter().filter(|r| !r.2.is_empty()).count(), 111);
+    let (at, _) = rows_within(&rows, 10.0, 10.0);
+    let (last, _) = rows_within(&rows, 20.0, 20.0);
+    assert_eq!((at, last), (500, 1000));
+    let log = write("rate-change.csv", "time_s,t_c,p_a_pa", &rows);
+    for command in ["monitor", "estimate"] {
+        let (code, _, err) = run_cli(&[command, "--params", PARAMS, "--sensor-data", path(&log)]);
+        assert_eq!(code, 0, "{command}: {err}");
+        // No count of missing readings after the change, nor a stretch
+        // without one.
+        let next = if command == "monitor" { "\n" } else { "; " };
+        assert!(
+            err.contains(&format!(
+                "111 readings of the second sensor (p_a_pa), one every 100 ms (the monitor's period), 1 change of \
+                 rate{next}"
+            )),
+            "{command}: {err}"
+        );
+        assert!(!err.contains("no reading"), "{command}: {err}");
+        assert!(
+            err.contains(&format!(
+                "{command}: column p_a_pa: the second sensor's interval changed from 100 ms to 1 s at row 501 (line \
+                 502, 10 s): one reading every 1 s from there to row 1001 (line 1002, 20 s), 10 intervals; a change \
+                 of its rate, not readings missing"
+            )),
+            "{command}: {err}"
+        );
+        assert!(
+            err.contains(&format!(
+                "{command}: column p_a_pa: the monitor's period is 100 ms, the interval of its stretch with the most \
+                 readings (100 intervals of the column's 110, row 1 (line 2, 0 s) to row 501 (line 502, 10 s))"
+            )),
+            "{command}: {err}"
+        );
+    }
+    // The reverse: 1 s, then 100 ms.
+    let log = write(
+        "rate-change-reverse.csv",
+        "time_s,t_c,p_a_pa",
+        &second_rate_change(true, false),
+    );
+    let (code, _, err) = run_cli(&["monitor", "--params", PARAMS, "--sensor-data", path(&log)]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains(
+            "111 readings of the second sensor (p_a_pa), one every 100 ms (the monitor's period), 1 change of rate\n"
+        ) && err.contains(
+            "monitor: column p_a_pa: the second sensor's interval changed from 1 s to 100 ms at row 501 (line 502, 10 \
+             s): one reading every 100 ms from there to row 1001 (line 1002, 20 s), 100 intervals"
+        ) && err.contains("the monitor's period is 100 ms, the interval of its stretch with the most readings (100 intervals of the column's 110, row 501 (line 502, 10 s) to row 1001 (line 1002, 20 s))"),
+        "{err}"
+    );
+    // The slower stretch's reading of 15.00 s dropped: 1 missing at its
+    // 1 s, due on the rows more than 0.5 s from 14 s and 16 s.
+    let rows = second_rate_change(false, true);
+    let (first, last) = rows_within(&rows, 14.52, 15.48);
+    assert_eq!((first, last), (726, 774));
+    let log = write("rate-change-dropped.csv", "time_s,t_c,p_a_pa", &rows);
+    let (code, _, err) = run_cli(&["monitor", "--params", PARAMS, "--sensor-data", path(&log)]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains(
+            "110 readings of the second sensor (p_a_pa), one every 100 ms (the monitor's period), 1 change of rate, 1 \
+             missing"
+        ) && err.contains(
+            "monitor: column p_a_pa: no reading from row 727 (line 728) to row 775 (line 776): 2 s between the \
+             readings either side, where the second sensor reads one every 1 s; 1 reading missing, the monitor ran \
+             without them\n"
+        ) && err.contains("one reading every 1 s from there to row 1001 (line 1002, 20 s), 9 intervals"),
+        "{err}"
+    );
+}

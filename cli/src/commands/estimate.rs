@@ -57,8 +57,10 @@ estimate:
 The *_sd_* columns are standard uncertainties (k = 1): +-1.96 of them is
 the 95 % band (docs/firmware.md). stderr: the readings, their interval and
 the ticks run; with a second sensor's column, the readings it missed
-(more than 1.5 of its median interval between two of them) and the rows
-of the longest such stretch.
+(more than 1.5 of its period between two of them) and the rows of the
+longest such stretch, where its rate changed (the row, from what
+interval to what), or that its readings are too few (under 8 intervals)
+to measure a period, the device file's taken.
 
 Example:
   compensator estimate --params presets/paper.toml \\

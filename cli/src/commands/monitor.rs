@@ -32,9 +32,12 @@ INNOVATION_REJECTED), in that order; none: a header alone:
   flag; DEVICE_CHANGED above 10), unit (of estimate and sd: 1, Pa, m,
   N or K; a string in JSON as in CSV)
 stderr: what ran, the second sensor's readings missing (more than 1.5 of
-its median interval between two of them: the rows, line numbers and
-length of the longest such stretch), and the health estimate at the
-log's end.
+its period between two of them: the rows, line numbers and length of
+the longest such stretch), where its rate changed (the row, from what
+interval to what; each stretch's missing readings counted at its own),
+or that its readings are too few (under 8 intervals) to measure a
+period, the device file's taken, and the health estimate at the log's
+end.
 --plot FILE.png|svg: the standardised innovations with the gate, the CUSUM
 with its threshold, the divider and spring factors and the offset, each
 with its 95 % band, over time.
