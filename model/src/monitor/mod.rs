@@ -876,7 +876,7 @@ impl Monitor {
         if self.design.quantity != Quantity::Displacement || self.friction_width > 0.0 || !twin.is_finite() {
             return false;
         }
-        let moved = STILL_READING * 1.414_213_6 * self.settings.sd_noise;
+        let moved = STILL_READING * core::f32::consts::SQRT_2 * self.settings.sd_noise;
         if !self.still_reading.is_finite()
             || !self.still_probe.is_finite()
             || libm::fabsf(y - self.still_reading) > moved
@@ -1062,10 +1062,10 @@ impl Monitor {
         if let Some(p) = view.probe {
             self.probe_now = p.value;
         }
-        if let Some(y) = reading {
-            if self.held_still(y, twin, theta[OFFSET], dy_dt, view.oil.state.temperature) {
-                flags.insert(Hypothesis::Sticking.flag(self.design.quantity));
-            }
+        if let Some(y) = reading
+            && self.held_still(y, twin, theta[OFFSET], dy_dt, view.oil.state.temperature)
+        {
+            flags.insert(Hypothesis::Sticking.flag(self.design.quantity));
         }
         // The second sensor's temperature and the signals the lag carries.
         // The twin's transient (its distance from its own equilibrium) is
