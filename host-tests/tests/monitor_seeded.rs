@@ -187,3 +187,26 @@ fn a_ramp_s_end_is_no_held_plunger() {
     assert_eq!(out.false_alarms, 0, "first alarm at {:?} s", out.false_alarm);
     assert!(out.healthy_time >= 800.0, "{} s", out.healthy_time);
 }
+
+/// Design 9's simulated day with the displacement sensor, through the
+/// step of its oil by 0.8 K in 2 s at 15,222 s: the reading stops with
+/// the oil while the probe and the observer's oil are both still short
+/// of it (the observer's estimate of what the probe had left to catch up,
+/// 0.19 K, fell 0.4 K short), and both then travel 0.55 K past the still
+/// reading. A stillness test naming at half the design band's half width
+/// (0.33 K of this design's oil) named sticking 15 s after the step; at
+/// the whole half width (the design friction's) nothing is raised.
+#[test]
+fn a_step_s_end_is_no_held_plunger() {
+    use compensator::estimator::Flags;
+    use host_tests::monitor_campaign::{ALARMS, Replay};
+    let s = healthy(9, Quantity::X, 24.0);
+    let mut replay = Replay::new(&s).unwrap();
+    let mut last = 0.0;
+    while let Some((r, e)) = replay.next_fed().filter(|(r, _)| r.t < 15_300.0) {
+        let alarm = Flags(e.flags.0 & ALARMS.0);
+        assert!(alarm.is_empty(), "{alarm:?} at {} s, oil {:.2} C", r.t, r.t_true);
+        last = r.t;
+    }
+    assert!(last > 15_290.0, "the day ran to {last} s");
+}
