@@ -577,7 +577,7 @@ pub struct Monitor {
     /// The probe's reading at the anchor \[C\], and its last \[C\].
     still_probe: f32,
     probe_now: f32,
-    /// The observer's oil less the probe at the anchor \[K\].
+    /// How far the observer's oil stood from the probe at the anchor \[K\].
     still_gap: f32,
     /// The design band's half width in oil temperature at the last
     /// informed reading \[K\] (`design_width / |dy/dT|`).
@@ -858,20 +858,26 @@ impl Monitor {
     /// named): a plunger held by friction reads still while the free
     /// plunger travels. Its anchor is where reading `y` \[m\] last moved
     /// (by more than [`STILL_READING`] standard deviations of the
-    /// difference of two readings) or stood at a stop: the reading there,
-    /// the twin's plunger (`twin` \[m\]) and the probe's reading. The free
+    /// difference of two readings), stood at a stop, or had no finite
+    /// probe reading or observer's oil beside it: the reading there, the
+    /// twin's plunger (`twin` \[m\]) and the probe's reading. The free
     /// plunger's travel since is the smaller of two that agree in sign:
     /// the twin's, whose oil is the observer's (`oil` \[C\]), which
     /// overshoots a ramp's end by up to a kelvin (on design 3 of the
     /// campaign, at the end of a 0.9 C/s warming, it moved the twin 2.2e-5
-    /// m, a fifth of its design band, past a reading that had stopped with
-    /// the oil); and the probe's, through `dy_dt` \[m/K\], less what the
-    /// probe still had to catch up with the observer's oil at the anchor
-    /// (after a ramp's end the probe goes on by the ramp's rate times its
-    /// time constant). Once that travel reaches [`STILL_TRAVEL`] of the
-    /// design band's half width, the plunger is held by at least the
-    /// design's friction: sticking is named and its band, as wide as the travel,
-    /// enters the prediction. `offset` \[m\]: the filter's, for the stops
+    /// m, more than the design band's half width, past a reading that had
+    /// stopped with the oil); and the probe's, through `dy_dt` \[m/K\],
+    /// less what the probe still had to catch up with the observer's oil
+    /// at the anchor (after a ramp's end the probe goes on by the ramp's
+    /// rate times its time constant). Once that travel reaches
+    /// [`STILL_TRAVEL`] of the design band's half width (and 4 still
+    /// bounds, for a sensor whose noise is that wide), sticking is named:
+    /// the play band's half width, the travel, enters the prediction, the
+    /// monitor's plunger held where the reading stands. The
+    /// band's half width is at least the travel if the plunger stood at
+    /// its middle at the anchor (at rest), at least half of it if at its
+    /// edge (dragged, then reversed): `HealthEstimate::friction` may be up
+    /// to twice the friction. `offset` \[m\]: the filter's, for the stops
     /// ([`Monitor::at_stop`]). Returns whether it named sticking.
     ///
     /// The probe-lag sticking test of the isolation sees a held plunger
@@ -885,6 +891,7 @@ impl Monitor {
         let moved = STILL_READING * core::f32::consts::SQRT_2 * self.settings.sd_noise;
         if !self.still_reading.is_finite()
             || !self.still_probe.is_finite()
+            || !self.still_gap.is_finite()
             || libm::fabsf(y - self.still_reading) > moved
             || self.at_stop(y, offset)
         {
@@ -908,8 +915,11 @@ impl Monitor {
         if !(travel >= STILL_TRAVEL * self.design_width) || travel < 4.0 * moved {
             return false;
         }
+        // The monitor's plunger is held where the reading stands (its
+        // prediction is the reading's); released to the free plunger, it
+        // stood the whole travel off the held reading.
         self.friction_width = travel;
-        self.held = f32::NAN;
+        self.held = y;
         self.still_reading = f32::NAN;
         self.restart_tests();
         true
@@ -1065,7 +1075,7 @@ impl Monitor {
                 None
             }
         };
-        if let Some(p) = view.probe {
+        if let Some(p) = view.probe.filter(|p| p.value.is_finite()) {
             self.probe_now = p.value;
         }
         if let Some(y) = reading
