@@ -920,7 +920,6 @@ impl Monitor {
         // stood the whole travel off the held reading.
         self.friction_width = travel;
         self.held = y;
-        self.still_reading = f32::NAN;
         self.restart_tests();
         true
     }
